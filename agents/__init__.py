@@ -1,0 +1,1 @@
+"""Agent actions (planning, gait, bidding, communication), installed as ``petriflow.agents``."""

@@ -1,0 +1,1 @@
+"""Analysis of nets as free functions (reachability, boundedness, soundness, invariants)."""

@@ -1,0 +1,246 @@
+"""The ``petriflow`` command line.
+
+Exit codes: 0 ok, 1 a check found a problem (e.g. a transition is not enabled),
+2 bad input (unreadable net, unknown transition, malformed marking, bad option).
+Errors are one line on standard error, location first; no traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import warnings
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+from petriflow.engine import Simulation, fire
+from petriflow.errors import NotEnabledError, PetriflowError
+from petriflow.io import load_net
+from petriflow.marking import Marking, parse_marking
+from petriflow.net import Net
+from petriflow.workflow import sink_places, source_places
+
+__all__ = ["main", "build_parser"]
+
+EXIT_OK, EXIT_PROBLEM, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the one-line error style of the rest of the tool."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    print(f"warning: {message}", file=sys.stderr)
+
+
+def _start_marking(net: Net, text: str | None) -> Marking:
+    if text is None:
+        return net.initial_marking
+    try:
+        return parse_marking(text, net.places)
+    except PetriflowError as exc:
+        raise PetriflowError(f"--marking: {exc}") from None
+
+
+def _print_json(data: Any) -> None:
+    json.dump(data, sys.stdout, indent=2)
+    sys.stdout.write("\n")
+
+
+def _format_marking(marking: Marking) -> str:
+    if not marking:
+        return "(empty)"
+    return ", ".join(f"{p}={c}" for p, c in marking.items())
+
+
+# Commands ----------------------------------------------------------------------------
+
+
+def cmd_info(args: argparse.Namespace) -> int:
+    net = load_net(args.net)
+    info = {
+        "net": net.id,
+        "label": net.label,
+        "places": len(net.places),
+        "transitions": len(net.transitions),
+        "arcs": len(net.arcs),
+        "initial_marking": net.initial_marking.to_dict(),
+        "final_marking": None if net.final_marking is None else net.final_marking.to_dict(),
+        "source_places": source_places(net),
+        "sink_places": sink_places(net),
+        "subnets": {
+            s.id: {
+                "label": s.label,
+                "agent": s.agent or s.id,
+                "places": net.nodes_of(s.id)[0],
+                "transitions": net.nodes_of(s.id)[1],
+            }
+            for s in net.subnets.values()
+        },
+        "actions": net.actions(),
+    }
+    if args.json:
+        _print_json(info)
+        return EXIT_OK
+    title = f"{net.id}" + (f" — {net.label}" if net.label else "")
+    print(title)
+    print(f"  {info['places']} places, {info['transitions']} transitions, {info['arcs']} arcs")
+    print(f"  initial marking: {_format_marking(net.initial_marking)}")
+    if net.final_marking is not None:
+        print(f"  final marking:   {_format_marking(net.final_marking)}")
+    print(f"  source places: {', '.join(info['source_places']) or '-'}")
+    print(f"  sink places:   {', '.join(info['sink_places']) or '-'}")
+    if net.subnets:
+        print("  subnets:")
+        for sid, sub in info["subnets"].items():
+            label = f" ({sub['label']})" if sub["label"] else ""
+            print(f"    {sid}{label}: agent {sub['agent']}, {len(sub['places'])} places,"
+                  f" {len(sub['transitions'])} transitions")
+    if info["actions"]:
+        print("  bound actions:")
+        for tid, action in info["actions"].items():
+            params = net.transitions[tid].params
+            shown = f" {json.dumps(params, sort_keys=True)}" if params else ""
+            print(f"    {tid}: {action}{shown}")
+    else:
+        print("  bound actions: none")
+    return EXIT_OK
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    net = load_net(args.net)
+    if args.steps < 0:
+        raise PetriflowError(f"--steps must be >= 0, got {args.steps}")
+    sim = Simulation(net, _start_marking(net, args.marking), seed=args.seed)
+    fired = sim.run(until=args.steps)
+    result = {
+        "net": net.id,
+        "seed": args.seed,
+        "steps": len(fired),
+        "fired": fired,
+        "deadlock": sim.is_dead,
+        "marking": sim.marking.to_dict(),
+    }
+    if args.json:
+        _print_json(result)
+        return EXIT_OK
+    for number, transition in enumerate(fired, start=1):
+        print(f"{number:>6}  {transition}")
+    ending = " (deadlock: no transition enabled)" if sim.is_dead else ""
+    print(f"fired {len(fired)} transitions{ending}")
+    print(f"final marking: {_format_marking(sim.marking)}")
+    return EXIT_OK
+
+
+def cmd_fire(args: argparse.Namespace) -> int:
+    net = load_net(args.net)
+    marking = _start_marking(net, args.marking)
+    for transition in args.transitions:
+        if transition not in net.transitions:  # bad input, checked before anything fires
+            try:
+                net.transition(transition)
+            except PetriflowError as exc:
+                raise PetriflowError(f"{args.net}: {exc}") from None
+    steps = []
+    for number, transition in enumerate(args.transitions, start=1):
+        try:
+            marking = fire(net, marking, transition)
+        except NotEnabledError as exc:
+            if args.json:
+                _print_json({"net": net.id, "fired": steps, "marking": marking.to_dict(),
+                             "error": str(exc), "failed_step": number})
+            print(f"petriflow: {args.net}: step {number}: {exc}", file=sys.stderr)
+            return EXIT_PROBLEM
+        steps.append({"transition": transition, "marking": marking.to_dict()})
+        if not args.json:
+            print(f"{transition:>20} -> {_format_marking(marking)}")
+    if args.json:
+        _print_json({"net": net.id, "fired": steps, "marking": marking.to_dict()})
+    return EXIT_OK
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    net = load_net(args.net)
+    marking = _start_marking(net, args.marking)
+    from petriflow.export import export_net
+
+    export_net(net, args.output, args.format, marking=marking)
+    return EXIT_OK
+
+
+def _reserved(name: str, issue: str) -> Callable[[argparse.Namespace], int]:
+    def command(args: argparse.Namespace) -> int:
+        print(f"petriflow: '{name}' is not available in this version yet ({issue})", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+    return command
+
+
+# Parser ------------------------------------------------------------------------------
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``petriflow`` command."""
+    from petriflow import __version__
+
+    parser = _Parser(prog="petriflow", description="Workflow Petri nets for multi-robot systems.")
+    parser.add_argument("--version", action="version", version=f"petriflow {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    def net_command(name: str, help: str, handler) -> argparse.ArgumentParser:
+        command = sub.add_parser(name, help=help, description=help)
+        command.add_argument("net", help="net file (.yaml, .yml, .pnml or .xml)")
+        command.set_defaults(handler=handler)
+        return command
+
+    info = net_command("info", "Show sizes, subnets and bound actions of a net.", cmd_info)
+    info.add_argument("--json", action="store_true", help="print JSON")
+
+    simulate = net_command("simulate", "Play the random token game.", cmd_simulate)
+    simulate.add_argument("--steps", type=int, default=100, help="firings to make (default 100)")
+    simulate.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    simulate.add_argument("--marking", help='start marking as JSON, e.g. \'{"p1": 1}\'')
+    simulate.add_argument("--json", action="store_true", help="print JSON")
+
+    fire_cmd = net_command("fire", "Fire named transitions in order.", cmd_fire)
+    fire_cmd.add_argument("transitions", nargs="+", metavar="T", help="transition ids")
+    fire_cmd.add_argument("--marking", help="start marking as JSON (default: initial marking)")
+    fire_cmd.add_argument("--json", action="store_true", help="print JSON")
+
+    export = net_command("export", "Convert a net or draw it.", cmd_export)
+    export.add_argument("--format", "-f", required=True,
+                        choices=["pnml", "yaml", "dot", "svg", "png"], help="output format")
+    export.add_argument("--output", "-o", required=True, help="output file")
+    export.add_argument("--marking", help="marking to draw, as JSON (default: initial)")
+
+    run = sub.add_parser("run", help="Run a net over a pybullet world (not yet available).")
+    run.add_argument("net")
+    run.set_defaults(handler=_reserved("run", "the runtime"))
+    check = sub.add_parser("check", help="Analyse a net (not yet available).")
+    check.add_argument("net")
+    check.set_defaults(handler=_reserved("check", "analysis"))
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    warnings.showwarning = _one_line_warning
+    try:
+        return args.handler(args)
+    except PetriflowError as exc:
+        print(f"petriflow: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:
+        return EXIT_OK
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

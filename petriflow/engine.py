@@ -1,0 +1,292 @@
+"""The firing engine: enabled transitions, firing, sequences and the random token game.
+
+Two paths share one semantics (a transition is enabled when every input place holds at
+least the arc weight; firing subtracts the preset and adds the postset):
+
+* :func:`enabled` and :func:`fire` work on :class:`~petriflow.marking.Marking` values
+  and read like the definition, for users and tests;
+* :class:`CompiledNet` turns a net into integer-indexed tuples (and numpy matrices for
+  analysis) once, and :class:`Simulation` plays the token game on a mutable list of
+  counts, re-checking after each firing only the transitions whose preset it touched.
+
+Examples:
+    >>> from petriflow.net import Net
+    >>> net = Net()
+    >>> _ = net.add_place("a", tokens=1); _ = net.add_place("b")
+    >>> _ = net.add_transition("t"); _ = net.add_arc("a", "t"); _ = net.add_arc("t", "b")
+    >>> enabled(net, net.initial_marking)
+    ['t']
+    >>> fire(net, net.initial_marking, "t")
+    Marking({'b': 1})
+    >>> sim = Simulation(net, seed=1)
+    >>> sim.run(until=5)
+    ['t']
+    >>> sim.marking, sim.is_dead
+    (Marking({'b': 1}), True)
+"""
+
+from __future__ import annotations
+
+import random
+from typing import Callable, Iterable, Mapping, Sequence
+
+import numpy as np
+
+from petriflow.errors import NotEnabledError, PetriflowError
+from petriflow.marking import Marking
+from petriflow.net import Net
+
+__all__ = [
+    "Deadlock",
+    "enabled",
+    "is_enabled",
+    "fire",
+    "fire_sequence",
+    "CompiledNet",
+    "Simulation",
+]
+
+
+class Deadlock(PetriflowError):
+    """No transition is enabled (raised by :meth:`Simulation.step`)."""
+
+
+def is_enabled(net: Net, marking: Mapping[str, int], transition: str) -> bool:
+    """Whether ``transition`` may fire in ``marking``."""
+    return all(marking.get(p, 0) >= w for p, w in net.preset(transition).items())
+
+
+def enabled(net: Net, marking: Mapping[str, int]) -> list[str]:
+    """Ids of the transitions enabled in ``marking``, in the net's order."""
+    return [t for t in net.transitions if is_enabled(net, marking, t)]
+
+
+def fire(net: Net, marking: Mapping[str, int], transition: str) -> Marking:
+    """The marking reached by firing ``transition`` in ``marking``.
+
+    Raises:
+        UnknownElementError: no such transition (with a did-you-mean hint).
+        NotEnabledError: the transition is not enabled; names each short place.
+    """
+    pre = net.preset(transition)
+    missing = {p: (marking.get(p, 0), w) for p, w in pre.items() if marking.get(p, 0) < w}
+    if missing:
+        raise NotEnabledError(transition, missing)
+    counts = dict(marking)
+    for place, weight in pre.items():
+        counts[place] -= weight
+    for place, weight in net.postset(transition).items():
+        counts[place] = counts.get(place, 0) + weight
+    return Marking(counts)
+
+
+def fire_sequence(net: Net, marking: Mapping[str, int], transitions: Iterable[str]) -> Marking:
+    """Fire ``transitions`` one after the other; raises at the first one not enabled."""
+    current = net.check_marking(marking)
+    for transition in transitions:
+        current = fire(net, current, transition)
+    return current
+
+
+class CompiledNet:
+    """A net turned into integer-indexed arrays, built once and then only read.
+
+    Attributes:
+        places: place ids; index ``i`` of a count vector is ``places[i]``.
+        transitions: transition ids, indexed likewise.
+        pre: per transition, a tuple of ``(place index, weight)`` it consumes.
+        post: per transition, a tuple of ``(place index, weight)`` it produces.
+        affected: per transition ``t``, the transitions whose enabledness can change
+            when ``t`` fires (those consuming from a place whose count ``t`` changes).
+        pre_matrix, post_matrix, incidence: ``|T| x |P|`` int64 numpy matrices.
+    """
+
+    def __init__(self, net: Net) -> None:
+        self.net = net
+        self.places: list[str] = list(net.places)
+        self.transitions: list[str] = list(net.transitions)
+        self.place_index = {p: i for i, p in enumerate(self.places)}
+        self.transition_index = {t: i for i, t in enumerate(self.transitions)}
+        index = self.place_index
+        self.pre: list[tuple[tuple[int, int], ...]] = []
+        self.post: list[tuple[tuple[int, int], ...]] = []
+        for t in self.transitions:
+            self.pre.append(tuple((index[p], w) for p, w in net.preset(t).items()))
+            self.post.append(tuple((index[p], w) for p, w in net.postset(t).items()))
+        consumers: list[list[int]] = [[] for _ in self.places]
+        for t, pre in enumerate(self.pre):
+            for p, _ in pre:
+                consumers[p].append(t)
+        self.consumers = [tuple(c) for c in consumers]
+        self.affected: list[tuple[int, ...]] = []
+        for t in range(len(self.transitions)):
+            change: dict[int, int] = {}
+            for p, w in self.pre[t]:
+                change[p] = change.get(p, 0) - w
+            for p, w in self.post[t]:
+                change[p] = change.get(p, 0) + w
+            touched = sorted({u for p, d in change.items() if d for u in self.consumers[p]})
+            self.affected.append(tuple(touched))
+        shape = (len(self.transitions), len(self.places))
+        self.pre_matrix = np.zeros(shape, dtype=np.int64)
+        self.post_matrix = np.zeros(shape, dtype=np.int64)
+        for t in range(shape[0]):
+            for p, w in self.pre[t]:
+                self.pre_matrix[t, p] = w
+            for p, w in self.post[t]:
+                self.post_matrix[t, p] = w
+        self.incidence = self.post_matrix - self.pre_matrix
+
+    def vector(self, marking: Mapping[str, int]) -> list[int]:
+        """The marking as a list of counts in place-index order."""
+        vec = [0] * len(self.places)
+        for place, count in marking.items():
+            vec[self.place_index[place]] = count
+        return vec
+
+    def marking(self, vector: Sequence[int]) -> Marking:
+        """The :class:`Marking` of a count vector."""
+        return Marking({self.places[i]: int(c) for i, c in enumerate(vector) if c})
+
+    def is_enabled(self, vector: Sequence[int], t: int) -> bool:
+        """Whether transition index ``t`` is enabled in ``vector``."""
+        for p, w in self.pre[t]:
+            if vector[p] < w:
+                return False
+        return True
+
+    def enabled(self, vector: Sequence[int]) -> list[int]:
+        """Indices of the transitions enabled in ``vector``."""
+        return [t for t in range(len(self.transitions)) if self.is_enabled(vector, t)]
+
+
+FireHandler = Callable[[str, Marking], None]
+
+
+class Simulation:
+    """The random token game, SimPy style: :meth:`step`, :meth:`run`, :meth:`peek`.
+
+    Conflicts are resolved uniformly at random with a seeded generator, so the same
+    net, marking and seed give the same firing sequence.
+
+    Args:
+        net: the net to play.
+        marking: the start marking (default: the net's initial marking).
+        seed: seed of the random choice between enabled transitions.
+        compiled: a :class:`CompiledNet` of ``net`` to reuse.
+    """
+
+    def __init__(
+        self,
+        net: Net,
+        marking: Mapping[str, int] | None = None,
+        *,
+        seed: int | None = None,
+        compiled: CompiledNet | None = None,
+    ) -> None:
+        self.compiled = compiled or CompiledNet(net)
+        self.net = net
+        start = net.initial_marking if marking is None else net.check_marking(marking)
+        self._counts = self.compiled.vector(start)
+        self._rng = random.Random(seed)
+        self._handlers: list[FireHandler] = []
+        self.fired = 0
+        n = len(self.compiled.transitions)
+        self._is_on = [False] * n
+        self._on: list[int] = []
+        self._slot = [0] * n
+        for t in range(n):
+            if self.compiled.is_enabled(self._counts, t):
+                self._switch_on(t)
+
+    def _switch_on(self, t: int) -> None:
+        self._is_on[t] = True
+        self._slot[t] = len(self._on)
+        self._on.append(t)
+
+    def _switch_off(self, t: int) -> None:
+        self._is_on[t] = False
+        slot, last = self._slot[t], self._on.pop()
+        if last != t:
+            self._on[slot] = last
+            self._slot[last] = slot
+
+    def on_fire(self, handler: FireHandler) -> None:
+        """Call ``handler(transition id, marking after)`` after every firing."""
+        self._handlers.append(handler)
+
+    @property
+    def marking(self) -> Marking:
+        """The current marking."""
+        return self.compiled.marking(self._counts)
+
+    @property
+    def is_dead(self) -> bool:
+        """Whether no transition is enabled."""
+        return not self._on
+
+    def peek(self) -> list[str]:
+        """Ids of the enabled transitions, in the net's order."""
+        names = self.compiled.transitions
+        return [names[t] for t in sorted(self._on)]
+
+    def _fire_index(self, t: int) -> None:
+        compiled, counts = self.compiled, self._counts
+        for p, w in compiled.pre[t]:
+            counts[p] -= w
+        for p, w in compiled.post[t]:
+            counts[p] += w
+        pre, is_on = compiled.pre, self._is_on
+        for u in compiled.affected[t]:
+            ok = True
+            for p, w in pre[u]:
+                if counts[p] < w:
+                    ok = False
+                    break
+            if ok != is_on[u]:
+                if ok:
+                    self._switch_on(u)
+                else:
+                    self._switch_off(u)
+        self.fired += 1
+        if self._handlers:
+            name, marking = compiled.transitions[t], self.marking
+            for handler in self._handlers:
+                handler(name, marking)
+
+    def fire(self, transition: str) -> None:
+        """Fire a named transition (raises :class:`NotEnabledError` if it is not enabled)."""
+        self.net.transition(transition)
+        t = self.compiled.transition_index[transition]
+        if not self._is_on[t]:
+            fire(self.net, self.marking, transition)  # raises with the short places named
+        self._fire_index(t)
+
+    def step(self) -> str:
+        """Fire one enabled transition chosen at random and return its id.
+
+        Raises:
+            Deadlock: no transition is enabled.
+        """
+        if not self._on:
+            raise Deadlock(f"no transition is enabled in {self.marking!r}")
+        t = self._on[int(self._rng.random() * len(self._on))]
+        self._fire_index(t)
+        return self.compiled.transitions[t]
+
+    def run(self, until: int | Callable[[Marking], bool]) -> list[str]:
+        """Fire until ``until`` firings were made (an int) or ``until(marking)`` holds,
+        or until no transition is enabled. Returns the ids fired, in order."""
+        fired: list[str] = []
+        if callable(until):
+            while self._on and not until(self.marking):
+                fired.append(self.step())
+            return fired
+        names, on, rng = self.compiled.transitions, self._on, self._rng
+        for _ in range(int(until)):
+            if not on:
+                break
+            t = on[int(rng.random() * len(on))]
+            self._fire_index(t)
+            fired.append(names[t])
+        return fired

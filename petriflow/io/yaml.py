@@ -1,0 +1,501 @@
+"""petriflow's YAML net format (``petriflow: 1``), read and written.
+
+The format is the constructor in data: every key maps onto an argument of
+:meth:`Net.add_place`, :meth:`Net.add_transition`, :meth:`Net.add_arc` or
+:func:`~petriflow.workflow.add_operator`. See ``docs/yaml-format.md``.
+
+Files are parsed with a safe loader (no Python tags) that records line numbers, so an
+error names the line: ``nets/relay.yaml:14: 't9': unknown place 'p9'``.
+
+Examples:
+    >>> net = loads_net('''
+    ... petriflow: 1
+    ... net: demo
+    ... places: [{id: i, tokens: 1}, o]
+    ... transitions:
+    ...   - {id: work, action: robot.move, params: {x: 1}, in: [i], out: [o]}
+    ... ''')
+    >>> net, net.initial_marking, net.transition("work").action
+    (<Net 'demo': 2 places, 1 transitions, 2 arcs>, Marking({'i': 1}), 'robot.move')
+    >>> loads_net(dumps_net(net)).structure() == net.structure()
+    True
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
+from petriflow.net import Net, Operator, Transition
+from petriflow.workflow import add_operator, operator_groups
+
+__all__ = ["FORMAT_VERSION", "load_yaml", "loads_net", "dumps_net", "save_yaml", "net_to_dict"]
+
+#: The version of the YAML format this module reads and writes.
+FORMAT_VERSION = 1
+
+_TOP_KEYS = {"petriflow", "net", "label", "subnets", "places", "transitions", "arcs", "final", "meta"}
+_SUBNET_KEYS = {"id", "label", "agent", "places", "transitions"}
+_PLACE_KEYS = {"id", "label", "tokens", "meta"}
+_TRANSITION_KEYS = {
+    "id", "label", "action", "params", "guard", "priority", "silent",
+    "in", "out", "split", "join", "operator", "meta",
+}
+_ARC_KEYS = {"from", "to", "weight", "id"}
+
+
+class _LineDict(dict):
+    line: int = 0
+
+
+class _LineList(list):
+    line: int = 0
+
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader that records line numbers and rejects duplicate keys."""
+
+
+def _construct_mapping(loader: _Loader, node: yaml.MappingNode) -> _LineDict:
+    loader.flatten_mapping(node)
+    result = _LineDict()
+    result.line = node.start_mark.line + 1
+    for key_node, value_node in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        if key in result:
+            raise NetFormatError(f"duplicate key {key!r}", line=key_node.start_mark.line + 1)
+        result[key] = loader.construct_object(value_node, deep=True)
+    return result
+
+
+def _construct_sequence(loader: _Loader, node: yaml.SequenceNode) -> _LineList:
+    result = _LineList(loader.construct_object(child, deep=True) for child in node.value)
+    result.line = node.start_mark.line + 1
+    return result
+
+
+_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _construct_sequence)
+
+
+def _line(item: Any, default: int | None = None) -> int | None:
+    return getattr(item, "line", default)
+
+
+class _Reader:
+    """Builds a :class:`Net` from parsed YAML, raising errors with line numbers."""
+
+    def __init__(self, data: Any, name: str) -> None:
+        self.data = data
+        self.name = name
+        self.net = Net(name)
+        self.pending_arcs: list[tuple[str, str, Any, int | None, str | None]] = []
+
+    def fail(self, message: str, item: Any = None, element: str | None = None, line=None):
+        raise NetFormatError(message, line=line or _line(item), element=element)
+
+    def check_keys(self, item: Any, allowed: set[str], what: str, element: str | None = None):
+        if not isinstance(item, dict):
+            self.fail(f"{what} must be a mapping, got {type(item).__name__}", item, element)
+        for key in item:
+            if key not in allowed:
+                hint = did_you_mean(str(key), allowed)
+                self.fail(f"unknown key {key!r} in {what}{hint}", item, element)
+
+    def read(self) -> Net:
+        data = self.data
+        if not isinstance(data, dict):
+            self.fail("a petriflow net file is a mapping with 'petriflow: 1' at the top", data, line=1)
+        self.check_keys(data, _TOP_KEYS, "net")
+        version = data.get("petriflow")
+        if version is None:
+            self.fail("missing 'petriflow: 1' version key", data)
+        if version != FORMAT_VERSION:
+            self.fail(f"unsupported format version {version!r}; this petriflow reads {FORMAT_VERSION}", data)
+        if "net" in data:
+            self.net.id = str(data["net"])
+        self.net.label = data.get("label")
+        self.net.meta = dict(data.get("meta") or {})
+        for subnet in self.as_list(data.get("subnets"), "subnets", data):
+            self.read_subnet(subnet)
+        for place in self.as_list(data.get("places"), "places", data):
+            self.read_place(place, None)
+        transitions = self.as_list(data.get("transitions"), "transitions", data)
+        for subnet in self.as_list(data.get("subnets"), "subnets", data):
+            for transition in self.as_list(subnet.get("transitions"), "transitions", subnet):
+                self.read_transition(transition, str(subnet["id"]))
+        for transition in transitions:
+            self.read_transition(transition, None)
+        for arc in self.as_list(data.get("arcs"), "arcs", data):
+            self.read_arc(arc)
+        self.add_pending_arcs()
+        if data.get("final") is not None:
+            final = data["final"]
+            self.net.set_final_marking(self.read_marking(final, "final marking"))
+        return self.net
+
+    def as_list(self, value: Any, what: str, parent: Any) -> list:
+        if value is None:
+            return []
+        if not isinstance(value, list):
+            self.fail(f"'{what}' must be a list", value if hasattr(value, "line") else parent)
+        return value
+
+    def read_subnet(self, item: Any) -> None:
+        self.check_keys(item, _SUBNET_KEYS, "subnet")
+        if "id" not in item:
+            self.fail("subnet without 'id'", item)
+        sid = str(item["id"])
+        if sid in self.net.subnets:
+            self.fail("duplicate subnet id", item, sid)
+        self.net.add_subnet(sid, item.get("label"), item.get("agent"))
+        for place in self.as_list(item.get("places"), "places", item):
+            self.read_place(place, sid)
+
+    def read_place(self, item: Any, subnet: str | None) -> None:
+        if isinstance(item, str):
+            item = _LineDict(id=item)
+        self.check_keys(item, _PLACE_KEYS, "place", item.get("id") if isinstance(item, dict) else None)
+        if "id" not in item:
+            self.fail("place without 'id'", item)
+        pid = str(item["id"])
+        tokens = item.get("tokens", 0)
+        if isinstance(tokens, bool) or not isinstance(tokens, int) or tokens < 0:
+            self.fail(f"tokens must be a whole number >= 0, got {tokens!r}", item, pid)
+        if pid in self.net.places or pid in self.net.transitions:
+            self.fail("duplicate id", item, pid)
+        self.net.add_place(pid, tokens=tokens, label=item.get("label"), subnet=subnet,
+                           meta=dict(item.get("meta") or {}))
+
+    def read_branches(self, value: Any, item: Any, tid: str, key: str) -> dict[str, int]:
+        if value is None:
+            return {}
+        if isinstance(value, str):
+            value = [value]
+        if isinstance(value, list):
+            pairs = [(str(p), 1) for p in value]
+        elif isinstance(value, dict):
+            pairs = [(str(p), w) for p, w in value.items()]
+        else:
+            self.fail(f"'{key}' must be a list of places or a mapping place: weight", item, tid)
+        branches: dict[str, int] = {}
+        for place, weight in pairs:
+            self.check_weight(weight, item, tid)
+            if place not in self.net.places:
+                hint = did_you_mean(place, self.net.places)
+                self.fail(f"'{key}' names unknown place {place!r}{hint}", item, tid)
+            if place in branches:
+                self.fail(f"'{key}' names place {place!r} twice", item, tid)
+            branches[place] = weight
+        return branches
+
+    def check_weight(self, weight: Any, item: Any, element: str | None) -> None:
+        if isinstance(weight, bool) or not isinstance(weight, int) or weight < 1:
+            self.fail(f"arc weight must be a whole number >= 1, got {weight!r}", item, element)
+
+    def read_transition(self, item: Any, subnet: str | None) -> None:
+        self.check_keys(item, _TRANSITION_KEYS, "transition", item.get("id") if isinstance(item, dict) else None)
+        if "id" not in item:
+            self.fail("transition without 'id'", item)
+        tid = str(item["id"])
+        if tid in self.net.places or tid in self.net.transitions:
+            self.fail("duplicate id", item, tid)
+        params = item.get("params") or {}
+        if not isinstance(params, dict):
+            self.fail("'params' must be a mapping", item, tid)
+        priority = item.get("priority", 0)
+        if isinstance(priority, bool) or not isinstance(priority, int):
+            self.fail(f"priority must be a whole number, got {priority!r}", item, tid)
+        attributes: dict[str, Any] = dict(
+            label=item.get("label"),
+            action=item.get("action"),
+            params=_plain(params),
+            guard=item.get("guard"),
+            subnet=subnet,
+            silent=bool(item.get("silent", False)),
+            priority=priority,
+            meta=_plain(item.get("meta") or {}),
+        )
+        for key in ("action", "guard"):
+            if attributes[key] is not None and not isinstance(attributes[key], str):
+                self.fail(f"'{key}' must be a name (a string)", item, tid)
+        inputs = self.read_branches(item.get("in"), item, tid, "in")
+        outputs = self.read_branches(item.get("out"), item, tid, "out")
+        split, join = item.get("split"), item.get("join")
+        try:
+            if split is not None or join is not None:
+                if "operator" in item:
+                    self.fail("give either 'split'/'join' or 'operator', not both", item, tid)
+                if attributes["label"] is None:
+                    attributes["label"] = tid
+                add_operator(self.net, tid, inputs=inputs, outputs=outputs, split=split,
+                             join=join, **attributes)
+                return
+            operator = item.get("operator")
+            if operator is not None:
+                if not isinstance(operator, dict) or "group" not in operator:
+                    self.fail("'operator' must be a mapping with 'group' (and 'split'/'join')", item, tid)
+                attributes["operator"] = Operator(str(operator["group"]), operator.get("split"),
+                                                  operator.get("join"))
+            self.net.add_transition(tid, **attributes)
+            for place, weight in inputs.items():
+                self.net.add_arc(place, tid, weight)
+            for place, weight in outputs.items():
+                self.net.add_arc(tid, place, weight)
+        except NetFormatError:
+            raise
+        except PetriflowError as exc:
+            self.fail(str(exc), item, tid)
+
+    def read_arc(self, item: Any) -> None:
+        if isinstance(item, list) and len(item) in (2, 3):
+            source, target = str(item[0]), str(item[1])
+            weight = item[2] if len(item) == 3 else 1
+            self.pending_arcs.append((source, target, weight, _line(item), None))
+            return
+        self.check_keys(item, _ARC_KEYS, "arc")
+        for key in ("from", "to"):
+            if key not in item:
+                self.fail(f"arc without '{key}'", item)
+        self.pending_arcs.append(
+            (str(item["from"]), str(item["to"]), item.get("weight", 1), _line(item), item.get("id"))
+        )
+
+    def add_pending_arcs(self) -> None:
+        for source, target, weight, line, arc_id in self.pending_arcs:
+            element = f"{source} -> {target}"
+            if isinstance(weight, bool) or not isinstance(weight, int) or weight < 1:
+                self.fail(f"arc weight must be a whole number >= 1, got {weight!r}", line=line,
+                          element=element)
+            nodes = list(self.net.places) + list(self.net.transitions)
+            for end in (source, target):
+                if end not in self.net.places and end not in self.net.transitions:
+                    self.fail(f"arc to unknown node {end!r}{did_you_mean(end, nodes)}", line=line,
+                              element=element)
+            try:
+                self.net.add_arc(source, target, weight, arc_id)
+            except PetriflowError as exc:
+                self.fail(str(exc), line=line, element=element)
+
+    def read_marking(self, value: Any, what: str) -> dict[str, int]:
+        if not isinstance(value, dict):
+            self.fail(f"{what} must be a mapping place: tokens", value)
+        for place, count in value.items():
+            if place not in self.net.places:
+                self.fail(f"{what} names unknown place {place!r}{did_you_mean(str(place), self.net.places)}",
+                          value)
+            if isinstance(count, bool) or not isinstance(count, int) or count < 0:
+                self.fail(f"{what}: tokens of {place!r} must be a whole number >= 0", value)
+        return {str(p): c for p, c in value.items()}
+
+
+def _plain(value: Any) -> Any:
+    """Strip the line-recording containers so parameters are plain dicts and lists."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    return value
+
+
+def loads_net(text: str, *, path: str | None = None, name: str | None = None) -> Net:
+    """Read a net from YAML text.
+
+    Args:
+        text: the YAML document.
+        path: the file it came from, named in errors.
+        name: the net id to use when the file has no ``net:`` key.
+
+    Raises:
+        NetFormatError: malformed YAML or a net that breaks the format's rules.
+    """
+    default = name or (Path(path).stem if path else "net")
+    try:
+        data = yaml.load(text, Loader=_Loader)  # noqa: S506 - _Loader is a SafeLoader
+        return _Reader(data, default).read()
+    except NetFormatError as exc:
+        raise exc.at(path) if path else exc from None
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark else None
+        problem = exc.problem or exc.context or "malformed YAML"
+        raise NetFormatError(f"malformed YAML: {problem}", path=path, line=line) from None
+    except yaml.YAMLError as exc:
+        raise NetFormatError(f"malformed YAML: {exc}", path=path) from None
+
+
+def load_yaml(path: str | Path) -> Net:
+    """Read a net from a YAML file (see :func:`loads_net`)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise NetFormatError(f"cannot read: {exc.strerror or exc}", path=str(path)) from None
+    return loads_net(text, path=str(path))
+
+
+# Writing -----------------------------------------------------------------------------
+
+
+def _transition_dict(net: Net, t: Transition, with_arcs: bool = True) -> dict[str, Any]:
+    entry: dict[str, Any] = {"id": t.id}
+    if t.label is not None:
+        entry["label"] = t.label
+    if t.action is not None:
+        entry["action"] = t.action
+    if t.params:
+        entry["params"] = t.params
+    if t.guard is not None:
+        entry["guard"] = t.guard
+    if t.priority:
+        entry["priority"] = t.priority
+    if t.silent:
+        entry["silent"] = True
+    if t.operator is not None:
+        entry["operator"] = {k: v for k, v in vars(t.operator).items() if v is not None}
+    if with_arcs:
+        entry["in"] = _branches(net.preset(t.id))
+        entry["out"] = _branches(net.postset(t.id))
+    if t.meta:
+        entry["meta"] = t.meta
+    return entry
+
+
+def _branches(weights: Mapping[str, int]) -> list[str] | dict[str, int]:
+    if all(w == 1 for w in weights.values()):
+        return list(weights)
+    return dict(weights)
+
+
+def _folded_operator(net: Net, group: str, parts: list[str]) -> dict[str, Any] | None:
+    """The ``split``/``join`` form of an operator, if it rebuilds exactly ``parts``."""
+    first = net.transitions[parts[0]]
+    operator = first.operator
+    assert operator is not None
+    if any(
+        net.transitions[p].operator != operator
+        or _transition_dict(net, net.transitions[p], False) | {"id": ""}
+        != _transition_dict(net, first, False) | {"id": ""}
+        or net.transitions[p].subnet != first.subnet
+        for p in parts
+    ):
+        return None
+    inputs: dict[str, int] = {}
+    outputs: dict[str, int] = {}
+    for p in parts:
+        inputs.update(net.preset(p))
+        outputs.update(net.postset(p))
+    trial = Net()
+    for place in net.places:
+        trial.add_place(place)
+    try:
+        made = add_operator(trial, group, inputs=inputs, outputs=outputs, split=operator.split,
+                            join=operator.join)
+    except PetriflowError:
+        return None
+    if sorted(made) != sorted(parts) or any(
+        trial.preset(p) != net.preset(p) or trial.postset(p) != net.postset(p) for p in made
+    ):
+        return None
+    entry = _transition_dict(net, first, False)
+    del entry["operator"]
+    entry["id"] = group
+    if entry.get("label") == group:
+        del entry["label"]
+    if operator.join:
+        entry["join"] = operator.join
+    if operator.split:
+        entry["split"] = operator.split
+    entry["in"] = _branches(inputs)
+    entry["out"] = _branches(outputs)
+    return entry
+
+
+def net_to_dict(net: Net) -> dict[str, Any]:
+    """The YAML form of ``net`` as plain data (what :func:`dumps_net` writes)."""
+    transitions_by_subnet: dict[str | None, list[dict[str, Any]]] = {}
+    done: set[str] = set()
+    groups = operator_groups(net)
+    for t in net.transitions.values():
+        if t.id in done:
+            continue
+        entry = None
+        if t.operator is not None:
+            parts = groups[t.operator.group]
+            if t.operator.group not in net.places and (
+                t.operator.group not in net.transitions or parts == [t.operator.group]
+            ):
+                entry = _folded_operator(net, t.operator.group, parts)
+            if entry is not None:
+                done.update(parts)
+        if entry is None:
+            entry = _transition_dict(net, t)
+            done.add(t.id)
+        transitions_by_subnet.setdefault(t.subnet, []).append(entry)
+
+    def place_entry(place) -> dict[str, Any] | str:
+        entry: dict[str, Any] = {"id": place.id}
+        if place.label is not None:
+            entry["label"] = place.label
+        if net.initial_marking[place.id]:
+            entry["tokens"] = net.initial_marking[place.id]
+        if place.meta:
+            entry["meta"] = place.meta
+        return entry if len(entry) > 1 else place.id
+
+    data: dict[str, Any] = {"petriflow": FORMAT_VERSION, "net": net.id}
+    if net.label is not None:
+        data["label"] = net.label
+    if net.subnets:
+        data["subnets"] = []
+        for subnet in net.subnets.values():
+            entry: dict[str, Any] = {"id": subnet.id}
+            if subnet.label is not None:
+                entry["label"] = subnet.label
+            if subnet.agent is not None:
+                entry["agent"] = subnet.agent
+            entry["places"] = [place_entry(p) for p in net.places.values() if p.subnet == subnet.id]
+            entry["transitions"] = transitions_by_subnet.get(subnet.id, [])
+            data["subnets"].append(entry)
+    data["places"] = [place_entry(p) for p in net.places.values() if p.subnet is None]
+    data["transitions"] = transitions_by_subnet.get(None, [])
+    if net.final_marking is not None:
+        data["final"] = net.final_marking.to_dict()
+    if net.meta:
+        data["meta"] = net.meta
+    return data
+
+
+class _Dumper(yaml.SafeDumper):
+    pass
+
+
+def _represent_list(dumper: yaml.SafeDumper, value: list) -> yaml.Node:
+    flow = all(isinstance(v, (str, int, float)) for v in value)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", value, flow_style=flow)
+
+
+def _represent_dict(dumper: yaml.SafeDumper, value: dict) -> yaml.Node:
+    flow = len(value) <= 3 and all(isinstance(v, (str, int, float, bool)) for v in value.values())
+    return dumper.represent_mapping("tag:yaml.org,2002:map", value.items(), flow_style=flow)
+
+
+_Dumper.add_representer(dict, _represent_dict)
+_Dumper.add_representer(list, _represent_list)
+_Dumper.add_representer(tuple, _represent_list)
+
+
+def dumps_net(net: Net) -> str:
+    """The net as YAML text in petriflow's format."""
+    return yaml.dump(net_to_dict(net), Dumper=_Dumper, sort_keys=False, allow_unicode=True,
+                     default_flow_style=False, width=100)
+
+
+def save_yaml(net: Net, path: str | Path) -> None:
+    """Write ``net`` to ``path`` as YAML (atomically: a failed write leaves the old file)."""
+    from petriflow.io.files import write_atomic
+
+    write_atomic(path, dumps_net(net))

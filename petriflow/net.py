@@ -1,0 +1,344 @@
+"""The net model: places, transitions, weighted arcs, subnets.
+
+A :class:`Net` is structure only. Its initial and final markings are :class:`Marking`
+values kept beside the structure; firing never changes a net. Analysis and firing are
+free functions in :mod:`petriflow.engine` and :mod:`petriflow.analysis`.
+
+Examples:
+    >>> net = Net("pingpong")
+    >>> net.add_place("ready", tokens=1)
+    Place(id='ready', label=None, subnet=None, meta={})
+    >>> net.add_place("done")
+    Place(id='done', label=None, subnet=None, meta={})
+    >>> _ = net.add_transition("go", action="robot.move", params={"speed": 0.2})
+    >>> net.add_arc("ready", "go"); net.add_arc("go", "done", weight=2)
+    Arc(source='ready', target='go', weight=1, id=None)
+    Arc(source='go', target='done', weight=2, id=None)
+    >>> net.preset("go"), net.postset("go")
+    ({'ready': 1}, {'done': 2})
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Iterator, Mapping
+
+from petriflow.errors import NetStructureError, UnknownElementError, did_you_mean
+from petriflow.marking import Marking
+
+__all__ = ["Place", "Transition", "Arc", "Subnet", "Operator", "Net", "OPERATOR_KINDS"]
+
+#: The routing kinds of a WF-net operator's split or join side.
+OPERATOR_KINDS = ("and", "xor")
+
+
+@dataclass(frozen=True)
+class Place:
+    """A place. Tokens live in markings, not here.
+
+    Attributes:
+        id: unique id within the net.
+        label: human-readable name (defaults to the id when drawn).
+        subnet: id of the agent subnet the place belongs to, if any.
+        meta: free-form data other tools wrote (graphics position, ...), kept for
+            round-trips; petriflow's semantics never read it.
+    """
+
+    id: str
+    label: str | None = None
+    subnet: str | None = None
+    meta: dict[str, Any] = field(default_factory=dict, compare=False)
+
+
+@dataclass(frozen=True)
+class Operator:
+    """Membership of a transition in a WF-net operator (WoPeD-style AND/XOR split/join).
+
+    An operator ``t`` with an XOR side is expanded into plain P/T transitions
+    ``t_op_1``, ``t_op_2``, ... that all carry ``Operator(group="t", ...)``, so a writer
+    can fold them back into one operator.
+
+    Attributes:
+        group: id of the operator as the user wrote it.
+        split: ``"and"``, ``"xor"`` or ``None`` (a single output branch).
+        join: ``"and"``, ``"xor"`` or ``None`` (a single input branch).
+    """
+
+    group: str
+    split: str | None = None
+    join: str | None = None
+
+
+@dataclass(frozen=True)
+class Transition:
+    """A transition, optionally bound to an agent action.
+
+    Attributes:
+        id: unique id within the net.
+        label: activity label (what an event log calls it); defaults to the id.
+        action: registered action name this transition runs, e.g. ``"vision.capture"``.
+        params: the action's parameters (plain data).
+        guard: registered predicate name that must hold for the transition to fire
+            at run time (no code from files is ever evaluated).
+        subnet: id of the agent subnet the transition belongs to, if any.
+        silent: an invisible (tau) transition: routing only, no event in logs.
+        priority: higher fires first when several are enabled at run time.
+        operator: the WF operator this transition was expanded from, if any.
+        meta: free-form data for round-trips (graphics...), never read by semantics.
+    """
+
+    id: str
+    label: str | None = None
+    action: str | None = None
+    params: dict[str, Any] = field(default_factory=dict, hash=False)
+    guard: str | None = None
+    subnet: str | None = None
+    silent: bool = False
+    priority: int = 0
+    operator: Operator | None = None
+    meta: dict[str, Any] = field(default_factory=dict, compare=False)
+
+
+@dataclass(frozen=True)
+class Arc:
+    """A weighted arc from a place to a transition or from a transition to a place."""
+
+    source: str
+    target: str
+    weight: int = 1
+    id: str | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Subnet:
+    """A named group of places and transitions, typically one agent's part of the net.
+
+    Attributes:
+        id: unique id among subnets.
+        label: readable title (drawn on the cluster).
+        agent: the agent that runs this subnet (defaults to the id).
+    """
+
+    id: str
+    label: str | None = None
+    agent: str | None = None
+
+
+class Net:
+    """A place/transition net with weighted arcs, agent subnets and markings.
+
+    Args:
+        id: the net's id (file name stem by default when loaded).
+        label: readable title.
+
+    Attributes:
+        places: ``{id: Place}`` in insertion order.
+        transitions: ``{id: Transition}`` in insertion order.
+        subnets: ``{id: Subnet}``.
+        initial_marking: the marking the net starts in.
+        final_marking: the marking a run should end in (WF-nets: one token in ``o``),
+            or ``None`` when the file gives none.
+        meta: free-form data kept for round-trips.
+    """
+
+    def __init__(self, id: str = "net", label: str | None = None) -> None:
+        self.id = id
+        self.label = label
+        self.places: dict[str, Place] = {}
+        self.transitions: dict[str, Transition] = {}
+        self.subnets: dict[str, Subnet] = {}
+        self._arcs: dict[tuple[str, str], Arc] = {}
+        self._pre: dict[str, dict[str, int]] = {}
+        self._post: dict[str, dict[str, int]] = {}
+        self.initial_marking: Marking = Marking()
+        self.final_marking: Marking | None = None
+        self.meta: dict[str, Any] = {}
+
+    # Building -----------------------------------------------------------------------
+    def _check_new_id(self, node_id: str) -> None:
+        if not isinstance(node_id, str) or not node_id:
+            raise NetStructureError(f"node id must be a non-empty string, got {node_id!r}")
+        if node_id in self.places or node_id in self.transitions:
+            raise NetStructureError(f"duplicate id {node_id!r}")
+
+    def _check_subnet(self, node_id: str, subnet: str | None) -> None:
+        if subnet is not None and subnet not in self.subnets:
+            raise NetStructureError(
+                f"{node_id!r}: unknown subnet {subnet!r}{did_you_mean(subnet, self.subnets)}"
+            )
+
+    def add_subnet(self, id: str, label: str | None = None, agent: str | None = None) -> Subnet:
+        """Add an agent subnet; nodes join it through their ``subnet`` attribute."""
+        if id in self.subnets:
+            raise NetStructureError(f"duplicate subnet id {id!r}")
+        subnet = Subnet(id, label, agent)
+        self.subnets[id] = subnet
+        return subnet
+
+    def add_place(
+        self,
+        id: str,
+        *,
+        tokens: int = 0,
+        label: str | None = None,
+        subnet: str | None = None,
+        meta: dict[str, Any] | None = None,
+    ) -> Place:
+        """Add a place holding ``tokens`` tokens in the initial marking."""
+        self._check_new_id(id)
+        self._check_subnet(id, subnet)
+        place = Place(id, label, subnet, dict(meta or {}))
+        self.places[id] = place
+        if tokens:
+            self.initial_marking = self.initial_marking + Marking({id: tokens})
+        return place
+
+    def add_transition(self, id: str, **attributes: Any) -> Transition:
+        """Add a transition; ``attributes`` are the fields of :class:`Transition`."""
+        self._check_new_id(id)
+        self._check_subnet(id, attributes.get("subnet"))
+        transition = Transition(id, **attributes)
+        self.transitions[id] = transition
+        self._pre[id] = {}
+        self._post[id] = {}
+        return transition
+
+    def add_arc(self, source: str, target: str, weight: int = 1, id: str | None = None) -> Arc:
+        """Connect a place and a transition (either way) with a positive integer weight."""
+        if isinstance(weight, bool) or not isinstance(weight, int) or weight < 1:
+            raise NetStructureError(
+                f"arc {source!r} -> {target!r}: weight must be a whole number >= 1, got {weight!r}"
+            )
+        if source in self.places and target in self.transitions:
+            self._pre[target][source] = weight
+        elif source in self.transitions and target in self.places:
+            self._post[source][target] = weight
+        else:
+            raise NetStructureError(self._arc_problem(source, target))
+        if (source, target) in self._arcs:
+            raise NetStructureError(f"duplicate arc {source!r} -> {target!r}")
+        arc = Arc(source, target, weight, id)
+        self._arcs[(source, target)] = arc
+        return arc
+
+    def _arc_problem(self, source: str, target: str) -> str:
+        nodes = list(self.places) + list(self.transitions)
+        for end in (source, target):
+            if end not in self.places and end not in self.transitions:
+                return f"arc {source!r} -> {target!r}: unknown node {end!r}{did_you_mean(end, nodes)}"
+        kind = "places" if source in self.places else "transitions"
+        return f"arc {source!r} -> {target!r} joins two {kind}; arcs join a place and a transition"
+
+    def set_initial_marking(self, marking: Mapping[str, int]) -> None:
+        """Replace the initial marking (every place it names must exist)."""
+        self.initial_marking = self.check_marking(marking)
+
+    def set_final_marking(self, marking: Mapping[str, int] | None) -> None:
+        """Replace the final marking (``None``: the net declares none)."""
+        self.final_marking = None if marking is None else self.check_marking(marking)
+
+    def check_marking(self, marking: Mapping[str, int]) -> Marking:
+        """Return ``marking`` as a :class:`Marking`, checking every place exists."""
+        for place in marking:
+            if place not in self.places:
+                raise UnknownElementError("place", place, self.places)
+        return marking if isinstance(marking, Marking) else Marking(marking)
+
+    # Queries ------------------------------------------------------------------------
+    @property
+    def arcs(self) -> list[Arc]:
+        """Every arc, in insertion order."""
+        return list(self._arcs.values())
+
+    def arc(self, source: str, target: str) -> Arc | None:
+        """The arc from ``source`` to ``target``, or ``None``."""
+        return self._arcs.get((source, target))
+
+    def transition(self, id: str) -> Transition:
+        """The transition ``id``; raises :class:`UnknownElementError` with a hint."""
+        try:
+            return self.transitions[id]
+        except KeyError:
+            raise UnknownElementError("transition", id, self.transitions) from None
+
+    def place(self, id: str) -> Place:
+        """The place ``id``; raises :class:`UnknownElementError` with a hint."""
+        try:
+            return self.places[id]
+        except KeyError:
+            raise UnknownElementError("place", id, self.places) from None
+
+    def preset(self, transition: str) -> dict[str, int]:
+        """``{place: weight}`` consumed by ``transition``."""
+        self.transition(transition)
+        return dict(self._pre[transition])
+
+    def postset(self, transition: str) -> dict[str, int]:
+        """``{place: weight}`` produced by ``transition``."""
+        self.transition(transition)
+        return dict(self._post[transition])
+
+    def place_preset(self, place: str) -> dict[str, int]:
+        """``{transition: weight}`` of the transitions that put tokens into ``place``."""
+        self.place(place)
+        return {t: post[place] for t, post in self._post.items() if place in post}
+
+    def place_postset(self, place: str) -> dict[str, int]:
+        """``{transition: weight}`` of the transitions that take tokens from ``place``."""
+        self.place(place)
+        return {t: pre[place] for t, pre in self._pre.items() if place in pre}
+
+    def nodes_of(self, subnet: str) -> tuple[list[str], list[str]]:
+        """``(place ids, transition ids)`` of one subnet."""
+        places = [p.id for p in self.places.values() if p.subnet == subnet]
+        transitions = [t.id for t in self.transitions.values() if t.subnet == subnet]
+        return places, transitions
+
+    def actions(self) -> dict[str, str]:
+        """``{transition id: action name}`` for every bound transition."""
+        return {t.id: t.action for t in self.transitions.values() if t.action}
+
+    def __iter__(self) -> Iterator[str]:
+        yield from self.places
+        yield from self.transitions
+
+    def __repr__(self) -> str:
+        return (
+            f"<Net {self.id!r}: {len(self.places)} places, {len(self.transitions)} transitions,"
+            f" {len(self._arcs)} arcs>"
+        )
+
+    def structure(self) -> tuple:
+        """A comparable summary of the net's semantics (nodes, arcs, markings, bindings).
+
+        Two nets with equal ``structure()`` fire alike and bind the same actions; ids
+        of arcs and graphics are left out.
+        """
+        return (
+            tuple(sorted((p.id, p.label, p.subnet) for p in self.places.values())),
+            tuple(
+                sorted(
+                    (t.id, t.label, t.action, repr(sorted(t.params.items())), t.guard, t.subnet,
+                     t.silent, t.priority, t.operator)
+                    for t in self.transitions.values()
+                )
+            ),
+            tuple(sorted((a.source, a.target, a.weight) for a in self._arcs.values())),
+            tuple(sorted((s.id, s.label, s.agent) for s in self.subnets.values())),
+            tuple(self.initial_marking.items()),
+            None if self.final_marking is None else tuple(self.final_marking.items()),
+        )
+
+    def copy(self) -> "Net":
+        """An independent copy (elements are immutable, so they are shared)."""
+        other = Net(self.id, self.label)
+        other.places = dict(self.places)
+        other.transitions = dict(self.transitions)
+        other.subnets = dict(self.subnets)
+        other._arcs = dict(self._arcs)
+        other._pre = {t: dict(p) for t, p in self._pre.items()}
+        other._post = {t: dict(p) for t, p in self._post.items()}
+        other.initial_marking = self.initial_marking
+        other.final_marking = self.final_marking
+        other.meta = dict(self.meta)
+        return other

@@ -1,0 +1,108 @@
+"""WF-net operators: AND/XOR split and join as plain P/T structure.
+
+WoPeD and the SMART net (seed 003) draw operators such as an AND-split or an XOR-join
+as one box. Their meaning is plain P/T structure:
+
+* an AND side is one transition touching every branch place;
+* an XOR side is one transition per branch place.
+
+:func:`add_operator` builds that structure. Every transition it makes carries an
+:class:`~petriflow.net.Operator` naming the group, so writers can fold it back.
+
+Examples:
+    >>> from petriflow.net import Net
+    >>> net = Net()
+    >>> for p in ("i", "a", "b"):
+    ...     _ = net.add_place(p)
+    >>> add_operator(net, "choose", inputs=["i"], outputs=["a", "b"], split="xor")
+    ['choose_op_1', 'choose_op_2']
+    >>> net.postset("choose_op_2")
+    {'b': 1}
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+from petriflow.errors import NetStructureError
+from petriflow.net import OPERATOR_KINDS, Net, Operator
+
+__all__ = ["add_operator", "operator_groups", "source_places", "sink_places"]
+
+
+def _weights(branches: Sequence[str] | Mapping[str, int]) -> list[tuple[str, int]]:
+    if isinstance(branches, Mapping):
+        return [(p, int(w)) for p, w in branches.items()]
+    return [(p, 1) for p in branches]
+
+
+def add_operator(
+    net: Net,
+    id: str,
+    *,
+    inputs: Sequence[str] | Mapping[str, int],
+    outputs: Sequence[str] | Mapping[str, int],
+    split: str | None = None,
+    join: str | None = None,
+    **attributes: Any,
+) -> list[str]:
+    """Add a WF operator ``id`` and return the ids of the transitions it expands to.
+
+    Args:
+        net: the net to extend (the branch places must exist).
+        id: the operator's id. With no XOR side this is the id of the one transition
+            made; otherwise the parts are ``{id}_op_1``, ``{id}_op_2``, ...
+        inputs: input places (a list, or ``{place: weight}``).
+        outputs: output places (a list, or ``{place: weight}``).
+        split: ``"and"`` or ``"xor"`` routing over ``outputs`` (``None`` = ``"and"``).
+        join: ``"and"`` or ``"xor"`` routing over ``inputs`` (``None`` = ``"and"``).
+        **attributes: fields of :class:`~petriflow.net.Transition` (action, params...)
+            given to every part.
+
+    Raises:
+        NetStructureError: unknown kind, or an XOR side with no branch.
+    """
+    for side, kind in (("split", split), ("join", join)):
+        if kind is not None and kind not in OPERATOR_KINDS:
+            raise NetStructureError(
+                f"operator {id!r}: {side} must be one of {', '.join(OPERATOR_KINDS)}, got {kind!r}"
+            )
+    ins, outs = _weights(inputs), _weights(outputs)
+    in_groups = [[b] for b in ins] if join == "xor" else [ins]
+    out_groups = [[b] for b in outs] if split == "xor" else [outs]
+    if (join == "xor" and not ins) or (split == "xor" and not outs):
+        raise NetStructureError(f"operator {id!r}: an XOR side needs at least one branch")
+    parts = [(i, o) for i in in_groups for o in out_groups]
+    operator = Operator(id, split, join) if (split or join) else None
+    attributes.setdefault("label", id)
+    made = []
+    for number, (in_part, out_part) in enumerate(parts, start=1):
+        part_id = id if len(parts) == 1 else f"{id}_op_{number}"
+        net.add_transition(part_id, operator=operator, **attributes)
+        for place, weight in in_part:
+            net.add_arc(place, part_id, weight)
+        for place, weight in out_part:
+            net.add_arc(part_id, place, weight)
+        made.append(part_id)
+    return made
+
+
+def operator_groups(net: Net) -> dict[str, list[str]]:
+    """``{operator id: [transition ids]}`` for every operator in ``net``."""
+    groups: dict[str, list[str]] = {}
+    for transition in net.transitions.values():
+        if transition.operator is not None:
+            groups.setdefault(transition.operator.group, []).append(transition.id)
+    return groups
+
+
+def source_places(net: Net) -> list[str]:
+    """Places no transition puts tokens into (a WF-net has exactly one: ``i``)."""
+    fed = {a.target for a in net.arcs if a.target in net.places}
+    return [p for p in net.places if p not in fed]
+
+
+def sink_places(net: Net) -> list[str]:
+    """Places no transition takes tokens from (a WF-net has exactly one: ``o``)."""
+    drained = {a.source for a in net.arcs if a.source in net.places}
+    return [p for p in net.places if p not in drained]

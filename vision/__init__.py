@@ -1,0 +1,1 @@
+"""Camera capture and image processing, installed as ``petriflow.vision``."""
