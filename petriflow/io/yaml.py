@@ -118,17 +118,19 @@ class _Reader:
         if "net" in data:
             self.net.id = str(data["net"])
         self.net.label = data.get("label")
-        self.net.meta = dict(data.get("meta") or {})
+        self.net.meta = _plain(data.get("meta") or {})
         for subnet in self.as_list(data.get("subnets"), "subnets", data):
             self.read_subnet(subnet)
-        for place in self.as_list(data.get("places"), "places", data):
-            self.read_place(place, None)
+        places = self.as_list(data.get("places"), "places", data)
+        for place in places:
+            self.read_place(place, None, _line(places))
         transitions = self.as_list(data.get("transitions"), "transitions", data)
         for subnet in self.as_list(data.get("subnets"), "subnets", data):
-            for transition in self.as_list(subnet.get("transitions"), "transitions", subnet):
-                self.read_transition(transition, str(subnet["id"]))
+            members = self.as_list(subnet.get("transitions"), "transitions", subnet)
+            for transition in members:
+                self.read_transition(transition, str(subnet["id"]), _line(members))
         for transition in transitions:
-            self.read_transition(transition, None)
+            self.read_transition(transition, None, _line(transitions))
         for arc in self.as_list(data.get("arcs"), "arcs", data):
             self.read_arc(arc)
         self.add_pending_arcs()
@@ -152,12 +154,14 @@ class _Reader:
         if sid in self.net.subnets:
             self.fail("duplicate subnet id", item, sid)
         self.net.add_subnet(sid, item.get("label"), item.get("agent"))
-        for place in self.as_list(item.get("places"), "places", item):
-            self.read_place(place, sid)
+        places = self.as_list(item.get("places"), "places", item)
+        for place in places:
+            self.read_place(place, sid, _line(places))
 
-    def read_place(self, item: Any, subnet: str | None) -> None:
-        if isinstance(item, str):
-            item = _LineDict(id=item)
+    def read_place(self, item: Any, subnet: str | None, list_line: int | None = None) -> None:
+        if isinstance(item, (str, int)) and not isinstance(item, bool):
+            item = _LineDict(id=str(item))
+            item.line = list_line or 0
         self.check_keys(item, _PLACE_KEYS, "place", item.get("id") if isinstance(item, dict) else None)
         if "id" not in item:
             self.fail("place without 'id'", item)
@@ -168,7 +172,7 @@ class _Reader:
         if pid in self.net.places or pid in self.net.transitions:
             self.fail("duplicate id", item, pid)
         self.net.add_place(pid, tokens=tokens, label=item.get("label"), subnet=subnet,
-                           meta=dict(item.get("meta") or {}))
+                           meta=_plain(item.get("meta") or {}))
 
     def read_branches(self, value: Any, item: Any, tid: str, key: str) -> dict[str, int]:
         if value is None:
@@ -196,7 +200,10 @@ class _Reader:
         if isinstance(weight, bool) or not isinstance(weight, int) or weight < 1:
             self.fail(f"arc weight must be a whole number >= 1, got {weight!r}", item, element)
 
-    def read_transition(self, item: Any, subnet: str | None) -> None:
+    def read_transition(self, item: Any, subnet: str | None, list_line: int | None = None) -> None:
+        if isinstance(item, (str, int)) and not isinstance(item, bool):
+            item = _LineDict(id=str(item))
+            item.line = list_line or 0
         self.check_keys(item, _TRANSITION_KEYS, "transition", item.get("id") if isinstance(item, dict) else None)
         if "id" not in item:
             self.fail("transition without 'id'", item)

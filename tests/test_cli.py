@@ -1,0 +1,122 @@
+"""The petriflow command line: results, exit codes and one-line errors."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from petriflow.cli import main
+from tests.conftest import NETS, SEQUENCE_YAML
+
+INSPECTION = str(NETS / "examples" / "inspection.yaml")
+
+
+@pytest.fixture
+def sequence_file(tmp_path):
+    path = tmp_path / "sequence.yaml"
+    path.write_text(SEQUENCE_YAML)
+    return str(path)
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize("command", ["info", "simulate", "fire", "export", "run", "check"])
+def test_every_command_has_help(command, capsys):
+    """--help works on every command and exits 0."""
+    with pytest.raises(SystemExit) as info:
+        main([command, "--help"])
+    assert info.value.code == 0
+    assert "usage: petriflow" in capsys.readouterr().out
+
+
+def test_info_lists_subnets_and_actions(capsys):
+    """info shows sizes, subnets and bound actions."""
+    code, out, _ = run(capsys, "info", INSPECTION, "--json")
+    data = json.loads(out)
+    assert code == 0
+    assert (data["places"], data["transitions"]) == (9, 8)
+    assert set(data["subnets"]) == {"camera", "planner", "red", "blue"}
+    assert data["actions"]["capture"] == "vision.capture"
+
+
+def test_simulate_is_deterministic_for_a_seed(capsys):
+    """The same seed gives the same firing sequence."""
+    first = json.loads(run(capsys, "simulate", INSPECTION, "--steps", "50", "--seed", "7", "--json")[1])
+    second = json.loads(run(capsys, "simulate", INSPECTION, "--steps", "50", "--seed", "7", "--json")[1])
+    assert first == second
+    assert first["deadlock"] and first["marking"] == {"o": 1}
+
+
+def test_simulate_prints_fired_transitions_and_final_marking(capsys, sequence_file):
+    """Human output lists each firing and the final marking."""
+    code, out, _ = run(capsys, "simulate", sequence_file, "--steps", "5")
+    assert code == 0
+    assert out.splitlines()[:2] == ["     1  a", "     2  b"]
+    assert "final marking: o=2" in out
+
+
+def test_fire_prints_marking_after_each_transition(capsys, sequence_file):
+    """fire shows the marking reached after each named transition."""
+    code, out, _ = run(capsys, "fire", sequence_file, "a", "b", "--json")
+    assert code == 0
+    assert json.loads(out)["marking"] == {"o": 2}
+
+
+def test_fire_from_given_marking(capsys, sequence_file):
+    """--marking replaces the initial marking."""
+    code, out, _ = run(capsys, "fire", sequence_file, "b", "--marking", '{"p": 1}', "--json")
+    assert code == 0 and json.loads(out)["marking"] == {"o": 2}
+
+
+def test_fire_not_enabled_exits_1_naming_step_and_place(capsys, sequence_file):
+    """A transition that cannot fire is reported with its short place; exit 1."""
+    code, _, err = run(capsys, "fire", sequence_file, "b")
+    assert code == 1
+    assert "step 1: transition 'b' is not enabled: p has 0, needs 1" in err
+
+
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["fire", "{net}", "x"], "unknown transition 'x'"),
+        (["fire", "{net}", "a", "--marking", '{"i": 1.5}'], "--marking: place 'i': token count"),
+        (["fire", "{net}", "a", "--marking", '{"zz": 1}'], "unknown place 'zz'"),
+        (["simulate", "{net}", "--steps", "-1"], "--steps must be >= 0"),
+        (["info", "missing.yaml"], "missing.yaml: no such file"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(argv, fragment, capsys, sequence_file):
+    """Bad input: one line on stderr, exit 2, nothing on stdout."""
+    code, out, err = run(capsys, *[a.replace("{net}", sequence_file) for a in argv])
+    assert code == 2
+    assert fragment in err and err.count("\n") == 1
+    assert out == ""
+
+
+def test_malformed_yaml_exits_2_naming_file_and_line(capsys, tmp_path):
+    """A YAML net with a bad arc is named with file and line."""
+    path = tmp_path / "bad.yaml"
+    path.write_text("petriflow: 1\nplaces: [p]\ntransitions:\n  - {id: t, in: [p], out: [nowhere]}\n")
+    code, _, err = run(capsys, "info", str(path))
+    assert code == 2
+    assert err.strip() == f"petriflow: {path}:4: 't': 'out' names unknown place 'nowhere'"
+
+
+def test_reserved_commands_say_not_available(capsys, sequence_file):
+    """run and check exist as names but are not in this version."""
+    assert run(capsys, "run", sequence_file)[0] == 2
+
+
+def test_console_script_runs_without_traceback(tmp_path):
+    """The installed entry point prints one line and no traceback on bad input."""
+    path = tmp_path / "broken.yaml"
+    path.write_text("petriflow: 1\nplaces: [p\n")
+    done = subprocess.run([sys.executable, "-m", "petriflow.cli", "info", str(path)],
+                          capture_output=True, text=True)
+    assert done.returncode == 2
+    assert "Traceback" not in done.stderr and done.stderr.count("\n") == 1
