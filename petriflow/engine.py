@@ -44,6 +44,7 @@ __all__ = [
     "fire_sequence",
     "CompiledNet",
     "Simulation",
+    "variant_id",
 ]
 
 
@@ -61,8 +62,11 @@ def enabled(net: Net, marking: Mapping[str, int]) -> list[str]:
     return [t for t in net.transitions if is_enabled(net, marking, t)]
 
 
-def fire(net: Net, marking: Mapping[str, int], transition: str) -> Marking:
+def fire(net: Net, marking: Mapping[str, int], transition: str, outcome: str | None = None) -> Marking:
     """The marking reached by firing ``transition`` in ``marking``.
+
+    The preset is consumed, the places of the transition's cancellation region are
+    emptied, then the outputs for ``outcome`` (default ``ok``) are produced.
 
     Raises:
         UnknownElementError: no such transition (with a did-you-mean hint).
@@ -75,7 +79,10 @@ def fire(net: Net, marking: Mapping[str, int], transition: str) -> Marking:
     counts = dict(marking)
     for place, weight in pre.items():
         counts[place] -= weight
-    for place, weight in net.postset(transition).items():
+    for node in net.transitions[transition].cancels:
+        if node in net.places:
+            counts[node] = 0
+    for place, weight in net.postset(transition, outcome).items():
         counts[place] = counts.get(place, 0) + weight
     return Marking(counts)
 
@@ -88,31 +95,61 @@ def fire_sequence(net: Net, marking: Mapping[str, int], transitions: Iterable[st
     return current
 
 
+def variant_id(transition: str, outcome: str | None) -> str:
+    """Id of the outcome variant of a transition: ``t`` for ok, ``t@failed`` otherwise.
+
+    Examples:
+        >>> variant_id("walk", "timeout"), variant_id("walk", None)
+        ('walk@timeout', 'walk')
+    """
+    return transition if outcome in (None, "ok") else f"{transition}@{outcome}"
+
+
 class CompiledNet:
     """A net turned into integer-indexed arrays, built once and then only read.
 
+    A transition whose action outcomes are routed (output arcs reserved for
+    ``failed``, ``timeout`` or ``cancelled``) becomes one row per outcome: ``t`` for
+    ok and ``t@failed`` etc., each consuming the same preset and producing its own
+    outputs, so the token game and analysis explore failure routes too. A
+    cancellation region empties its places after the preset is consumed and before
+    the outputs are produced (reset arcs).
+
     Attributes:
         places: place ids; index ``i`` of a count vector is ``places[i]``.
-        transitions: transition ids, indexed likewise.
-        pre: per transition, a tuple of ``(place index, weight)`` it consumes.
-        post: per transition, a tuple of ``(place index, weight)`` it produces.
-        affected: per transition ``t``, the transitions whose enabledness can change
-            when ``t`` fires (those consuming from a place whose count ``t`` changes).
-        pre_matrix, post_matrix, incidence: ``|T| x |P|`` int64 numpy matrices.
+        transitions: row ids (transition ids and outcome variants), indexed likewise.
+        origin: per row, ``(transition id, outcome or None)``.
+        pre: per row, a tuple of ``(place index, weight)`` it consumes.
+        post: per row, a tuple of ``(place index, weight)`` it produces.
+        reset: per row, the place indices its cancellation region empties.
+        has_resets: whether any row empties places (not a plain P/T net then).
+        affected: per row ``t``, the rows whose enabledness can change when ``t``
+            fires (those consuming from a place whose count ``t`` may change).
+        pre_matrix, post_matrix, incidence: ``|rows| x |P|`` int64 numpy matrices
+            (resets are not in them).
     """
 
     def __init__(self, net: Net) -> None:
         self.net = net
         self.places: list[str] = list(net.places)
-        self.transitions: list[str] = list(net.transitions)
         self.place_index = {p: i for i, p in enumerate(self.places)}
-        self.transition_index = {t: i for i, t in enumerate(self.transitions)}
         index = self.place_index
+        self.transitions: list[str] = []
+        self.origin: list[tuple[str, str | None]] = []
         self.pre: list[tuple[tuple[int, int], ...]] = []
         self.post: list[tuple[tuple[int, int], ...]] = []
-        for t in self.transitions:
-            self.pre.append(tuple((index[p], w) for p, w in net.preset(t).items()))
-            self.post.append(tuple((index[p], w) for p, w in net.postset(t).items()))
+        self.reset: list[tuple[int, ...]] = []
+        for t, transition in net.transitions.items():
+            pre = tuple((index[p], w) for p, w in net.preset(t).items())
+            reset = tuple(index[n] for n in transition.cancels if n in index)
+            for outcome in [None, *net.outcomes(t)]:
+                self.transitions.append(variant_id(t, outcome))
+                self.origin.append((t, outcome))
+                self.pre.append(pre)
+                self.post.append(tuple((index[p], w) for p, w in net.postset(t, outcome).items()))
+                self.reset.append(reset)
+        self.has_resets = any(self.reset)
+        self.transition_index = {t: i for i, t in enumerate(self.transitions)}
         consumers: list[list[int]] = [[] for _ in self.places]
         for t, pre in enumerate(self.pre):
             for p, _ in pre:
@@ -120,7 +157,7 @@ class CompiledNet:
         self.consumers = [tuple(c) for c in consumers]
         self.affected: list[tuple[int, ...]] = []
         for t in range(len(self.transitions)):
-            change: dict[int, int] = {}
+            change: dict[int, int] = {p: 1 for p in self.reset[t]}
             for p, w in self.pre[t]:
                 change[p] = change.get(p, 0) - w
             for p, w in self.post[t]:
@@ -234,6 +271,8 @@ class Simulation:
         compiled, counts = self.compiled, self._counts
         for p, w in compiled.pre[t]:
             counts[p] -= w
+        for p in compiled.reset[t]:
+            counts[p] = 0
         for p, w in compiled.post[t]:
             counts[p] += w
         pre, is_on = compiled.pre, self._is_on
@@ -255,9 +294,12 @@ class Simulation:
                 handler(name, marking)
 
     def fire(self, transition: str) -> None:
-        """Fire a named transition (raises :class:`NotEnabledError` if it is not enabled)."""
-        self.net.transition(transition)
+        """Fire a named transition or outcome variant (``t@failed``); raises
+        :class:`NotEnabledError` if it is not enabled."""
+        if transition not in self.compiled.transition_index:
+            self.net.transition(transition)  # raises with a did-you-mean hint
         t = self.compiled.transition_index[transition]
+        transition = self.compiled.origin[t][0]
         if not self._is_on[t]:
             fire(self.net, self.marking, transition)  # raises with the short places named
         self._fire_index(t)

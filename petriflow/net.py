@@ -26,10 +26,13 @@ from typing import Any, Iterator, Mapping
 from petriflow.errors import NetStructureError, UnknownElementError, did_you_mean
 from petriflow.marking import Marking
 
-__all__ = ["Place", "Transition", "Arc", "Subnet", "Operator", "Net", "OPERATOR_KINDS"]
+__all__ = ["Place", "Transition", "Arc", "Subnet", "Operator", "Net", "OPERATOR_KINDS", "OUTCOMES"]
 
 #: The routing kinds of a WF-net operator's split or join side.
 OPERATOR_KINDS = ("and", "xor")
+
+#: Outcomes of an action that output arcs can be reserved for (plain arcs mean ``ok``).
+OUTCOMES = ("failed", "timeout", "cancelled")
 
 
 @dataclass(frozen=True)
@@ -42,12 +45,16 @@ class Place:
         subnet: id of the agent subnet the place belongs to, if any.
         meta: free-form data other tools wrote (graphics position, ...), kept for
             round-trips; petriflow's semantics never read it.
+        channel: name of the communication channel this place stands for, if it
+            carries messages between agents; at run time a channel model decides
+            whether and when a token put here arrives.
     """
 
     id: str
     label: str | None = None
     subnet: str | None = None
     meta: dict[str, Any] = field(default_factory=dict, compare=False)
+    channel: str | None = None
 
 
 @dataclass(frozen=True)
@@ -85,6 +92,10 @@ class Transition:
         priority: higher fires first when several are enabled at run time.
         operator: the WF operator this transition was expanded from, if any.
         meta: free-form data for round-trips (graphics...), never read by semantics.
+        timeout: simulated seconds after which a running action ends with the
+            ``timeout`` outcome (``None``: no limit).
+        cancels: the cancellation region: ids of places emptied and of transitions
+            whose running actions are cancelled when this transition fires.
     """
 
     id: str
@@ -97,16 +108,24 @@ class Transition:
     priority: int = 0
     operator: Operator | None = None
     meta: dict[str, Any] = field(default_factory=dict, compare=False)
+    timeout: float | None = None
+    cancels: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
 class Arc:
-    """A weighted arc from a place to a transition or from a transition to a place."""
+    """A weighted arc from a place to a transition or from a transition to a place.
+
+    Attributes:
+        outcome: on an output arc, the action outcome it is reserved for (one of
+            :data:`OUTCOMES`); ``None`` means the arc produces when the action ends ``ok``.
+    """
 
     source: str
     target: str
     weight: int = 1
     id: str | None = field(default=None, compare=False)
+    outcome: str | None = None
 
 
 @dataclass(frozen=True)
@@ -147,9 +166,10 @@ class Net:
         self.places: dict[str, Place] = {}
         self.transitions: dict[str, Transition] = {}
         self.subnets: dict[str, Subnet] = {}
-        self._arcs: dict[tuple[str, str], Arc] = {}
+        self._arcs: dict[tuple[str, str, str | None], Arc] = {}
         self._pre: dict[str, dict[str, int]] = {}
         self._post: dict[str, dict[str, int]] = {}
+        self._post_outcome: dict[str, dict[str, dict[str, int]]] = {}
         self.initial_marking: Marking = Marking()
         self.final_marking: Marking | None = None
         self.meta: dict[str, Any] = {}
@@ -183,11 +203,12 @@ class Net:
         label: str | None = None,
         subnet: str | None = None,
         meta: dict[str, Any] | None = None,
+        channel: str | None = None,
     ) -> Place:
         """Add a place holding ``tokens`` tokens in the initial marking."""
         self._check_new_id(id)
         self._check_subnet(id, subnet)
-        place = Place(id, label, subnet, dict(meta or {}))
+        place = Place(id, label, subnet, dict(meta or {}), channel)
         self.places[id] = place
         if tokens:
             self.initial_marking = self.initial_marking + Marking({id: tokens})
@@ -197,28 +218,54 @@ class Net:
         """Add a transition; ``attributes`` are the fields of :class:`Transition`."""
         self._check_new_id(id)
         self._check_subnet(id, attributes.get("subnet"))
+        timeout = attributes.get("timeout")
+        if timeout is not None and (isinstance(timeout, bool) or not isinstance(timeout, (int, float))
+                                    or not timeout > 0):
+            raise NetStructureError(f"{id!r}: timeout must be a number of seconds > 0, got {timeout!r}")
+        if "cancels" in attributes:
+            attributes["cancels"] = tuple(attributes["cancels"] or ())
         transition = Transition(id, **attributes)
         self.transitions[id] = transition
         self._pre[id] = {}
         self._post[id] = {}
+        self._post_outcome[id] = {}
         return transition
 
-    def add_arc(self, source: str, target: str, weight: int = 1, id: str | None = None) -> Arc:
-        """Connect a place and a transition (either way) with a positive integer weight."""
+    def add_arc(self, source: str, target: str, weight: int = 1, id: str | None = None,
+                outcome: str | None = None) -> Arc:
+        """Connect a place and a transition (either way) with a positive integer weight.
+
+        ``outcome`` reserves an output arc for an action outcome (see :data:`OUTCOMES`).
+        """
         if isinstance(weight, bool) or not isinstance(weight, int) or weight < 1:
             raise NetStructureError(
                 f"arc {source!r} -> {target!r}: weight must be a whole number >= 1, got {weight!r}"
             )
+        if outcome == "ok":
+            outcome = None
+        if outcome is not None and outcome not in OUTCOMES:
+            raise NetStructureError(
+                f"arc {source!r} -> {target!r}: outcome must be one of ok, {', '.join(OUTCOMES)};"
+                f" got {outcome!r}"
+            )
+        key = (source, target, outcome)
+        if key in self._arcs:
+            raise NetStructureError(f"duplicate arc {source!r} -> {target!r}")
         if source in self.places and target in self.transitions:
+            if outcome is not None:
+                raise NetStructureError(
+                    f"arc {source!r} -> {target!r}: only output arcs can be reserved for an outcome"
+                )
             self._pre[target][source] = weight
         elif source in self.transitions and target in self.places:
-            self._post[source][target] = weight
+            if outcome is None:
+                self._post[source][target] = weight
+            else:
+                self._post_outcome[source].setdefault(outcome, {})[target] = weight
         else:
             raise NetStructureError(self._arc_problem(source, target))
-        if (source, target) in self._arcs:
-            raise NetStructureError(f"duplicate arc {source!r} -> {target!r}")
-        arc = Arc(source, target, weight, id)
-        self._arcs[(source, target)] = arc
+        arc = Arc(source, target, weight, id, outcome)
+        self._arcs[key] = arc
         return arc
 
     def _arc_problem(self, source: str, target: str) -> str:
@@ -250,9 +297,9 @@ class Net:
         """Every arc, in insertion order."""
         return list(self._arcs.values())
 
-    def arc(self, source: str, target: str) -> Arc | None:
-        """The arc from ``source`` to ``target``, or ``None``."""
-        return self._arcs.get((source, target))
+    def arc(self, source: str, target: str, outcome: str | None = None) -> Arc | None:
+        """The arc from ``source`` to ``target`` (for ``outcome``), or ``None``."""
+        return self._arcs.get((source, target, None if outcome == "ok" else outcome))
 
     def transition(self, id: str) -> Transition:
         """The transition ``id``; raises :class:`UnknownElementError` with a hint."""
@@ -273,15 +320,43 @@ class Net:
         self.transition(transition)
         return dict(self._pre[transition])
 
-    def postset(self, transition: str) -> dict[str, int]:
-        """``{place: weight}`` produced by ``transition``."""
+    def postset(self, transition: str, outcome: str | None = None) -> dict[str, int]:
+        """``{place: weight}`` produced by ``transition`` when its action ends with
+        ``outcome`` (default ``ok``: the plain output arcs)."""
         self.transition(transition)
-        return dict(self._post[transition])
+        if outcome is None or outcome == "ok":
+            return dict(self._post[transition])
+        return dict(self._post_outcome[transition].get(outcome, {}))
+
+    def outcomes(self, transition: str) -> list[str]:
+        """The non-``ok`` outcomes ``transition`` has output arcs for, in :data:`OUTCOMES` order."""
+        self.transition(transition)
+        return [o for o in OUTCOMES if o in self._post_outcome[transition]]
 
     def place_preset(self, place: str) -> dict[str, int]:
-        """``{transition: weight}`` of the transitions that put tokens into ``place``."""
+        """``{transition: weight}`` of the transitions that put tokens into ``place``
+        (on any outcome; the largest weight when several outcomes do)."""
         self.place(place)
-        return {t: post[place] for t, post in self._post.items() if place in post}
+        found: dict[str, int] = {}
+        for arc in self._arcs.values():
+            if arc.target == place:
+                found[arc.source] = max(found.get(arc.source, 0), arc.weight)
+        return found
+
+    def check_references(self) -> None:
+        """Check ids that may name nodes added later (cancellation regions).
+
+        Raises:
+            NetStructureError: a cancellation region names an unknown node.
+        """
+        nodes = list(self.places) + list(self.transitions)
+        for transition in self.transitions.values():
+            for node in transition.cancels:
+                if node not in self.places and node not in self.transitions:
+                    raise NetStructureError(
+                        f"{transition.id!r}: cancellation region names unknown node {node!r}"
+                        f"{did_you_mean(node, nodes)}"
+                    )
 
     def place_postset(self, place: str) -> dict[str, int]:
         """``{transition: weight}`` of the transitions that take tokens from ``place``."""
@@ -315,15 +390,15 @@ class Net:
         of arcs and graphics are left out.
         """
         return (
-            tuple(sorted((p.id, p.label, p.subnet) for p in self.places.values())),
+            tuple(sorted((p.id, p.label, p.subnet, p.channel) for p in self.places.values())),
             tuple(
                 sorted(
                     (t.id, t.label, t.action, repr(sorted(t.params.items())), t.guard, t.subnet,
-                     t.silent, t.priority, t.operator)
+                     t.silent, t.priority, t.operator, t.timeout, t.cancels)
                     for t in self.transitions.values()
                 )
             ),
-            tuple(sorted((a.source, a.target, a.weight) for a in self._arcs.values())),
+            tuple(sorted((a.source, a.target, a.weight, a.outcome or "") for a in self._arcs.values())),
             tuple(sorted((s.id, s.label, s.agent) for s in self.subnets.values())),
             tuple(self.initial_marking.items()),
             None if self.final_marking is None else tuple(self.final_marking.items()),
@@ -338,6 +413,9 @@ class Net:
         other._arcs = dict(self._arcs)
         other._pre = {t: dict(p) for t, p in self._pre.items()}
         other._post = {t: dict(p) for t, p in self._post.items()}
+        other._post_outcome = {
+            t: {o: dict(p) for o, p in by.items()} for t, by in self._post_outcome.items()
+        }
         other.initial_marking = self.initial_marking
         other.final_marking = self.final_marking
         other.meta = dict(self.meta)

@@ -29,7 +29,7 @@ from typing import Any, Mapping
 import yaml
 
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
-from petriflow.net import Net, Operator, Transition
+from petriflow.net import OUTCOMES, Net, Operator, Transition
 from petriflow.workflow import add_operator, operator_groups
 
 __all__ = ["FORMAT_VERSION", "load_yaml", "loads_net", "dumps_net", "save_yaml", "net_to_dict"]
@@ -39,12 +39,12 @@ FORMAT_VERSION = 1
 
 _TOP_KEYS = {"petriflow", "net", "label", "subnets", "places", "transitions", "arcs", "final", "meta"}
 _SUBNET_KEYS = {"id", "label", "agent", "places", "transitions"}
-_PLACE_KEYS = {"id", "label", "tokens", "meta"}
+_PLACE_KEYS = {"id", "label", "tokens", "channel", "meta"}
 _TRANSITION_KEYS = {
-    "id", "label", "action", "params", "guard", "priority", "silent",
-    "in", "out", "split", "join", "operator", "meta",
+    "id", "label", "action", "params", "guard", "priority", "silent", "timeout", "cancels",
+    "in", "out", "outcomes", "split", "join", "operator", "meta",
 }
-_ARC_KEYS = {"from", "to", "weight", "id"}
+_ARC_KEYS = {"from", "to", "weight", "id", "when"}
 
 
 class _LineDict(dict):
@@ -92,7 +92,7 @@ class _Reader:
         self.data = data
         self.name = name
         self.net = Net(name)
-        self.pending_arcs: list[tuple[str, str, Any, int | None, str | None]] = []
+        self.pending_arcs: list[tuple[str, str, Any, int | None, str | None, str | None]] = []
 
     def fail(self, message: str, item: Any = None, element: str | None = None, line=None):
         raise NetFormatError(message, line=line or _line(item), element=element)
@@ -134,6 +134,10 @@ class _Reader:
         for arc in self.as_list(data.get("arcs"), "arcs", data):
             self.read_arc(arc)
         self.add_pending_arcs()
+        try:
+            self.net.check_references()
+        except PetriflowError as exc:
+            self.fail(str(exc), data)
         if data.get("final") is not None:
             final = data["final"]
             self.net.set_final_marking(self.read_marking(final, "final marking"))
@@ -171,8 +175,11 @@ class _Reader:
             self.fail(f"tokens must be a whole number >= 0, got {tokens!r}", item, pid)
         if pid in self.net.places or pid in self.net.transitions:
             self.fail("duplicate id", item, pid)
+        channel = item.get("channel")
+        if channel is not None and not isinstance(channel, str):
+            self.fail("'channel' must be a channel name (a string)", item, pid)
         self.net.add_place(pid, tokens=tokens, label=item.get("label"), subnet=subnet,
-                           meta=_plain(item.get("meta") or {}))
+                           meta=_plain(item.get("meta") or {}), channel=channel)
 
     def read_branches(self, value: Any, item: Any, tid: str, key: str) -> dict[str, int]:
         if value is None:
@@ -216,7 +223,18 @@ class _Reader:
         priority = item.get("priority", 0)
         if isinstance(priority, bool) or not isinstance(priority, int):
             self.fail(f"priority must be a whole number, got {priority!r}", item, tid)
+        timeout = item.get("timeout")
+        if timeout is not None and (isinstance(timeout, bool) or not isinstance(timeout, (int, float))
+                                    or not timeout > 0):
+            self.fail(f"timeout must be a number of seconds > 0, got {timeout!r}", item, tid)
+        cancels = item.get("cancels") or []
+        if isinstance(cancels, str):
+            cancels = [cancels]
+        if not isinstance(cancels, list):
+            self.fail("'cancels' must be a list of place and transition ids", item, tid)
         attributes: dict[str, Any] = dict(
+            timeout=None if timeout is None else float(timeout),
+            cancels=tuple(str(c) for c in cancels),
             label=item.get("label"),
             action=item.get("action"),
             params=_plain(params),
@@ -231,7 +249,18 @@ class _Reader:
                 self.fail(f"'{key}' must be a name (a string)", item, tid)
         inputs = self.read_branches(item.get("in"), item, tid, "in")
         outputs = self.read_branches(item.get("out"), item, tid, "out")
+        outcomes = item.get("outcomes") or {}
+        if not isinstance(outcomes, dict):
+            self.fail("'outcomes' must map an outcome (failed, timeout, cancelled) to places", item, tid)
+        routed = {}
+        for outcome, branches in outcomes.items():
+            if outcome not in OUTCOMES:
+                self.fail(f"unknown outcome {outcome!r} in 'outcomes'{did_you_mean(str(outcome), OUTCOMES)}"
+                          f" (one of {', '.join(OUTCOMES)})", item, tid)
+            routed[outcome] = self.read_branches(branches, item, tid, f"outcomes.{outcome}")
         split, join = item.get("split"), item.get("join")
+        if routed and (split is not None or join is not None):
+            self.fail("'outcomes' cannot be combined with 'split'/'join'", item, tid)
         try:
             if split is not None or join is not None:
                 if "operator" in item:
@@ -252,6 +281,9 @@ class _Reader:
                 self.net.add_arc(place, tid, weight)
             for place, weight in outputs.items():
                 self.net.add_arc(tid, place, weight)
+            for outcome, branches in routed.items():
+                for place, weight in branches.items():
+                    self.net.add_arc(tid, place, weight, outcome=outcome)
         except NetFormatError:
             raise
         except PetriflowError as exc:
@@ -261,18 +293,21 @@ class _Reader:
         if isinstance(item, list) and len(item) in (2, 3):
             source, target = str(item[0]), str(item[1])
             weight = item[2] if len(item) == 3 else 1
-            self.pending_arcs.append((source, target, weight, _line(item), None))
+            self.pending_arcs.append((source, target, weight, _line(item), None, None))
             return
         self.check_keys(item, _ARC_KEYS, "arc")
         for key in ("from", "to"):
             if key not in item:
                 self.fail(f"arc without '{key}'", item)
+        when = item.get("when")
+        if when is not None and when != "ok" and when not in OUTCOMES:
+            self.fail(f"'when' must be ok or one of {', '.join(OUTCOMES)}, got {when!r}", item)
         self.pending_arcs.append(
-            (str(item["from"]), str(item["to"]), item.get("weight", 1), _line(item), item.get("id"))
+            (str(item["from"]), str(item["to"]), item.get("weight", 1), _line(item), item.get("id"), when)
         )
 
     def add_pending_arcs(self) -> None:
-        for source, target, weight, line, arc_id in self.pending_arcs:
+        for source, target, weight, line, arc_id, when in self.pending_arcs:
             element = f"{source} -> {target}"
             if isinstance(weight, bool) or not isinstance(weight, int) or weight < 1:
                 self.fail(f"arc weight must be a whole number >= 1, got {weight!r}", line=line,
@@ -283,7 +318,7 @@ class _Reader:
                     self.fail(f"arc to unknown node {end!r}{did_you_mean(end, nodes)}", line=line,
                               element=element)
             try:
-                self.net.add_arc(source, target, weight, arc_id)
+                self.net.add_arc(source, target, weight, arc_id, outcome=when)
             except PetriflowError as exc:
                 self.fail(str(exc), line=line, element=element)
 
@@ -361,11 +396,17 @@ def _transition_dict(net: Net, t: Transition, with_arcs: bool = True) -> dict[st
         entry["priority"] = t.priority
     if t.silent:
         entry["silent"] = True
+    if t.timeout is not None:
+        entry["timeout"] = t.timeout
+    if t.cancels:
+        entry["cancels"] = list(t.cancels)
     if t.operator is not None:
         entry["operator"] = {k: v for k, v in vars(t.operator).items() if v is not None}
     if with_arcs:
         entry["in"] = _branches(net.preset(t.id))
         entry["out"] = _branches(net.postset(t.id))
+        if net.outcomes(t.id):
+            entry["outcomes"] = {o: _branches(net.postset(t.id, o)) for o in net.outcomes(t.id)}
     if t.meta:
         entry["meta"] = t.meta
     return entry
@@ -382,6 +423,8 @@ def _folded_operator(net: Net, group: str, parts: list[str]) -> dict[str, Any] |
     first = net.transitions[parts[0]]
     operator = first.operator
     assert operator is not None
+    if any(net.outcomes(p) for p in parts):
+        return None
     if any(
         net.transitions[p].operator != operator
         or _transition_dict(net, net.transitions[p], False) | {"id": ""}
@@ -449,6 +492,8 @@ def net_to_dict(net: Net) -> dict[str, Any]:
             entry["label"] = place.label
         if net.initial_marking[place.id]:
             entry["tokens"] = net.initial_marking[place.id]
+        if place.channel is not None:
+            entry["channel"] = place.channel
         if place.meta:
             entry["meta"] = place.meta
         return entry if len(entry) > 1 else place.id

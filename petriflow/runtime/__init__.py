@@ -1,0 +1,1 @@
+"""Running nets: actions, the registry, the scheduler, channels, trace and journal."""

@@ -1,0 +1,127 @@
+"""The run journal: an embedded SQLite database (WAL) committed once per firing.
+
+The journal holds what is needed to resume a killed run: the run's inputs (net file
+content, world and run configuration, seed, time limit) and every event, in order.
+Events are buffered and committed together at each firing boundary, so a kill leaves
+the journal at the last complete firing.
+
+Resuming is deterministic re-execution checked against the journal: the scheduler
+runs the same inputs again, compares each event it makes with the journaled one
+(a mismatch is an error, never silently accepted) and only appends events past the
+journal's end. The world resumes with it, since the world is rebuilt by the same
+steps. The resumed trace is therefore the uninterrupted trace, event for event.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from pathlib import Path
+from typing import Any
+
+from petriflow.errors import PetriflowError
+from petriflow.runtime.trace import Event
+
+__all__ = ["Journal", "JournalError", "ResumeMismatch"]
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS run (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS event (
+    seq INTEGER PRIMARY KEY,
+    line TEXT NOT NULL
+);
+"""
+
+
+class JournalError(PetriflowError):
+    """The journal file cannot be used (not a journal, locked, finished...)."""
+
+
+class ResumeMismatch(JournalError):
+    """Re-execution made a different event than the journal holds."""
+
+
+class Journal:
+    """A run journal in a SQLite file.
+
+    Args:
+        path: the database file.
+        inputs: for a new run, the run's inputs (JSON-able); for a resume, ``None``
+            (they are read from the file).
+
+    Attributes:
+        inputs: the run's inputs.
+        journaled: number of events already in the journal when opened.
+    """
+
+    def __init__(self, path: str | Path, inputs: dict[str, Any] | None = None) -> None:
+        self.path = Path(path)
+        resuming = inputs is None
+        if resuming and not self.path.is_file():
+            raise JournalError(f"{self.path}: no such journal")
+        if not resuming and self.path.exists():
+            raise JournalError(f"{self.path}: already exists; use --resume to continue it or pick a new file")
+        try:
+            self._db = sqlite3.connect(str(self.path), isolation_level=None)
+            self._db.execute("PRAGMA journal_mode=WAL")
+            self._db.execute("PRAGMA synchronous=NORMAL")
+            self._db.executescript(_SCHEMA)
+        except sqlite3.DatabaseError as exc:
+            raise JournalError(f"{self.path}: not a petriflow journal ({exc})") from None
+        self._pending: list[Event] = []
+        if resuming:
+            rows = dict(self._db.execute("SELECT key, value FROM run"))
+            if "inputs" not in rows:
+                raise JournalError(f"{self.path}: not a petriflow journal (no run inputs)")
+            self.inputs = json.loads(rows["inputs"])
+            self.finished = rows.get("finished") == "1"
+            self._lines = [line for (line,) in self._db.execute("SELECT line FROM event ORDER BY seq")]
+        else:
+            self.inputs = inputs
+            self.finished = False
+            self._lines = []
+            with self._db:
+                self._db.execute("BEGIN")
+                self._db.execute("INSERT INTO run VALUES ('inputs', ?)", (json.dumps(inputs, sort_keys=True),))
+        self.journaled = len(self._lines)
+
+    def events(self) -> list[Event]:
+        """The events in the journal (committed ones only)."""
+        return [Event.from_dict(json.loads(line)) for line in self._lines]
+
+    def record(self, event: Event) -> None:
+        """Check a re-executed event against the journal, or buffer a new one."""
+        line = event.to_json()
+        if event.seq < self.journaled:
+            if self._lines[event.seq] != line:
+                raise ResumeMismatch(
+                    f"{self.path}: event {event.seq} differs on re-execution:\n"
+                    f"  journal: {self._lines[event.seq]}\n  now:     {line}"
+                )
+            return
+        self._pending.append(event)
+
+    def commit(self) -> None:
+        """Write the buffered events in one transaction (a firing boundary)."""
+        if not self._pending:
+            return
+        with self._db:
+            self._db.execute("BEGIN")
+            self._db.executemany(
+                "INSERT INTO event (seq, line) VALUES (?, ?)",
+                [(e.seq, e.to_json()) for e in self._pending],
+            )
+        self._lines.extend(e.to_json() for e in self._pending)
+        self.journaled = len(self._lines)
+        self._pending.clear()
+
+    def finish(self) -> None:
+        """Commit the rest and mark the run finished."""
+        self.commit()
+        with self._db:
+            self._db.execute("BEGIN")
+            self._db.execute("INSERT OR REPLACE INTO run VALUES ('finished', '1')")
+        self.finished = True
+
+    def close(self) -> None:
+        self._db.close()

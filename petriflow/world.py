@@ -1,0 +1,362 @@
+"""A thin pybullet world built from a description, stepped by the scheduler.
+
+The description is plain data (a ``world.yaml`` beside a net)::
+
+    dt: 0.01                 # seconds per physics step
+    gravity: -9.81
+    plane: true
+    boxes:                   # static (mass 0) or dynamic boxes
+      - {id: wall, size: [4, 0.1, 0.5], position: [0, 2, 0.25], yaw: 0, colour: grey}
+    grid:                    # walls from an occupancy grid ('#' occupied)
+      cell: 0.25
+      height: 0.4
+      origin: [-2, -2]       # world x, y of the grid's lower-left corner
+      rows: ["#####", "#...#", "#####"]   # first row is the top (largest y)
+    robots:
+      - {id: red, urdf: "petriflow.agents:robots/diffdrive.urdf", position: [0, 0],
+         yaw: 0, colour: red, agent: robot_red}
+    cameras:
+      - {id: top, position: [0, 0, 6], target: [0, 0, 0], up: [0, 1, 0], fov: 60,
+         width: 640, height: 480}
+
+A ``urdf`` is a path relative to the description file, or ``"package:path"`` naming a
+file shipped inside an installed Python package (``pybullet_data:r2d2.urdf``). It is
+data; nothing from a world file is imported or evaluated.
+
+pybullet runs in DIRECT mode unless ``gui=True``. Nothing here knows a particular
+robot: actions in ``petriflow.agents`` drive the bodies.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+import math
+import os
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from petriflow.errors import DependencyNotInstalled, NetFormatError, did_you_mean
+
+__all__ = ["World", "Camera", "load_world", "COLOURS"]
+
+#: Named colours (RGBA) a description may use.
+COLOURS = {
+    "red": (0.9, 0.1, 0.1, 1.0),
+    "blue": (0.1, 0.2, 0.9, 1.0),
+    "yellow": (0.95, 0.85, 0.1, 1.0),
+    "green": (0.1, 0.75, 0.2, 1.0),
+    "black": (0.02, 0.02, 0.02, 1.0),
+    "white": (1.0, 1.0, 1.0, 1.0),
+    "grey": (0.45, 0.45, 0.45, 1.0),
+    "orange": (1.0, 0.55, 0.0, 1.0),
+}
+
+_KEYS = {"dt", "gravity", "plane", "boxes", "grid", "robots", "cameras"}
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Silence C-level prints on standard output and error (pybullet announces its
+    build time on import)."""
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        saved = (os.dup(1), os.dup(2))
+    except (OSError, ValueError):  # no real file descriptors (e.g. captured output)
+        yield
+        return
+    try:
+        with open(os.devnull, "w") as devnull:
+            os.dup2(devnull.fileno(), 1)
+            os.dup2(devnull.fileno(), 2)
+            yield
+            _flush_c_stdio()  # C's buffered output would otherwise print at exit
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        os.close(saved[0])
+        os.close(saved[1])
+
+
+def _flush_c_stdio() -> None:
+    try:
+        import ctypes
+
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):  # pragma: no cover - no C library to flush
+        pass
+
+
+def _pybullet():
+    try:
+        with _quiet_stdout():
+            import pybullet
+    except ImportError:  # pragma: no cover - depends on the installation
+        raise DependencyNotInstalled("pybullet is not installed: pip install pybullet") from None
+    return pybullet
+
+
+@dataclass
+class Camera:
+    """A fixed camera; :meth:`capture` renders an RGB frame (H x W x 3, uint8)."""
+
+    world: "World"
+    id: str
+    position: tuple[float, float, float]
+    target: tuple[float, float, float]
+    up: tuple[float, float, float]
+    fov: float
+    width: int
+    height: int
+    near: float = 0.05
+    far: float = 20.0
+
+    def __post_init__(self) -> None:
+        p = self.world.p
+        self.view = p.computeViewMatrix(self.position, self.target, self.up)
+        self.projection = p.computeProjectionMatrixFOV(self.fov, self.width / self.height, self.near, self.far)
+
+    def capture(self):
+        """Render the current scene with pybullet's CPU renderer."""
+        import numpy as np
+
+        p = self.world.p
+        _, _, rgba, _, _ = p.getCameraImage(
+            self.width, self.height, self.view, self.projection,
+            renderer=p.ER_TINY_RENDERER, physicsClientId=self.world.client,
+        )
+        frame = np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)
+        return frame[:, :, :3].copy()
+
+    def project(self, x: float, y: float, z: float = 0.0) -> tuple[float, float]:
+        """Pixel coordinates (column, row) of a world point."""
+        import numpy as np
+
+        view = np.asarray(self.view).reshape(4, 4).T
+        projection = np.asarray(self.projection).reshape(4, 4).T
+        clip = projection @ view @ np.array([x, y, z, 1.0])
+        ndc = clip[:3] / clip[3]
+        return ((ndc[0] + 1) / 2 * self.width, (1 - ndc[1]) / 2 * self.height)
+
+
+class World:
+    """A pybullet physics client built from a description.
+
+    Args:
+        description: the world as plain data (see the module docstring).
+        base: folder that relative URDF paths start from.
+        gui: open pybullet's GUI instead of DIRECT mode.
+        path: the description's file, named in errors.
+    """
+
+    def __init__(self, description: dict[str, Any] | None = None, *, base: str | Path = ".",
+                 gui: bool = False, path: str | None = None) -> None:
+        self.p = _pybullet()
+        self.path = path
+        self.base = Path(base)
+        description = dict(description or {})
+        for key in description:
+            if key not in _KEYS:
+                self._fail(f"unknown key {key!r}{did_you_mean(str(key), _KEYS)}")
+        self.dt = float(description.get("dt", 1.0 / 240.0))
+        if not self.dt > 0:
+            self._fail(f"dt must be > 0, got {self.dt}")
+        p = self.p
+        with _quiet_stdout():
+            self.client = p.connect(p.GUI if gui else p.DIRECT)
+        p.resetSimulation(physicsClientId=self.client)
+        p.setPhysicsEngineParameter(fixedTimeStep=self.dt, deterministicOverlappingPairs=1,
+                                    physicsClientId=self.client)
+        p.setGravity(0, 0, float(description.get("gravity", -9.81)), physicsClientId=self.client)
+        self.bodies: dict[str, int] = {}
+        self.agents: dict[str, str] = {}
+        self.cameras: dict[str, Camera] = {}
+        self.steps = 0
+        if description.get("plane", True):
+            self.bodies["plane"] = self._load_urdf("pybullet_data:plane.urdf", (0, 0, 0), 0.0, fixed=True)
+        for box in description.get("boxes") or []:
+            self.add_box(**self._checked(box, {"id", "size", "position", "yaw", "colour", "mass"}, "box"))
+        if description.get("grid"):
+            self._add_grid(description["grid"])
+        for robot in description.get("robots") or []:
+            self._add_robot(robot)
+        for camera in description.get("cameras") or []:
+            self._add_camera(camera)
+
+    # Building -----------------------------------------------------------------------
+    def _fail(self, message: str, element: str | None = None):
+        raise NetFormatError(message, path=self.path, element=element)
+
+    def _checked(self, entry: Any, keys: set[str], what: str) -> dict[str, Any]:
+        if not isinstance(entry, dict):
+            self._fail(f"a {what} is a mapping, got {entry!r}")
+        for key in entry:
+            if key not in keys:
+                self._fail(f"unknown key {key!r} in {what}{did_you_mean(str(key), keys)}", entry.get("id"))
+        return dict(entry)
+
+    def _colour(self, colour: Any) -> tuple[float, ...]:
+        if isinstance(colour, str):
+            if colour not in COLOURS:
+                self._fail(f"unknown colour {colour!r}{did_you_mean(colour, COLOURS)}")
+            return COLOURS[colour]
+        if isinstance(colour, (list, tuple)) and len(colour) in (3, 4):
+            return tuple(float(c) for c in colour) + ((1.0,) if len(colour) == 3 else ())
+        self._fail(f"a colour is a name or [r, g, b(, a)], got {colour!r}")
+
+    def _resolve(self, reference: str) -> str:
+        package, sep, relative = reference.partition(":")
+        if sep and not Path(reference).exists() and "/" not in package and "\\" not in package:
+            spec = importlib.util.find_spec(package)
+            if spec is None or not spec.submodule_search_locations:
+                self._fail(f"unknown package {package!r} in {reference!r}")
+            candidate = Path(list(spec.submodule_search_locations)[0]) / relative
+        else:
+            candidate = self.base / reference
+        if not candidate.is_file():
+            self._fail(f"URDF not found: {reference!r}")
+        return str(candidate)
+
+    def _load_urdf(self, reference: str, position, yaw: float, fixed: bool = False) -> int:
+        p = self.p
+        orientation = p.getQuaternionFromEuler((0, 0, yaw))
+        try:
+            return p.loadURDF(self._resolve(reference), position, orientation, useFixedBase=fixed,
+                              physicsClientId=self.client)
+        except p.error as exc:
+            self._fail(f"cannot load URDF {reference!r}: {exc}")
+
+    def add_box(self, id: str, size, position, yaw: float = 0.0, colour: Any = "grey",
+                mass: float = 0.0) -> int:
+        """Add a box of full extents ``size`` centred at ``position``."""
+        p = self.p
+        if id in self.bodies:
+            self._fail("duplicate body id", id)
+        half = [float(s) / 2 for s in size]
+        shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=self.client)
+        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=self._colour(colour),
+                                     physicsClientId=self.client)
+        body = p.createMultiBody(float(mass), shape, visual, [float(c) for c in position],
+                                 p.getQuaternionFromEuler((0, 0, float(yaw))), physicsClientId=self.client)
+        self.bodies[id] = body
+        return body
+
+    def _add_grid(self, grid: Any) -> None:
+        grid = self._checked(grid, {"cell", "height", "origin", "rows", "colour"}, "grid")
+        cell = float(grid.get("cell", 0.25))
+        height = float(grid.get("height", 0.4))
+        ox, oy = (float(v) for v in grid.get("origin", (0.0, 0.0)))
+        rows = grid.get("rows") or []
+        if not all(isinstance(r, str) for r in rows):
+            self._fail("grid rows are strings of '#' (occupied) and '.' (free)")
+        for r, row in enumerate(rows):
+            y = oy + (len(rows) - r - 0.5) * cell
+            c = 0
+            while c < len(row):  # merge runs of occupied cells into one box per run
+                if row[c] != "#":
+                    c += 1
+                    continue
+                start = c
+                while c < len(row) and row[c] == "#":
+                    c += 1
+                x = ox + (start + c) / 2 * cell
+                self.add_box(f"grid_{r}_{start}", ((c - start) * cell, cell, height), (x, y, height / 2),
+                             colour=grid.get("colour", "grey"))
+
+    def _add_robot(self, robot: Any) -> None:
+        robot = self._checked(robot, {"id", "urdf", "position", "yaw", "colour", "agent", "z"}, "robot")
+        if "id" not in robot or "urdf" not in robot:
+            self._fail("a robot needs 'id' and 'urdf'")
+        x, y = (float(v) for v in robot.get("position", (0, 0)))
+        body = self._load_urdf(robot["urdf"], (x, y, float(robot.get("z", 0.0))), float(robot.get("yaw", 0.0)))
+        if robot["id"] in self.bodies:
+            self._fail("duplicate body id", robot["id"])
+        self.bodies[robot["id"]] = body
+        self.agents[robot.get("agent", robot["id"])] = robot["id"]
+        if "colour" in robot:
+            self.p.changeVisualShape(body, -1, rgbaColor=self._colour(robot["colour"]),
+                                     physicsClientId=self.client)
+
+    def _add_camera(self, camera: Any) -> None:
+        camera = self._checked(camera, {"id", "position", "target", "up", "fov", "width", "height"}, "camera")
+        cid = camera.get("id", "camera")
+        self.cameras[cid] = Camera(
+            self, cid, tuple(camera.get("position", (0, 0, 5))), tuple(camera.get("target", (0, 0, 0))),
+            tuple(camera.get("up", (0, 1, 0))), float(camera.get("fov", 60)),
+            int(camera.get("width", 640)), int(camera.get("height", 480)),
+        )
+
+    # Running ------------------------------------------------------------------------
+    def step(self) -> None:
+        """Advance physics by one ``dt``."""
+        self.p.stepSimulation(physicsClientId=self.client)
+        self.steps += 1
+
+    @property
+    def time(self) -> float:
+        """Simulated seconds stepped so far."""
+        return self.steps * self.dt
+
+    def body(self, name: str) -> int:
+        """The pybullet body id of a body or of an agent's robot."""
+        name = self.agents.get(name, name)
+        if name not in self.bodies:
+            raise NetFormatError(f"world has no body or agent {name!r}{did_you_mean(name, self.bodies)}",
+                                 path=self.path)
+        return self.bodies[name]
+
+    def pose(self, name: str) -> tuple[float, float, float]:
+        """``(x, y, yaw)`` of a body or agent's robot."""
+        position, orientation = self.p.getBasePositionAndOrientation(self.body(name), physicsClientId=self.client)
+        yaw = self.p.getEulerFromQuaternion(orientation)[2]
+        return (position[0], position[1], yaw)
+
+    def position(self, agent: str) -> tuple[float, float] | None:
+        """``(x, y)`` of an agent's robot, or ``None`` if the agent has no body."""
+        name = self.agents.get(agent, agent)
+        if name not in self.bodies:
+            return None
+        x, y, _ = self.pose(name)
+        return (x, y)
+
+    def distance(self, a: str, b: str) -> float | None:
+        """Distance in metres between two agents' robots (``None`` if either has none)."""
+        pa, pb = self.position(a), self.position(b)
+        if pa is None or pb is None:
+            return None
+        return math.hypot(pa[0] - pb[0], pa[1] - pb[1])
+
+    def camera(self, name: str = "camera") -> Camera:
+        """A camera by id."""
+        if name not in self.cameras:
+            raise NetFormatError(f"world has no camera {name!r}{did_you_mean(name, self.cameras)}",
+                                 path=self.path)
+        return self.cameras[name]
+
+    def close(self) -> None:
+        """Disconnect from pybullet."""
+        try:
+            self.p.disconnect(physicsClientId=self.client)
+        except self.p.error:
+            pass
+
+
+def load_world(path: str | Path, gui: bool = False) -> World:
+    """Build a :class:`World` from a YAML description file (safe loader)."""
+    import yaml
+
+    path = Path(path)
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise NetFormatError(f"cannot read: {exc.strerror or exc}", path=str(path)) from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise NetFormatError(f"malformed YAML: {getattr(exc, 'problem', exc)}", path=str(path),
+                             line=mark.line + 1 if mark else None) from None
+    if data is not None and not isinstance(data, dict):
+        raise NetFormatError("a world description is a mapping", path=str(path))
+    return World(data, base=path.parent, gui=gui, path=str(path))
