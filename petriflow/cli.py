@@ -172,6 +172,59 @@ def cmd_export(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_run(args: argparse.Namespace) -> int:
+    from petriflow.runtime.session import resume, run_files
+
+    if args.resume:
+        if args.db is None:
+            raise PetriflowError("--resume needs --db RUN_DB (the journal of the run to continue)")
+        outcome = resume(args.db, trace=args.trace, xes=args.xes, realtime=args.realtime,
+                         gui=args.gui, progress=not args.json)
+    else:
+        if args.net is None:
+            raise PetriflowError("give the net to run (or --resume --db RUN_DB)")
+        for option, value in (("--until", args.until), ("--max-firings", args.max_firings)):
+            if value is not None and value < 0:
+                raise PetriflowError(f"{option} must be >= 0, got {value}")
+        outcome = run_files(args.net, world=args.world, config=args.config, seed=args.seed,
+                            until=args.until, trace=args.trace, xes=args.xes, db=args.db,
+                            realtime=args.realtime, gui=args.gui, progress=not args.json,
+                            max_firings=args.max_firings)
+    result = outcome.result
+    summary = {
+        "net": outcome.net.id,
+        "reason": result.reason,
+        "time": result.time,
+        "firings": result.firings,
+        "events": result.events,
+        "wall_seconds": round(outcome.wall, 3),
+        "realtime_factor": round(outcome.realtime_factor, 2) if outcome.wall > 0 else None,
+        "marking": result.marking.to_dict(),
+        "error": result.error,
+        "written": outcome.written,
+    }
+    if args.json:
+        _print_json(summary)
+    else:
+        print(f"{outcome.net.id}: {result.reason} at t = {result.time:g} s after {result.firings} firings"
+              f" ({outcome.wall:.2f} s wall, {outcome.realtime_factor:.1f}x real time)")
+        print(f"  final marking: {_format_marking(result.marking)}")
+        if result.error:
+            print(f"  error: {result.error}")
+        for path in outcome.written:
+            print(f"  wrote {path}")
+    problem = result.reason == "failed" or (
+        result.reason == "dead" and outcome.net.final_marking is not None
+    )
+    return EXIT_PROBLEM if problem else EXIT_OK
+
+
+def cmd_replay(args: argparse.Namespace) -> int:
+    from petriflow.runtime.replay import replay
+
+    return replay(args.trace, net_path=args.net, draw=args.draw, at=args.at)
+
+
 def _reserved(name: str, issue: str) -> Callable[[argparse.Namespace], int]:
     def command(args: argparse.Namespace) -> int:
         print(f"petriflow: '{name}' is not available in this version yet ({issue})", file=sys.stderr)
@@ -217,9 +270,36 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("--output", "-o", required=True, help="output file")
     export.add_argument("--marking", help="marking to draw, as JSON (default: initial)")
 
-    run = sub.add_parser("run", help="Run a net over a pybullet world (not yet available).")
-    run.add_argument("net")
-    run.set_defaults(handler=_reserved("run", "the runtime"))
+    run = sub.add_parser(
+        "run", help="Run a net: fire transitions as agent actions over a pybullet world.",
+        description="Run a net: fire transitions as agent actions over a pybullet world. The run"
+        " configuration (seed, limits, world, channels, faults) is --config, or run.yaml beside"
+        " the net when it exists. Exit 0 when the run ends, 1 when an action failed without a"
+        " failure route or the net stopped short of its final marking, 2 on bad input.")
+    run.add_argument("net", nargs="?", help="net file (omit with --resume)")
+    run.add_argument("--world", help="world description (YAML); overrides the configuration's")
+    run.add_argument("--config", help="run configuration (YAML)")
+    run.add_argument("--seed", type=int, help="random seed (overrides the configuration's)")
+    run.add_argument("--until", type=float, help="simulated-time limit in seconds")
+    run.add_argument("--max-firings", type=int, help="stop after this many firings")
+    run.add_argument("--trace", help="write the events as JSON Lines")
+    run.add_argument("--xes", help="write the firings as an XES event log")
+    run.add_argument("--db", help="SQLite run journal (new file; or the one to --resume)")
+    run.add_argument("--resume", action="store_true", help="continue the killed run journaled in --db")
+    run.add_argument("--realtime", action="store_true", help="pace simulated time to the wall clock")
+    run.add_argument("--gui", action="store_true", help="open pybullet's GUI (needs a display)")
+    run.add_argument("--json", action="store_true", help="print the summary as JSON")
+    run.set_defaults(handler=cmd_run)
+
+    replay_cmd = sub.add_parser("replay", help="Print (or draw) the token game of a recorded run.",
+                                description="Print the token game of a recorded run, or draw the"
+                                " marking at one event.")
+    replay_cmd.add_argument("trace", help="trace file written by petriflow run --trace")
+    replay_cmd.add_argument("--net", help="the net, to draw markings")
+    replay_cmd.add_argument("--draw", help="draw the marking (after --at, default: the end) to this"
+                            " .svg/.png/.dot file; needs --net")
+    replay_cmd.add_argument("--at", type=int, help="event number to stop at")
+    replay_cmd.set_defaults(handler=cmd_replay)
     check = sub.add_parser("check", help="Analyse a net (not yet available).")
     check.add_argument("net")
     check.set_defaults(handler=_reserved("check", "analysis"))

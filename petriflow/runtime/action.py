@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import enum
 import inspect
+import random
 from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar, Generator
 
@@ -125,7 +126,8 @@ class ActionContext:
         params: the checked parameters.
         inputs: ``{place id: [token data, ...]}`` consumed by the firing.
         world: the world the run steps (``None`` in a world-less run).
-        rng: a random generator seeded from the run seed and the firing number.
+        rng: a random generator seeded from the run seed and the firing number
+            (made on first use from ``seed``).
         started: simulated time the action started.
         now: current simulated time (updated by the scheduler before each poll).
         result: data given to the output tokens (one value for all outputs, or a
@@ -140,7 +142,7 @@ class ActionContext:
     params: dict[str, Any]
     inputs: dict[str, list[Any]]
     world: Any
-    rng: Any
+    seed: Any
     started: float
     now: float = 0.0
     result: Any = None
@@ -148,6 +150,14 @@ class ActionContext:
     reason: str = ""
     blackboard: dict[str, Any] = field(default_factory=dict)
     emitted: list[tuple[str, dict[str, Any]]] = field(default_factory=list)
+    _rng: random.Random | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def rng(self) -> random.Random:
+        """This firing's random generator (deterministic for the run seed and firing)."""
+        if self._rng is None:
+            self._rng = random.Random(self.seed)
+        return self._rng
 
     @property
     def elapsed(self) -> float:

@@ -163,6 +163,7 @@ class Scheduler:
         self._channels: dict[str, ChannelModel] = dict(self.config.channel_models())
         self.blackboard: dict[str, Any] = {}
         self._started = False
+        self._max_firings: int | None = None
         self._finished: RunResult | None = None
         self._wall_start = 0.0
         for fault in self.config.faults:
@@ -253,7 +254,7 @@ class Scheduler:
         """
         fired_here = 0
         enabled = {t for t in self.net.transitions if self._can_fire(t)}
-        while enabled:
+        while enabled and (self._max_firings is None or self._firings < self._max_firings):
             t = self._choose(sorted(enabled, key=self._order.__getitem__))
             touched = self._fire(t)
             fired_here += 1
@@ -284,16 +285,19 @@ class Scheduler:
             inputs[place] = [queue.popleft() for _ in range(weight)]
         touched = set(inputs)
         agent = self._agent_of[t]
-        self._emit("start", t, agent, firing=firing,
-                   consumed={p: len(v) for p, v in inputs.items()},
-                   inputs={p: [summarize(d) for d in v] for p, v in inputs.items() if any(
-                       d is not None for d in v)})
-        touched |= self._cancel_region(transition, firing)
+        details: dict[str, Any] = {"firing": firing, "consumed": {p: len(v) for p, v in inputs.items()}}
+        carried = {p: [summarize(d) for d in v] for p, v in inputs.items() if any(d is not None for d in v)}
+        if carried:
+            details["inputs"] = carried
+        self._emit("start", t, agent, **details)
+        if transition.cancels:
+            touched |= self._cancel_region(transition, firing)
         bound = self.bound.get(t)
+        now = self.now
         ctx = ActionContext(
             transition=t, agent=agent, params=bound[1] if bound else dict(transition.params),
-            inputs=inputs, world=self.world, rng=random.Random(f"{self.seed}:{firing}"),
-            started=self.now, now=self.now, blackboard=self.blackboard,
+            inputs=inputs, world=self.world, seed=f"{self.seed}:{firing}",
+            started=now, now=now, blackboard=self.blackboard,
         )
         if bound is None:
             ctx.result = ctx.token()
@@ -482,6 +486,49 @@ class Scheduler:
             else:
                 self._apply(kind, payload)
 
+    def set_tokens(self, tokens: dict[str, list[Any]]) -> None:
+        """Replace the tokens (with their data) before the run starts.
+
+        Args:
+            tokens: ``{place: [data, ...]}``; places not named keep no token.
+        """
+        if self._started:
+            raise PetriflowError("tokens can only be set before the run starts")
+        for place in tokens:
+            self.net.place(place)
+        for place in self.tokens:
+            self.tokens[place] = deque(tokens.get(place, []))
+
+    def fire_one(self, transition: str, timeout: float = 60.0) -> RunResult:
+        """Fire ``transition`` now and run only its action until it ends.
+
+        No other transition fires; the world steps as the action needs. This is what
+        :func:`petriflow.testing.fire_one` uses to test one transition on its own.
+
+        Raises:
+            NotEnabledError: the transition cannot fire in the current marking.
+            ActionFailed: its action failed and the net has no failure route.
+        """
+        from petriflow.engine import fire as fire_counts
+
+        self.net.transition(transition)
+        self.start()
+        if not self._can_fire(transition):
+            fire_counts(self.net, self.marking(), transition)  # raises naming short places
+            raise PetriflowError(f"transition {transition!r} cannot fire now (guard false or agent down)")
+        self._fire(transition)
+        limit = self._ticks_at(self.now + timeout)
+        while transition in self._running:
+            target = self._next_tick()
+            if target is None or target > limit:
+                return self._end("until")
+            self._advance_to(target, False)
+            self._apply_due()
+            for running in sorted(self._running.values(), key=lambda r: r.firing):
+                if running.transition in self._running:
+                    self._poll(running)
+        return self._end("fired")
+
     # Main loop ----------------------------------------------------------------------
     def start(self) -> None:
         """Record the run's start (called by :meth:`run` if needed)."""
@@ -530,6 +577,7 @@ class Scheduler:
         """
         until = self.config.until if until is None else until
         limit_tick = None if until is None else self._ticks_at(until)
+        self._max_firings = max_firings
         self.start()
         try:
             while True:

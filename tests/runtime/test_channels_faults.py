@@ -1,0 +1,120 @@
+"""Channels between agents and injected faults."""
+
+import pytest
+
+from petriflow.errors import NetFormatError
+from petriflow.io.yaml import loads_net
+from petriflow.runtime.channels import BusChannel, Message, RangeChannel
+from petriflow.runtime.config import RunConfig
+from petriflow.runtime.scheduler import Scheduler
+from petriflow.testing import StubWorld
+
+TALK = """
+petriflow: 1
+subnets:
+  - id: a
+    places: [{id: a_ready, tokens: 1}, a_done]
+    transitions: [{id: send, action: core.set, params: {value: {size: 4}}, in: [a_ready], out: [a_done, inbox]}]
+  - id: b
+    places: [{id: inbox, channel: radio}, b_done]
+    transitions: [{id: receive, in: [inbox], out: [b_done]}]
+"""
+
+
+def run(config=None, world=None, until=10):
+    scheduler = Scheduler(loads_net(TALK), config=config, world=world)
+    events = []
+    scheduler.on_event(events.append)
+    return scheduler.run(until=until), events
+
+
+def messages(events):
+    return [(e.data["fate"], e.time) for e in events if e.kind == "message"]
+
+
+def test_ideal_channel_delivers_after_its_latency():
+    """A token put in a channel place arrives after the model's delay."""
+    result, events = run(RunConfig(channels={"radio": {"model": "ideal", "latency": 0.25}}))
+    assert messages(events) == [("sent", 0.0), ("delivered", 0.25)]
+    assert result.marking == {"a_done": 1, "b_done": 1}
+
+
+def test_out_of_range_message_is_lost():
+    """The range model drops messages whose RSSI is under the threshold."""
+    config = RunConfig(channels={"radio": {"model": "range", "tx_power_dbm": -40, "exponent": 2.0,
+                                           "threshold_dbm": -63.4375}})
+    near = StubWorld(positions={"a": (0, 0), "b": (1, 0)})
+    far = StubWorld(positions={"a": (0, 0), "b": (30, 0)})
+    assert run(config, near)[0].marking == {"a_done": 1, "b_done": 1}
+    result, events = run(config, far)
+    assert result.marking == {"a_done": 1}
+    assert [e.data["why"] for e in events if e.kind == "message"] == ["channel model"]
+
+
+def test_dropped_link_loses_messages_until_restored():
+    """drop_link loses what the two agents send each other in that window."""
+    config = RunConfig.from_dict({"faults": [{"drop_link": ["a", "b"], "at": 0, "until": 5}]})
+    result, events = run(config)
+    assert result.marking == {"a_done": 1}
+    assert [e.data for e in events if e.kind == "message"][0]["why"] == "link down"
+
+
+def test_killed_agent_stops_and_its_running_action_is_cancelled():
+    """kill stops an agent's running action (outcome cancelled) and its transitions."""
+    net = loads_net("""
+petriflow: 1
+subnets:
+  - {id: r1, places: [{id: go, tokens: 2}, done], transitions: [{id: walk, action: core.wait, params: {seconds: 4}, in: [go], out: [done]}]}
+  - {id: r2, places: [{id: go2, tokens: 1}, done2], transitions: [{id: walk2, action: core.wait, params: {seconds: 6}, in: [go2], out: [done2]}]}
+""")
+    config = RunConfig.from_dict({"faults": [{"kill": "r1", "at": 1}]})
+    scheduler = Scheduler(net, config=config)
+    events = []
+    scheduler.on_event(events.append)
+    result = scheduler.run()
+    ends = [(e.transition, e.data["outcome"], e.time) for e in events if e.kind == "end"]
+    assert ends == [("walk", "cancelled", 1.0), ("walk2", "ok", 6.0)]
+    assert result.marking == {"go": 1, "done2": 1}
+
+
+def test_late_joiner_starts_only_when_it_joins():
+    """An agent that joins at t does nothing before t."""
+    config = RunConfig.from_dict({"faults": [{"join": "a", "at": 3}]})
+    result, events = run(config)
+    first = [e for e in events if e.kind == "start"][0]
+    assert first.time == 3.0 and result.marking == {"a_done": 1, "b_done": 1}
+
+
+def test_faults_must_name_known_agents():
+    """A fault naming an agent the net lacks is bad input."""
+    config = RunConfig.from_dict({"faults": [{"kill": "robot9", "at": 1}]})
+    with pytest.raises(NetFormatError, match="unknown agent 'robot9'"):
+        Scheduler(loads_net(TALK), config=config)
+
+
+def test_unknown_channel_model_is_rejected():
+    """Channel models are looked up by name with a hint."""
+    with pytest.raises(NetFormatError, match="unknown channel model 'rang'.*did you mean 'range'"):
+        RunConfig.from_dict({"channels": {"radio": {"model": "rang"}}})
+
+
+def test_bus_with_arbitration_queues_frames():
+    """On an arbitrated bus a second frame waits for the first."""
+    bus = BusChannel(baud=1000.0, overhead_bits=0)
+    first = bus.deliver(Message("p", "a", "b", None, 0.0, size=10), None)
+    second = bus.deliver(Message("p", "c", "b", None, 0.0, size=10), None)
+    assert (first, second) == (0.08, 0.16)
+
+
+def test_bus_without_arbitration_loses_colliding_frame():
+    """Without arbitration a frame sent onto a busy bus is lost."""
+    bus = BusChannel(baud=1000.0, overhead_bits=0, arbitration=False)
+    assert bus.deliver(Message("p", "a", "b", None, 0.0, size=10), None) == 0.08
+    assert bus.deliver(Message("p", "c", "b", None, 0.05, size=10), None) is None
+    assert bus.deliver(Message("p", "c", "b", None, 0.09, size=10), None) == pytest.approx(0.08)
+
+
+def test_range_model_rssi_falls_with_distance():
+    """RSSI follows the log-distance law: -20 dB per decade at exponent 2."""
+    radio = RangeChannel(tx_power_dbm=-40.0, exponent=2.0)
+    assert radio.rssi(1.0) - radio.rssi(10.0) == pytest.approx(20.0)
