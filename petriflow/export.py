@@ -1,0 +1,407 @@
+"""Drawing nets with Graphviz, and exporting them in every format petriflow writes.
+
+:func:`to_dot` turns a net (and a marking) into Graphviz DOT text: places are circles
+holding their tokens, transitions are boxes naming the action they run, agent subnets
+are labelled clusters, and the layout flows left to right. :func:`render` runs the
+``dot`` program to make SVG or PNG, and :func:`export_net` is what ``petriflow export``
+calls for any of ``pnml``, ``yaml``, ``dot``, ``svg`` and ``png``.
+
+Only ``dot`` itself is needed for pictures (no Python Graphviz binding); DOT text can
+be made without it.
+
+Examples:
+    >>> from petriflow.net import Net
+    >>> net = Net("demo")
+    >>> _ = net.add_place("ready", tokens=1)
+    >>> _ = net.add_place("done")
+    >>> _ = net.add_transition("go", action="robot.move")
+    >>> _ = net.add_arc("ready", "go"), net.add_arc("go", "done", weight=2)
+    >>> source = to_dot(net)
+    >>> source.startswith('digraph "demo" {'), "rankdir=LR" in source
+    (True, True)
+    >>> print(next(line.strip() for line in source.splitlines() if "->" in line))
+    "ready" -> "go";
+"""
+
+from __future__ import annotations
+
+import html
+import re
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Mapping, Sequence
+
+from petriflow.errors import DependencyNotInstalled, PetriflowError, UnknownElementError
+from petriflow.net import Net
+
+__all__ = [
+    "to_dot", "render", "export_net", "EXPORT_FORMATS", "PICTURE_FORMATS", "DOT_EXECUTABLE",
+    "HIGHLIGHT_COLOUR",
+]
+
+#: Every format :func:`export_net` writes.
+EXPORT_FORMATS = ("pnml", "yaml", "dot", "svg", "png")
+#: The formats :func:`render` makes with Graphviz.
+PICTURE_FORMATS = ("svg", "png")
+#: Name (or path) of the Graphviz layout program; looked up on ``PATH``.
+DOT_EXECUTABLE = "dot"
+#: Seconds ``dot`` may run before :func:`render` gives up.
+DOT_TIMEOUT_S = 60.0
+#: Resolution of PNG pictures (Graphviz's default of 96 is blurry for small labels).
+PNG_DPI = 150
+
+_MISSING_DOT = "Graphviz 'dot' not found: run scripts/setup.sh or apt-get install graphviz"
+
+# Colours and sizes. Inches for sizes, points for fonts, as Graphviz counts them.
+_FONT = "Helvetica"
+#: Colour of highlighted nodes and arcs (see :func:`to_dot`).
+HIGHLIGHT_COLOUR = "#d62728"
+_HIGHLIGHT_FILL = "#fde0dd"
+_TRANSITION_FILL = "#dfe6ee"
+_CLUSTER_COLOURS = (  # (fill, border) per subnet, in turn
+    ("#eef5fc", "#6b9bc8"),
+    ("#f1f8ec", "#7fae62"),
+    ("#fdf3e7", "#d39a4f"),
+    ("#f5effa", "#9c7dbf"),
+    ("#eef8f7", "#5fa8a0"),
+    ("#fbeff2", "#c77b90"),
+)
+_PLACE_SIZE = 0.42
+_NAME_ROW = 14  # points: height of the name under a place
+_DOT = "\u25cf"  # a black circle: one token
+
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
+_BACKSLASHES_AT_RISK = re.compile(r'\\+(?=["\n]|\Z)')
+
+
+# Escaping ------------------------------------------------------------------------------
+
+
+def _quote(text: str) -> str:
+    """A DOT double-quoted string naming ``text``, distinct for distinct texts.
+
+    Inside quotes Graphviz reads ``\\"`` as a quote, keeps ``\\\\`` as two
+    backslashes and drops a backslash that ends a line. So quotes are escaped, and a
+    run of backslashes just before a quote, a line break or the end (which Graphviz
+    could misread) is doubled; every other text comes back exactly as it was.
+
+    Examples:
+        >>> print(_quote('say "hi"'), _quote("a:b/c d"))
+        "say \\"hi\\"" "a:b/c d"
+    """
+    quoted = _BACKSLASHES_AT_RISK.sub(lambda run: run.group(0) * 2, text)
+    return '"' + quoted.replace('"', '\\"') + '"'
+
+
+def _html(text: str) -> str:
+    """``text`` as the content of a Graphviz HTML-like label (lines kept)."""
+    text = text.replace("\r\n", "\n").replace("\r", "\n").replace("\t", " ")
+    text = _CONTROL.sub("\ufffd", text)
+    return "<BR/>".join(html.escape(line, quote=True) for line in text.split("\n"))
+
+
+# DOT text ------------------------------------------------------------------------------
+
+
+def _attributes(attrs: Mapping[str, str]) -> str:
+    return "[" + ", ".join(f"{key}={value}" for key, value in attrs.items()) + "]"
+
+
+def _tokens_text(count: int) -> str:
+    """Tokens drawn inside a place: dots for 1 to 4, the number from 5 on."""
+    if count == 0:
+        return " "
+    if count <= 4:
+        rows = {1: [1], 2: [2], 3: [2, 1], 4: [2, 2]}[count]
+        dots = "<BR/>".join(" ".join([_DOT] * n) for n in rows)
+        return f'<FONT POINT-SIZE="{12 if count == 1 else 8}">{dots}</FONT>'
+    digits = len(str(count))
+    size = {1: 10, 2: 10, 3: 9, 4: 8}.get(digits, 7)  # from 6 digits on it spills over the rim
+    return f'<FONT POINT-SIZE="{size}"><B>{count}</B></FONT>'
+
+
+def _place_lines(net: Net, place: str, count: int, highlighted: bool, indent: str) -> str:
+    """A place: a circle, with its name in the same label under it.
+
+    ``fixedsize=shape`` keeps the circle small while the label (a three-row table: a
+    spacer as tall as the name row, the circle's inside, the name) stays centred on
+    it, so the name always sits right under its own circle and never on anything else.
+    """
+    spec = net.places[place]
+    colour = HIGHLIGHT_COLOUR if highlighted else "black"
+    side = round(_PLACE_SIZE * 72)
+    name = _html(spec.label or spec.id)
+    label = (
+        '<<TABLE BORDER="0" CELLBORDER="0" CELLSPACING="0" CELLPADDING="0">'
+        f'<TR><TD HEIGHT="{_NAME_ROW}"> </TD></TR>'
+        f'<TR><TD HEIGHT="{side}" WIDTH="{side}" FIXEDSIZE="TRUE">{_tokens_text(count)}</TD></TR>'
+        f'<TR><TD HEIGHT="{_NAME_ROW}" VALIGN="BOTTOM">{name}</TD></TR>'
+        "</TABLE>>"
+    )
+    attrs = {"label": label, "color": f'"{colour}"', "fontcolor": f'"{colour}"'}
+    if highlighted:
+        attrs["penwidth"] = "2.5"
+    return f"{indent}{_quote(place)} {_attributes(attrs)};"
+
+
+def _transition_lines(net: Net, transition: str, highlighted: bool, indent: str) -> str:
+    spec = net.transitions[transition]
+    colour = HIGHLIGHT_COLOUR if highlighted else "black"
+    if spec.silent:
+        attrs = {
+            "label": '""', "width": "0.1", "height": "0.45", "fixedsize": "true",
+            "style": "filled", "fillcolor": f'"{colour}"', "color": f'"{colour}"',
+        }
+        return f"{indent}{_quote(transition)} {_attributes(attrs)};"
+    lines = [f"<B>{_html(spec.label or spec.id)}</B>"]
+    if spec.action:
+        lines.append(f'<FONT POINT-SIZE="8" COLOR="#404040">{_html(spec.action)}</FONT>')
+    if spec.guard:
+        lines.append(f'<FONT POINT-SIZE="8" COLOR="#404040">[{_html(spec.guard)}]</FONT>')
+    attrs = {
+        "label": "<" + "<BR/>".join(lines) + ">",
+        "fillcolor": f'"{_HIGHLIGHT_FILL if highlighted else _TRANSITION_FILL}"',
+        "color": f'"{colour}"',
+        "fontcolor": f'"{colour}"',
+    }
+    if highlighted:
+        attrs["penwidth"] = "2.5"
+    return f"{indent}{_quote(transition)} {_attributes(attrs)};"
+
+
+def _highlight_sets(net: Net, highlight: Sequence[str] | None) -> tuple[set[str], set[tuple[str, str]]]:
+    """The highlighted nodes, and the arcs to draw bold.
+
+    An arc is bold when both its ends are highlighted, or when it joins two transitions
+    that follow each other in ``highlight`` through a place (a firing sequence given as
+    transition ids only still shows as a connected path).
+    """
+    if highlight is None:
+        return set(), set()
+    if isinstance(highlight, str):
+        highlight = [highlight]
+    nodes = list(highlight)
+    for node in nodes:
+        if node not in net.places and node not in net.transitions:
+            raise UnknownElementError("node", node, list(net.places) + list(net.transitions))
+    chosen = set(nodes)
+    arcs = {(a.source, a.target) for a in net.arcs if a.source in chosen and a.target in chosen}
+    for first, second in zip(nodes, nodes[1:]):
+        if first in net.transitions and second in net.transitions:
+            for place in set(net.postset(first)) & set(net.preset(second)):
+                arcs.add((first, place))
+                arcs.add((place, second))
+    return chosen, arcs
+
+
+def to_dot(
+    net: Net,
+    marking: Mapping[str, int] | None = None,
+    *,
+    highlight: Sequence[str] | None = None,
+    title: str | None = None,
+) -> str:
+    """Graphviz DOT source drawing ``net`` in ``marking``.
+
+    Places are circles with their tokens inside (dots for 1 to 4, the number from 5)
+    and their label (or id) under them; transitions are boxes with their label (or id)
+    in bold and the bound action below it; silent transitions are thin black bars.
+    Arcs of weight above 1 carry the weight. Each agent subnet is a labelled cluster
+    naming its agent. The layout runs left to right.
+
+    Args:
+        net: the net to draw.
+        marking: tokens to draw; defaults to the net's initial marking.
+        highlight: ids of places and/or transitions to draw in a highlight colour, such
+            as a firing sequence that leads to a problem. Arcs whose two ends are
+            highlighted are drawn bold in that colour, and so are the arcs through a
+            place joining two transitions that follow each other in ``highlight``.
+            A single string is taken as one id.
+        title: text above the picture; defaults to the net's label or id; ``""`` for
+            none.
+
+    Returns:
+        The DOT text (Graphviz reads it with ``dot -Tsvg`` and the like).
+
+    Raises:
+        UnknownElementError: ``marking`` or ``highlight`` names a node the net lacks.
+
+    Examples:
+        >>> from petriflow.net import Net
+        >>> net = Net("n")
+        >>> _ = net.add_subnet("cam", label="Camera", agent="robot_1")
+        >>> _ = net.add_place("p", tokens=7, subnet="cam")
+        >>> "<B>7</B>" in to_dot(net), 'subgraph "cluster_cam"' in to_dot(net)
+        (True, True)
+    """
+    marking = net.initial_marking if marking is None else net.check_marking(marking)
+    chosen, bold_arcs = _highlight_sets(net, highlight)
+    title = (net.label or net.id) if title is None else title
+
+    out = [f"digraph {_quote(net.id)} {{"]
+    graph = {
+        "rankdir": "LR", "nodesep": "0.3", "ranksep": "0.45", "newrank": "true",
+        "fontname": f'"{_FONT}"', "fontsize": "12", "pad": "0.25", "outputorder": "edgesfirst",
+    }
+    if title:
+        graph.update({"label": f"<<B>{_html(title)}</B>>", "labelloc": "t", "fontsize": "14"})
+    out.append(f"  graph {_attributes(graph)};")
+    out.append(
+        f'  node [fontname="{_FONT}", fontsize=10, shape=circle, fixedsize=shape,'
+        f" width={_PLACE_SIZE}, height={_PLACE_SIZE}, penwidth=1.3];"
+    )
+    out.append(f'  edge [fontname="{_FONT}", fontsize=10, arrowsize=0.7, penwidth=1.1];')
+
+    def node_lines(places: list[str], transitions: list[str], indent: str) -> list[str]:
+        lines = [_place_lines(net, p, marking[p], p in chosen, indent) for p in places]
+        if transitions:
+            lines.append(
+                f"{indent}node [shape=box, fixedsize=false, style=\"filled,rounded\","
+                f" width=0.3, height=0.35, margin=\"0.08,0.03\", penwidth=1.2];"
+            )
+            lines += [_transition_lines(net, t, t in chosen, indent) for t in transitions]
+        return lines
+
+    for number, subnet in enumerate(net.subnets.values()):
+        fill, border = _CLUSTER_COLOURS[number % len(_CLUSTER_COLOURS)]
+        caption = (
+            f'<B>{_html(subnet.label or subnet.id)}</B><BR ALIGN="LEFT"/>'
+            f'<FONT POINT-SIZE="9">agent: {_html(subnet.agent or subnet.id)}</FONT><BR ALIGN="LEFT"/>'
+        )
+        out.append(f"  subgraph {_quote('cluster_' + subnet.id)} {{")
+        out.append(
+            f'    graph [label=<{caption}>, labeljust=l, labelloc=t, fontsize=11,'
+            f' style="rounded,filled", fillcolor="{fill}", color="{border}", penwidth=1.2,'
+            f" margin=10];"
+        )
+        places, transitions = net.nodes_of(subnet.id)
+        out += node_lines(places, transitions, "    ")
+        out.append("  }")
+
+    loose_places = [p.id for p in net.places.values() if p.subnet is None]
+    loose_transitions = [t.id for t in net.transitions.values() if t.subnet is None]
+    out += node_lines(loose_places, loose_transitions, "  ")
+
+    for arc in net.arcs:
+        attrs: dict[str, str] = {}
+        if arc.weight > 1:
+            attrs["label"] = _quote(str(arc.weight))
+        if (arc.source, arc.target) in bold_arcs:
+            colour = f'"{HIGHLIGHT_COLOUR}"'
+            attrs.update({"color": colour, "fontcolor": colour, "penwidth": "2.8"})
+        line = f"  {_quote(arc.source)} -> {_quote(arc.target)}"
+        out.append(f"{line} {_attributes(attrs)};" if attrs else f"{line};")
+    out.append("}")
+    return "\n".join(out) + "\n"
+
+
+# Pictures ------------------------------------------------------------------------------
+
+
+def _check_directory(path: Path) -> None:
+    parent = path.parent
+    if not parent.is_dir():
+        raise PetriflowError(f"{path}: output directory {str(parent)!r} does not exist")
+
+
+def _write(path: Path, data: bytes) -> None:
+    from petriflow.io.files import write_atomic
+
+    try:
+        write_atomic(path, data)
+    except OSError as exc:
+        raise PetriflowError(f"{path}: cannot write: {exc.strerror or exc}") from None
+
+
+def render(dot_source: str, path: str | Path, format: str) -> None:
+    """Lay out ``dot_source`` with Graphviz and write the picture to ``path``.
+
+    The picture is written atomically: when ``dot`` is missing, fails or times out,
+    an existing file at ``path`` keeps its content.
+
+    Args:
+        dot_source: DOT text, e.g. from :func:`to_dot`.
+        path: the file to write.
+        format: ``"svg"`` or ``"png"``.
+
+    Raises:
+        DependencyNotInstalled: the ``dot`` program is not installed.
+        PetriflowError: unknown format, missing output directory, or ``dot`` failed
+            (the message carries the first line ``dot`` printed on standard error).
+    """
+    if format not in PICTURE_FORMATS:
+        raise PetriflowError(f"cannot draw format {format!r}; use one of {', '.join(PICTURE_FORMATS)}")
+    path = Path(path)
+    _check_directory(path)
+    executable = shutil.which(DOT_EXECUTABLE)
+    if executable is None:
+        raise DependencyNotInstalled(_MISSING_DOT)
+    command = [executable, f"-T{format}"]
+    if format == "png":
+        command.append(f"-Gdpi={PNG_DPI}")
+    try:
+        done = subprocess.run(
+            command, input=dot_source.encode("utf-8"), capture_output=True, timeout=DOT_TIMEOUT_S
+        )
+    except FileNotFoundError:
+        raise DependencyNotInstalled(_MISSING_DOT) from None
+    except subprocess.TimeoutExpired:
+        raise PetriflowError(
+            f"Graphviz 'dot' took longer than {DOT_TIMEOUT_S:g} s; {path} not written"
+        ) from None
+    if done.returncode != 0 or not done.stdout:
+        lines = done.stderr.decode("utf-8", "replace").strip().splitlines()
+        reason = lines[0].strip() if lines else f"exit status {done.returncode}"
+        raise PetriflowError(f"Graphviz 'dot' failed: {reason}")
+    _write(path, done.stdout)
+
+
+def export_net(
+    net: Net,
+    path: str | Path,
+    format: str,
+    marking: Mapping[str, int] | None = None,
+    highlight: Sequence[str] | None = None,
+) -> None:
+    """Write ``net`` to ``path`` as ``pnml``, ``yaml``, ``dot``, ``svg`` or ``png``.
+
+    Every format is written atomically, so a failure leaves an existing file as it was.
+
+    Args:
+        net: the net.
+        path: the output file; its directory must exist.
+        format: one of :data:`EXPORT_FORMATS`.
+        marking: for pictures and DOT, the tokens to draw (default: the initial
+            marking); for ``pnml``/``yaml``, the initial marking to write when it
+            differs from the net's own.
+        highlight: for pictures and DOT, node ids to highlight (see :func:`to_dot`);
+            not used by ``pnml``/``yaml``.
+
+    Raises:
+        PetriflowError: unknown format, missing output directory, unknown node in
+            ``marking``/``highlight``, or a failed write or layout.
+        DependencyNotInstalled: a picture was asked for and Graphviz is missing.
+    """
+    if format not in EXPORT_FORMATS:
+        raise PetriflowError(f"unknown export format {format!r}; use one of {', '.join(EXPORT_FORMATS)}")
+    path = Path(path)
+    _check_directory(path)
+    if format in ("pnml", "yaml"):
+        from petriflow.io import save_net
+
+        if marking is not None:
+            chosen = net.check_marking(marking)
+            if chosen != net.initial_marking:
+                net = net.copy()
+                net.set_initial_marking(chosen)
+        try:
+            save_net(net, path, format)
+        except OSError as exc:
+            raise PetriflowError(f"{path}: cannot write: {exc.strerror or exc}") from None
+        return
+    source = to_dot(net, marking, highlight=highlight)
+    if format == "dot":
+        _write(path, source.encode("utf-8"))
+    else:
+        render(source, path, format)
