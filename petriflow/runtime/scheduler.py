@@ -153,6 +153,19 @@ class Scheduler:
                 self._consumers[p].append(t)
         self._preset = {t: net.preset(t) for t in net.transitions}
         self._guarded = [t.id for t in net.transitions.values() if t.guard is not None]
+        # per transition: {route: [(place, weight, is channel)]}, route "ok" or an outcome
+        self._outputs = {
+            t: {route: [(p, w, net.places[p].channel is not None)
+                        for p, w in net.postset(t, None if route == "ok" else route).items()]
+                for route in ("ok", *net.outcomes(t))}
+            for t in net.transitions
+        }
+        # per transition: besides consumers of touched places, what to re-check after
+        # it fires: itself (its action may be running now) and the actions it cancels
+        self._recheck = {
+            t: {t, *(n for n in net.transitions[t].cancels if n in net.transitions)}
+            for t in net.transitions
+        }
         self._order = {t: i for i, t in enumerate(net.transitions)}
         self._actions: dict[str, Action] = {}
         self._running: dict[str, _Running] = {}
@@ -264,10 +277,8 @@ class Scheduler:
                     " passing (a cycle of instant transitions?)"
                 )
             dirty = {u for p in touched for u in self._consumers[p]}
-            dirty.add(t)
-            dirty.update(n for n in self.net.transitions[t].cancels if n in self._order)
-            dirty.update(self._guarded)
-            for u in dirty:
+            dirty |= self._recheck[t]
+            for u in (*dirty, *self._guarded):
                 if self._can_fire(u):
                     enabled.add(u)
                 else:
@@ -378,24 +389,24 @@ class Scheduler:
         """Produce the outputs of ``outcome`` and record the end of the firing."""
         net = self.net
         route = outcome.value
-        if outcome is Outcome.TIMEOUT and "timeout" not in net.outcomes(t) and "failed" in net.outcomes(t):
+        routes = self._outputs[t]
+        if outcome is Outcome.TIMEOUT and "timeout" not in routes and "failed" in routes:
             route = "failed"  # a timeout is a failure when the net routes only failures
-        if outcome in (Outcome.FAILED, Outcome.TIMEOUT) and route not in net.outcomes(t):
+        if outcome in (Outcome.FAILED, Outcome.TIMEOUT) and route not in routes:
             reason = ctx.reason or outcome.value
             self._emit("end", t, self._agent_of[t], firing=firing, outcome=outcome.value,
                        produced={}, reason=reason)
             raise ActionFailed(net.id, t, net.transitions[t].action or "-", reason)
-        outputs = net.postset(t, None if route == "ok" else route)
         produced: dict[str, int] = {}
         sent: list[tuple[str, Any]] = []
-        for place, weight in outputs.items():
-            data = ctx.result.get(place) if ctx.per_place and isinstance(ctx.result, dict) else ctx.result
-            for _ in range(weight):
-                if net.places[place].channel is not None:
-                    sent.append((place, data))
-                else:
-                    self.tokens[place].append(data)
-                    produced[place] = produced.get(place, 0) + 1
+        per_place = ctx.per_place and isinstance(ctx.result, dict)
+        for place, weight, channel in routes.get(route, ()):
+            data = ctx.result.get(place) if per_place else ctx.result
+            if channel:
+                sent.extend([(place, data)] * weight)
+            else:
+                self.tokens[place].extend([data] * weight)
+                produced[place] = weight
         for kind, data in ctx.emitted:
             self._emit("custom", t, ctx.agent, firing=firing, name=kind, data=summarize(data))
         ctx.emitted.clear()
