@@ -219,6 +219,32 @@ def cmd_run(args: argparse.Namespace) -> int:
     return EXIT_PROBLEM if problem else EXIT_OK
 
 
+def cmd_actions(args: argparse.Namespace) -> int:
+    from petriflow.runtime.action import REQUIRED
+    from petriflow.runtime.registry import default_registry
+
+    listing = []
+    for spec in default_registry.specs():
+        cls = spec.load()
+        params = {
+            name: {"type": " or ".join(t.__name__ for t in (p.type if isinstance(p.type, tuple) else (p.type,))),
+                   "default": None if p.default is REQUIRED else p.default,
+                   "required": p.default is REQUIRED, "doc": p.doc}
+            for name, p in cls.params.items()
+        }
+        doc = spec.doc or ((cls.__doc__ or "").strip().splitlines() or [""])[0]
+        listing.append({"name": spec.name, "doc": doc, "params": params})
+    if args.json:
+        _print_json(listing)
+        return EXIT_OK
+    for entry in listing:
+        print(f"{entry['name']:16} {entry['doc']}")
+        for name, p in entry["params"].items():
+            default = "required" if p["required"] else f"default {p['default']!r}"
+            print(f"{'':18}{name}: {p['type']}, {default}" + (f" — {p['doc']}" if p["doc"] else ""))
+    return EXIT_OK
+
+
 def cmd_replay(args: argparse.Namespace) -> int:
     from petriflow.runtime.replay import replay
 
@@ -290,6 +316,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--gui", action="store_true", help="open pybullet's GUI (needs a display)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     run.set_defaults(handler=cmd_run)
+
+    actions = sub.add_parser("actions", help="List the actions transitions can be bound to.",
+                             description="List the registered actions and their parameters.")
+    actions.add_argument("--json", action="store_true", help="print JSON")
+    actions.set_defaults(handler=cmd_actions)
 
     replay_cmd = sub.add_parser("replay", help="Print (or draw) the token game of a recorded run.",
                                 description="Print the token game of a recorded run, or draw the"
