@@ -1,0 +1,1 @@
+"""Path planning on grid maps (A*), path tracking and collision avoidance."""
