@@ -98,8 +98,10 @@ def decode(stream: bytes) -> list[Command]:
                 raise MessageError(f"command at byte {position} has no '%' end")
             if stream[cursor] == END:
                 break
-            if stream[cursor] != SEPARATOR or cursor + 1 >= len(stream):
+            if stream[cursor] != SEPARATOR:
                 raise MessageError(f"expected ',' or '%' at byte {cursor}")
+            if cursor + 1 >= len(stream):
+                raise MessageError(f"truncated command at byte {position}: parameter missing")
             params.append(stream[cursor + 1])
             cursor += 2
         commands.append(Command(action, robot, tuple(params)))
