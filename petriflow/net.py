@@ -7,13 +7,12 @@ free functions in :mod:`petriflow.engine` and :mod:`petriflow.analysis`.
 Examples:
     >>> net = Net("pingpong")
     >>> net.add_place("ready", tokens=1)
-    Place(id='ready', label=None, subnet=None, meta={})
-    >>> net.add_place("done")
-    Place(id='done', label=None, subnet=None, meta={})
+    Place(id='ready', label=None, subnet=None, meta={}, channel=None)
+    >>> _ = net.add_place("done")
     >>> _ = net.add_transition("go", action="robot.move", params={"speed": 0.2})
     >>> net.add_arc("ready", "go"); net.add_arc("go", "done", weight=2)
-    Arc(source='ready', target='go', weight=1, id=None)
-    Arc(source='go', target='done', weight=2, id=None)
+    Arc(source='ready', target='go', weight=1, id=None, outcome=None)
+    Arc(source='go', target='done', weight=2, id=None, outcome=None)
     >>> net.preset("go"), net.postset("go")
     ({'ready': 1}, {'done': 2})
 """

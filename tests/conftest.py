@@ -12,6 +12,20 @@ REPO = Path(__file__).resolve().parents[1]
 NETS = REPO / "nets"
 ORACLE = REPO.parent / "shared" / "oracle"
 
+def net_files() -> list[Path]:
+    """The nets shipped under nets/ (YAML files with a 'petriflow:' version key, and PNML);
+    world and run configuration files beside them are not nets."""
+    found = []
+    for path in sorted(NETS.rglob("*")):
+        if path.suffix == ".pnml":
+            found.append(path)
+        elif path.suffix in {".yaml", ".yml"} and any(
+            line.startswith("petriflow:") for line in path.read_text().splitlines()
+        ):
+            found.append(path)
+    return found
+
+
 SEQUENCE_YAML = """
 petriflow: 1
 net: sequence

@@ -108,8 +108,8 @@ def test_malformed_yaml_exits_2_naming_file_and_line(capsys, tmp_path):
 
 
 def test_reserved_commands_say_not_available(capsys, sequence_file):
-    """run and check exist as names but are not in this version."""
-    assert run(capsys, "run", sequence_file)[0] == 2
+    """check exists as a name but is not in this version."""
+    assert run(capsys, "check", sequence_file)[0] == 2
 
 
 def test_console_script_runs_without_traceback(tmp_path):

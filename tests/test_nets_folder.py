@@ -5,9 +5,9 @@ import pytest
 from petriflow.engine import Simulation
 from petriflow.io import load_net
 from petriflow.io.yaml import dumps_net, loads_net
-from tests.conftest import NETS
+from tests.conftest import NETS, net_files
 
-NET_FILES = sorted(p for p in NETS.rglob("*") if p.suffix in {".yaml", ".yml", ".pnml"})
+NET_FILES = net_files()
 
 
 def test_nets_folder_is_not_empty():
