@@ -169,7 +169,8 @@ class Net:
         self._pre: dict[str, dict[str, int]] = {}
         self._post: dict[str, dict[str, int]] = {}
         self._post_outcome: dict[str, dict[str, dict[str, int]]] = {}
-        self.initial_marking: Marking = Marking()
+        self._initial_counts: dict[str, int] = {}
+        self._initial: Marking | None = Marking()
         self.final_marking: Marking | None = None
         self.meta: dict[str, Any] = {}
 
@@ -210,7 +211,9 @@ class Net:
         place = Place(id, label, subnet, dict(meta or {}), channel)
         self.places[id] = place
         if tokens:
-            self.initial_marking = self.initial_marking + Marking({id: tokens})
+            Marking({id: tokens})  # validates the count
+            self._initial_counts[id] = tokens
+            self._initial = None  # rebuilt on demand: adding n marked places stays O(n)
         return place
 
     def add_transition(self, id: str, **attributes: Any) -> Transition:
@@ -274,6 +277,18 @@ class Net:
                 return f"arc {source!r} -> {target!r}: unknown node {end!r}{did_you_mean(end, nodes)}"
         kind = "places" if source in self.places else "transitions"
         return f"arc {source!r} -> {target!r} joins two {kind}; arcs join a place and a transition"
+
+    @property
+    def initial_marking(self) -> Marking:
+        """The marking the net starts in."""
+        if self._initial is None:
+            self._initial = Marking(self._initial_counts)
+        return self._initial
+
+    @initial_marking.setter
+    def initial_marking(self, marking: Mapping[str, int]) -> None:
+        self._initial = marking if isinstance(marking, Marking) else Marking(marking)
+        self._initial_counts = dict(self._initial)
 
     def set_initial_marking(self, marking: Mapping[str, int]) -> None:
         """Replace the initial marking (every place it names must exist)."""

@@ -120,3 +120,44 @@ def test_console_script_runs_without_traceback(tmp_path):
                           capture_output=True, text=True)
     assert done.returncode == 2
     assert "Traceback" not in done.stderr and done.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    "content, fragment",
+    [
+        ('<?xml version="1.0"?>\n<pnml><net id="n" type="http://www.pnml.org/version-2009/grammar/ptnet">\n<page id="g">',
+         "bad.pnml:3"),
+        ('<pnml><net id="n" type="http://www.pnml.org/version-2009/grammar/symmetricnet"><page id="g"/></net></pnml>',
+         "symmetricnet"),
+    ],
+    ids=["truncated-xml", "wrong-pnml-type"],
+)
+def test_bad_pnml_exits_2_with_one_line(content, fragment, capsys, tmp_path):
+    """Truncated XML and a coloured-net type are one-line errors naming the file."""
+    path = tmp_path / "bad.pnml"
+    path.write_text(content)
+    code, out, err = run(capsys, "info", str(path))
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert fragment in err and "bad.pnml" in err
+
+
+def test_commands_work_on_pnml_written_by_pm4py(capsys, tmp_path):
+    """info, simulate, fire and export accept a PNML file PM4Py wrote."""
+    pm4py = pytest.importorskip("pm4py")
+    from pm4py.objects.petri_net.obj import Marking as PM4PyMarking, PetriNet
+    from pm4py.objects.petri_net.utils import petri_utils
+
+    net = PetriNet("pm")
+    source, sink = PetriNet.Place("source"), PetriNet.Place("sink")
+    work = PetriNet.Transition("work", "Work")
+    net.places.update({source, sink})
+    net.transitions.add(work)
+    petri_utils.add_arc_from_to(source, work, net)
+    petri_utils.add_arc_from_to(work, sink, net, weight=2)
+    path = tmp_path / "pm.pnml"
+    pm4py.write_pnml(net, PM4PyMarking({source: 1}), PM4PyMarking({sink: 2}), str(path))
+    assert run(capsys, "info", str(path))[0] == 0
+    code, out, _ = run(capsys, "fire", str(path), "work", "--json")
+    assert code == 0 and json.loads(out)["marking"] == {"sink": 2}
+    assert run(capsys, "simulate", str(path), "--steps", "3")[0] == 0
+    assert run(capsys, "export", str(path), "-f", "yaml", "-o", str(tmp_path / "pm.yaml"))[0] == 0
