@@ -12,7 +12,7 @@ import json
 import sys
 import warnings
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any, Sequence
 
 from petriflow.engine import Simulation, fire
 from petriflow.errors import NotEnabledError, PetriflowError
@@ -168,7 +168,22 @@ def cmd_export(args: argparse.Namespace) -> int:
     marking = _start_marking(net, args.marking)
     from petriflow.export import export_net
 
-    export_net(net, args.output, args.format, marking=marking)
+    highlight = [h for h in (args.highlight or "").split(",") if h] or None
+    if args.violation:
+        from petriflow.analysis.report import check_net
+
+        violations = [v for v in check_net(net)["violations"] if v.get("transitions")]
+        if not violations:
+            print(f"petriflow: {args.net}: the analysis found no violation with a witness to draw",
+                  file=sys.stderr)
+            return EXIT_PROBLEM
+        witness = violations[0]
+        # outcome variants (t@failed) are drawn on their transition
+        highlight = list(dict.fromkeys(t.split("@")[0] for t in witness["transitions"]))
+        highlight += [p for p in (witness.get("marking") or {}) if p in net.places]
+        marking = net.check_marking(witness.get("marking") or {})
+        print(witness["message"])
+    export_net(net, args.output, args.format, marking=marking, highlight=highlight)
     return EXIT_OK
 
 
@@ -251,12 +266,10 @@ def cmd_replay(args: argparse.Namespace) -> int:
     return replay(args.trace, net_path=args.net, draw=args.draw, at=args.at)
 
 
-def _reserved(name: str, issue: str) -> Callable[[argparse.Namespace], int]:
-    def command(args: argparse.Namespace) -> int:
-        print(f"petriflow: '{name}' is not available in this version yet ({issue})", file=sys.stderr)
-        return EXIT_BAD_INPUT
+def cmd_check(args: argparse.Namespace) -> int:
+    from petriflow.analysis.report import cmd_check as check
 
-    return command
+    return check(args)
 
 
 # Parser ------------------------------------------------------------------------------
@@ -295,6 +308,10 @@ def build_parser() -> argparse.ArgumentParser:
                         choices=["pnml", "yaml", "dot", "svg", "png"], help="output format")
     export.add_argument("--output", "-o", required=True, help="output file")
     export.add_argument("--marking", help="marking to draw, as JSON (default: initial)")
+    export.add_argument("--highlight", metavar="IDS", help="comma-separated node ids to highlight")
+    export.add_argument("--violation", action="store_true",
+                        help="analyse the net and draw its first violation: the witness path"
+                        " highlighted, with the marking it reaches")
 
     run = sub.add_parser(
         "run", help="Run a net: fire transitions as agent actions over a pybullet world.",
@@ -331,9 +348,12 @@ def build_parser() -> argparse.ArgumentParser:
                             " .svg/.png/.dot file; needs --net")
     replay_cmd.add_argument("--at", type=int, help="event number to stop at")
     replay_cmd.set_defaults(handler=cmd_replay)
-    check = sub.add_parser("check", help="Analyse a net (not yet available).")
-    check.add_argument("net")
-    check.set_defaults(handler=_reserved("check", "analysis"))
+    check = net_command(
+        "check", "Analyse a net: WF-net soundness, boundedness, deadlocks, liveness, invariants.",
+        cmd_check)
+    check.add_argument("--json", action="store_true", help="print JSON")
+    check.add_argument("--max-states", type=int, default=None, metavar="N",
+                       help="most markings to explore (default 2,000,000); beyond it, exit 2")
     return parser
 
 

@@ -107,9 +107,10 @@ def test_malformed_yaml_exits_2_naming_file_and_line(capsys, tmp_path):
     assert err.strip() == f"petriflow: {path}:4: 't': 'out' names unknown place 'nowhere'"
 
 
-def test_reserved_commands_say_not_available(capsys, sequence_file):
-    """check exists as a name but is not in this version."""
-    assert run(capsys, "check", sequence_file)[0] == 2
+def test_check_reports_a_sound_workflow_net(capsys, sequence_file):
+    """check on a sound WF-net exits 0 and says so in JSON."""
+    code, out, _ = run(capsys, "check", sequence_file, "--json")
+    assert code == 0 and json.loads(out)["sound"] is True
 
 
 def test_console_script_runs_without_traceback(tmp_path):
@@ -161,3 +162,33 @@ def test_commands_work_on_pnml_written_by_pm4py(capsys, tmp_path):
     assert code == 0 and json.loads(out)["marking"] == {"sink": 2}
     assert run(capsys, "simulate", str(path), "--steps", "3")[0] == 0
     assert run(capsys, "export", str(path), "-f", "yaml", "-o", str(tmp_path / "pm.yaml"))[0] == 0
+
+
+def test_check_accepts_a_net_ending_in_its_final_marking(capsys):
+    """A non-WF net whose only dead marking is its declared final marking passes check."""
+    code, out, _ = run(capsys, "check", str(NETS / "passage" / "passage.yaml"), "--json")
+    result = json.loads(out)
+    assert code == 0
+    assert (result["deadlock_free"], result["stuck_markings"], result["final_marking_reached"]) == (
+        False, 0, True)
+
+
+def test_check_exit_1_with_a_witness_for_the_papers_smart_net(capsys):
+    """The SMART net as published deadlocks; check exits 1 with the firing sequence."""
+    code, out, _ = run(capsys, "check", str(NETS / "smart" / "smart-paper.yaml"), "--json")
+    violations = json.loads(out)["violations"]
+    assert code == 1
+    assert {v["kind"] for v in violations} >= {"not_wf_net", "deadlock"}
+    deadlock = next(v for v in violations if v["kind"] == "deadlock")
+    assert deadlock["transitions"][-1] == "T9" and deadlock["marking"] == {"P2": 1, "P5": 1}
+
+
+def test_export_draws_a_violation_witness(capsys, tmp_path):
+    """export --violation highlights the witness path of the first violation."""
+    out_file = tmp_path / "violation.dot"
+    code, out, _ = run(capsys, "export", str(NETS / "smart" / "smart-paper.yaml"), "-f", "dot",
+                       "-o", str(out_file), "--violation")
+    assert code == 0 and "deadlock" in out
+    from petriflow.export import HIGHLIGHT_COLOUR
+
+    assert out_file.read_text().count(HIGHLIGHT_COLOUR) >= 8

@@ -1,1 +1,66 @@
-"""Analysis of nets as free functions (reachability, boundedness, soundness, invariants)."""
+"""Analysis of nets as free functions: reachability, coverability, properties, soundness,
+invariants, and the ``petriflow check`` report.
+
+One concept per module:
+
+* :mod:`~petriflow.analysis.reachability` — the state space (:func:`reachability_graph`,
+  :class:`StateSpace`, :func:`to_networkx`);
+* :mod:`~petriflow.analysis.coverability` — Karp–Miller coverability graph, unbounded places;
+* :mod:`~petriflow.analysis.properties` — bounds, deadlocks, dead transitions, liveness,
+  reversibility, read off a state space;
+* :mod:`~petriflow.analysis.soundness` — WF-net structure and classical soundness;
+* :mod:`~petriflow.analysis.invariants` — P- and T-semiflows (Farkas);
+* :mod:`~petriflow.analysis.report` — :func:`check_net`, the ``petriflow check`` command.
+
+Examples:
+    >>> from petriflow.classic import dining_philosophers
+    >>> space = reachability_graph(dining_philosophers(5))
+    >>> space.num_states, is_live(space)
+    (11, True)
+"""
+
+from petriflow.analysis.coverability import OMEGA, CoverabilityGraph, coverability_graph, unbounded_places
+from petriflow.analysis.invariants import (
+    InvariantLimit,
+    is_covered_by_p_semiflows,
+    p_semiflows,
+    structural_bounds,
+    t_semiflows,
+)
+from petriflow.analysis.properties import (
+    dead_transitions,
+    deadlock_witness,
+    deadlocks,
+    is_live,
+    is_reversible,
+    is_safe,
+    non_live_transitions,
+    place_bounds,
+)
+from petriflow.analysis.reachability import (
+    DEFAULT_MAX_STATES,
+    StateSpace,
+    StateSpaceLimit,
+    UnboundedNetError,
+    reachability_graph,
+    to_networkx,
+)
+from petriflow.analysis.report import check_net, cmd_check, exit_code, format_report
+from petriflow.analysis.soundness import (
+    SoundnessReport,
+    Violation,
+    WorkflowStructure,
+    check_soundness,
+    is_free_choice,
+    workflow_structure,
+)
+
+__all__ = [
+    "DEFAULT_MAX_STATES", "OMEGA", "CoverabilityGraph", "InvariantLimit", "SoundnessReport",
+    "StateSpace", "StateSpaceLimit", "UnboundedNetError", "Violation", "WorkflowStructure",
+    "check_net", "check_soundness", "cmd_check", "coverability_graph", "dead_transitions",
+    "deadlock_witness", "deadlocks", "exit_code", "format_report", "is_covered_by_p_semiflows",
+    "is_free_choice", "is_live", "is_reversible", "is_safe", "non_live_transitions",
+    "p_semiflows", "place_bounds", "reachability_graph", "structural_bounds", "t_semiflows",
+    "to_networkx", "unbounded_places", "workflow_structure",
+]

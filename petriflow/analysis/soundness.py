@@ -1,0 +1,396 @@
+"""Workflow nets: the WF-net structure check and classical soundness, with witnesses.
+
+A **WF-net** has exactly one source place ``i`` (no arc into it), exactly one sink
+place ``o`` (no arc out of it), and every place and transition lies on a path from
+``i`` to ``o`` — equivalently, the *short-circuited* net, with an extra transition
+``o -> i``, is strongly connected.
+
+A WF-net is **sound** (van der Aalst) for one token in ``i`` and the final marking
+``Mf`` (the net's ``final_marking`` if it has one, else one token in ``o``) when:
+
+1. *option to complete*: from every marking reachable from ``[i]``, ``Mf`` is reachable;
+2. *proper completion*: every reachable marking that covers ``Mf`` equals ``Mf``;
+3. *no dead transitions*: every transition is enabled in some reachable marking.
+
+An unbounded WF-net is never sound (proper completion or the option to complete
+fails), so unboundedness is checked first, on the fly, and reported as such.
+
+:func:`check_soundness` decides all three on the reachability graph from ``[i]`` and
+returns every violation with a witness: the shortest firing sequence from ``[i]`` to a
+marking that shows it. For **free-choice** nets (every arc from a place ``p`` to a
+transition ``t`` has ``p`` as ``t``'s only input or ``t`` as ``p``'s only output) it
+cross-checks the verdict with the theorem that such a net is sound exactly when its
+short-circuited net is live and bounded.
+
+Examples:
+    >>> from petriflow.io.yaml import loads_net
+    >>> net = loads_net('''
+    ... petriflow: 1
+    ... places: [i, p, q, o]
+    ... transitions:
+    ...   - {id: split, in: [i], out: [p, q]}
+    ...   - {id: left, in: [p], out: [o]}
+    ...   - {id: right, in: [q], out: [o]}
+    ... ''')
+    >>> report = check_soundness(net)
+    >>> report.sound, [v.kind for v in report.violations]
+    (False, ['improper_completion', 'no_option_to_complete'])
+    >>> report.violations[0].transitions
+    ['split', 'left']
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from petriflow.analysis._graph import can_reach
+from petriflow.analysis.coverability import coverability_graph
+from petriflow.analysis.properties import dead_transitions, is_live
+from petriflow.analysis.reachability import (
+    DEFAULT_MAX_STATES,
+    StateSpace,
+    StateSpaceLimit,
+    UnboundedNetError,
+    reachability_graph,
+)
+from petriflow.engine import CompiledNet
+from petriflow.marking import Marking
+from petriflow.net import Net
+from petriflow.workflow import sink_places, source_places
+
+__all__ = [
+    "VIOLATION_KINDS",
+    "SoundnessReport",
+    "Violation",
+    "WorkflowStructure",
+    "check_soundness",
+    "is_free_choice",
+    "workflow_structure",
+]
+
+#: The kinds of :class:`Violation` the analyses report.
+VIOLATION_KINDS = ("not_wf_net", "no_option_to_complete", "improper_completion",
+                   "dead_transition", "unbounded", "deadlock")
+
+
+def _format(marking: Mapping[str, int]) -> str:
+    return ", ".join(f"{p}={c}" for p, c in marking.items()) or "(empty)"
+
+
+@dataclass
+class Violation:
+    """One way a property fails, with its witness.
+
+    Attributes:
+        kind: one of :data:`VIOLATION_KINDS`.
+        message: one readable sentence.
+        transitions: the witness firing sequence from the start marking (empty when the
+            violation is structural or is about something that never happens).
+        marking: the marking the witness sequence reaches, if any.
+        elements: the places or transitions concerned (dead transitions, unbounded
+            places, nodes not on a path from ``i`` to ``o``).
+    """
+
+    kind: str
+    message: str
+    transitions: list[str] = field(default_factory=list)
+    marking: dict[str, int] | None = None
+    elements: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data for JSON."""
+        return {"kind": self.kind, "transitions": list(self.transitions),
+                "message": self.message, "marking": self.marking,
+                "elements": list(self.elements)}
+
+
+@dataclass
+class WorkflowStructure:
+    """The result of the WF-net structure check.
+
+    Attributes:
+        is_wf_net: whether the net is a WF-net.
+        source: the source place ``i`` (``None`` unless there is exactly one).
+        sink: the sink place ``o`` (``None`` unless there is exactly one).
+        source_places: every place without an incoming arc.
+        sink_places: every place without an outgoing arc.
+        not_on_path: nodes not on any path from ``i`` to ``o``.
+        problem: why the net is not a WF-net (``None`` when it is).
+    """
+
+    is_wf_net: bool
+    source: str | None
+    sink: str | None
+    source_places: list[str]
+    sink_places: list[str]
+    not_on_path: list[str]
+    problem: str | None
+
+
+def workflow_structure(net: Net) -> WorkflowStructure:
+    """Check the WF-net structure: one source place, one sink place, all nodes on a path.
+
+    Examples:
+        >>> from petriflow.io.yaml import loads_net
+        >>> net = loads_net('''
+        ... petriflow: 1
+        ... places: [i, o, stray]
+        ... transitions: [{id: t, in: [i], out: [o]}, {id: u, in: [stray], out: [stray]}]
+        ... ''')
+        >>> found = workflow_structure(net)
+        >>> found.is_wf_net, found.not_on_path
+        (False, ['stray', 'u'])
+    """
+    sources, sinks = source_places(net), sink_places(net)
+    if len(sources) != 1 or len(sinks) != 1:
+        problems = []
+        if not sources:
+            problems.append("no source place (every place has an incoming arc)")
+        elif len(sources) > 1:
+            problems.append(f"{len(sources)} source places: {', '.join(sources)}")
+        if not sinks:
+            problems.append("no sink place (every place has an outgoing arc)")
+        elif len(sinks) > 1:
+            problems.append(f"{len(sinks)} sink places: {', '.join(sinks)}")
+        return WorkflowStructure(False, sources[0] if len(sources) == 1 else None,
+                                 sinks[0] if len(sinks) == 1 else None, sources, sinks, [],
+                                 "; ".join(problems))
+    source, sink = sources[0], sinks[0]
+    if source == sink:
+        return WorkflowStructure(False, source, sink, sources, sinks, [],
+                                 f"place {source!r} is both the source and the sink")
+    forward: dict[str, list[str]] = {node: [] for node in net}
+    backward: dict[str, list[str]] = {node: [] for node in net}
+    for arc in net.arcs:
+        forward[arc.source].append(arc.target)
+        backward[arc.target].append(arc.source)
+
+    def closure(start: str, edges: dict[str, list[str]]) -> set[str]:
+        seen, todo = {start}, [start]
+        while todo:
+            for nxt in edges[todo.pop()]:
+                if nxt not in seen:
+                    seen.add(nxt)
+                    todo.append(nxt)
+        return seen
+
+    on_path = closure(source, forward) & closure(sink, backward)
+    missing = [node for node in net if node not in on_path]
+    problem = None
+    if missing:
+        shown = ", ".join(missing[:10]) + (" ..." if len(missing) > 10 else "")
+        problem = f"{len(missing)} nodes are not on a path from {source!r} to {sink!r}: {shown}"
+    return WorkflowStructure(not missing, source, sink, sources, sinks, missing, problem)
+
+
+def is_free_choice(net: Net) -> bool:
+    """Whether the net is free-choice: for every arc ``p -> t``, either ``t`` is the only
+    transition consuming from ``p`` or ``p`` is the only input place of ``t``.
+
+    Examples:
+        >>> from petriflow.classic import dining_philosophers
+        >>> is_free_choice(dining_philosophers(3))
+        False
+    """
+    consumers: dict[str, int] = {}
+    for transition in net.transitions:
+        for place in net.preset(transition):
+            consumers[place] = consumers.get(place, 0) + 1
+    for transition in net.transitions:
+        preset = net.preset(transition)
+        if len(preset) > 1 and any(consumers[p] > 1 for p in preset):
+            return False
+    return True
+
+
+@dataclass
+class SoundnessReport:
+    """The verdict of :func:`check_soundness` and the evidence behind it.
+
+    Attributes:
+        sound: the verdict (``False`` for a net that is not a WF-net).
+        structure: the WF-net structure check.
+        violations: every failed criterion, each with a witness.
+        bounded: ``None`` when not a WF-net.
+        option_to_complete, proper_completion, no_dead_transitions: the three criteria
+            (``None`` when not decided: not a WF-net, or unbounded).
+        dead_transitions: transitions never enabled from ``[i]``.
+        free_choice: whether the net is free-choice.
+        algorithm: how the verdict was reached.
+        initial_marking: ``[i]``; final_marking: the ``Mf`` used.
+        crosscheck: for free-choice WF-nets, the short-circuited net's liveness and
+            boundedness and whether they agree with the verdict.
+        space: the reachability graph from ``[i]`` (bounded WF-nets only).
+    """
+
+    sound: bool
+    structure: WorkflowStructure
+    violations: list[Violation]
+    bounded: bool | None = None
+    option_to_complete: bool | None = None
+    proper_completion: bool | None = None
+    no_dead_transitions: bool | None = None
+    dead_transitions: list[str] = field(default_factory=list)
+    free_choice: bool = False
+    algorithm: str = ""
+    initial_marking: dict[str, int] | None = None
+    final_marking: dict[str, int] | None = None
+    crosscheck: dict[str, Any] | None = None
+    space: StateSpace | None = field(default=None, repr=False)
+
+
+def check_soundness(
+    net: Net,
+    *,
+    final_marking: Mapping[str, int] | None = None,
+    max_states: int = DEFAULT_MAX_STATES,
+    crosscheck: bool = True,
+) -> SoundnessReport:
+    """Decide classical soundness of a WF-net for one token in its source place.
+
+    Args:
+        net: the net (its own initial marking is ignored: soundness is about ``[i]``).
+        final_marking: ``Mf``; default the net's ``final_marking``, else ``[o]``.
+        max_states: passed to the reachability graph.
+        crosscheck: for free-choice WF-nets, also check that the short-circuited net is
+            live and bounded exactly when the net was found sound.
+
+    Returns:
+        A :class:`SoundnessReport`.
+
+    Raises:
+        StateSpaceLimit: more than ``max_states`` markings are reachable from ``[i]``.
+    """
+    structure = workflow_structure(net)
+    free_choice = is_free_choice(net)
+    if not structure.is_wf_net:
+        violation = Violation("not_wf_net", f"not a WF-net: {structure.problem}",
+                              elements=structure.not_on_path)
+        return SoundnessReport(False, structure, [violation], free_choice=free_choice,
+                               algorithm="structure check")
+    source, sink = structure.source, structure.sink
+    start = Marking({source: 1})
+    final = Marking(final_marking) if final_marking is not None else (
+        net.final_marking if net.final_marking is not None else Marking({sink: 1}))
+    final = net.check_marking(final)
+    compiled = CompiledNet(net)
+    report = SoundnessReport(False, structure, [], free_choice=free_choice,
+                             initial_marking=start.to_dict(), final_marking=final.to_dict())
+    try:
+        space = reachability_graph(net, start, max_states=max_states, compiled=compiled)
+    except UnboundedNetError as exc:
+        return _unbounded(net, compiled, start, exc, report, max_states)
+    report.space = space
+    report.bounded = True
+    report.algorithm = "reachability graph from [i] (explicit breadth-first search)"
+    markings = space.markings
+    final_vector = np.array(compiled.vector(final), dtype=np.int64)
+
+    covering = (markings >= final_vector).all(axis=1) & (markings != final_vector).any(axis=1)
+    improper = np.flatnonzero(covering)
+    report.proper_completion = not improper.size
+    if improper.size:
+        state = int(improper[0])
+        reached = space.marking(state)
+        report.violations.append(Violation(
+            "improper_completion",
+            f"improper completion: {len(improper)} reachable markings cover the final marking"
+            f" {_format(final)} with tokens left elsewhere, e.g. {_format(reached)}",
+            space.path(state), reached.to_dict()))
+
+    final_state = space.index(final)
+    stuck = np.ones(space.num_states, dtype=bool) if final_state is None else ~can_reach(
+        space.num_states, space.edge_source, space.edge_target, [final_state])
+    report.option_to_complete = not stuck.any()
+    if stuck.any():
+        deadlocked = space.deadlocks()
+        # Point at a deadlock when there is one among the stuck markings: it says more
+        # than the first stuck marking (which is [i] when Mf is unreachable altogether).
+        stuck_deadlocks = deadlocked[stuck[deadlocked]]
+        state = int(stuck_deadlocks[0] if final_state is None and stuck_deadlocks.size
+                    else np.flatnonzero(stuck)[0])
+        reached = space.marking(state)
+        dead_end = bool(space.out_degree()[state] == 0)
+        if final_state is None:
+            why = f"the final marking {_format(final)} is not reachable from [{source}] at all"
+            if dead_end:
+                why += f"; e.g. {_format(reached)} is a deadlock"
+        else:
+            kind = "a deadlock" if dead_end else "no firing sequence leads back"
+            why = (f"from {_format(reached)} the final marking {_format(final)} can no longer"
+                   f" be reached ({kind}); {int(stuck.sum())} of {space.num_states} reachable"
+                   " markings are like this")
+        report.violations.append(Violation("no_option_to_complete", f"no option to complete: {why}",
+                                           space.path(state), reached.to_dict()))
+
+    dead = dead_transitions(space)
+    report.dead_transitions = dead
+    report.no_dead_transitions = not dead
+    if dead:
+        report.violations.append(Violation(
+            "dead_transition",
+            f"{len(dead)} dead transitions (enabled in no marking reachable from [{source}]):"
+            f" {', '.join(dead)}", elements=dead))
+    report.sound = not report.violations
+    if crosscheck and free_choice and final == Marking({sink: 1}):
+        report.crosscheck = _free_choice_crosscheck(net, source, sink, report.sound, max_states)
+        report.algorithm += "; free-choice cross-check: short-circuited net live and bounded"
+    return report
+
+
+def _unbounded(net: Net, compiled: CompiledNet, start: Marking, exc: UnboundedNetError,
+               report: SoundnessReport, max_states: int) -> SoundnessReport:
+    """The report for an unbounded WF-net: unsound, with the pumping witness."""
+    report.bounded = False
+    report.algorithm = ("reachability graph from [i] stopped: a marking strictly covers an"
+                        " earlier one on its path (unbounded)")
+    places = list(exc.places)
+    try:
+        graph = coverability_graph(net, start, max_nodes=max_states, compiled=compiled)
+    except StateSpaceLimit:
+        graph = None
+    if graph is not None:
+        places = graph.unbounded_places
+        report.algorithm += "; Karp-Miller coverability graph for the unbounded places"
+    report.violations.append(Violation(
+        "unbounded",
+        f"unbounded: firing {' '.join(exc.pump)} from the marking reached by"
+        f" [{' '.join(exc.prefix)}] adds tokens to {', '.join(exc.places)} and can be repeated"
+        f" forever; unbounded places: {', '.join(places)}",
+        exc.prefix + exc.pump, exc.covering.to_dict(), places))
+    if graph is not None:
+        dead = graph.dead_transitions()
+        report.dead_transitions = dead
+        report.no_dead_transitions = not dead
+        if dead:
+            report.violations.append(Violation(
+                "dead_transition",
+                f"{len(dead)} dead transitions (enabled in no marking reachable from [i]):"
+                f" {', '.join(dead)}", elements=dead))
+    report.sound = False
+    return report
+
+
+def _free_choice_crosscheck(net: Net, source: str, sink: str, sound: bool,
+                            max_states: int) -> dict[str, Any]:
+    """Soundness of a free-choice WF-net <=> its short-circuited net is live and bounded."""
+    closed = net.copy()
+    name = "short_circuit"
+    while name in closed.places or name in closed.transitions:
+        name = "_" + name
+    closed.add_transition(name, silent=True)
+    closed.add_arc(sink, name)
+    closed.add_arc(name, source)
+    try:
+        space = reachability_graph(closed, {source: 1}, max_states=max_states)
+    except UnboundedNetError:
+        return {"short_circuit_bounded": False, "short_circuit_live": None,
+                "agrees": not sound}
+    except StateSpaceLimit:
+        return {"short_circuit_bounded": None, "short_circuit_live": None, "agrees": None}
+    live = is_live(space)
+    return {"short_circuit_bounded": True, "short_circuit_live": live, "agrees": live == sound}

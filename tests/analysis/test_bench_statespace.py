@@ -1,0 +1,37 @@
+"""Smoke test: bench/statespace.py runs in quick mode and writes its JSON (no timing checks)."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+BENCH = Path(__file__).resolve().parents[2] / "bench" / "statespace.py"
+
+
+def load_bench():
+    spec = importlib.util.spec_from_file_location("bench_statespace", BENCH)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_quick_run_writes_a_table_and_json(tmp_path, capsys):
+    """--quick --tools petriflow prints a Markdown table and writes matching JSON rows."""
+    out = tmp_path / "rows.json"
+    assert load_bench().main(["--quick", "--tools", "petriflow", "--json", str(out)]) == 0
+    table = capsys.readouterr().out
+    assert "| petriflow | philosophers | N=10 | 123 | 680 |" in table
+    rows = json.loads(out.read_text())["rows"]
+    states = {(r["net"], r["size"]): r["states"] for r in rows}
+    assert states[("philosophers", "N=15")] == 1364
+    assert states[("producer/consumer, batch 3", "c=300")] == 4 * 301
+
+
+def test_shared_buffer_is_bounded_by_its_capacity():
+    """The benchmark's shared-buffer net keeps buffer + free equal to the capacity."""
+    from petriflow.analysis.reachability import reachability_graph
+
+    space = reachability_graph(load_bench().shared_buffer(3, 4, 2))
+    columns = [space.places.index("buffer"), space.places.index("free")]
+    assert (space.markings[:, columns].sum(axis=1) == 4).all()
