@@ -24,3 +24,13 @@ def test_shipped_net_loads_plays_and_round_trips(path):
     sim.run(until=100)
     assert sim.fired > 0
     assert loads_net(dumps_net(net)).structure() == net.structure()
+
+
+@pytest.mark.parametrize("path", NET_FILES, ids=lambda p: str(p.relative_to(NETS)))
+def test_shipped_net_binds_every_action(path):
+    """Every action and guard a shipped net names is registered, with valid parameters."""
+    from petriflow.runtime.registry import default_registry
+
+    net = load_net(path)
+    bound = default_registry.bind(net, str(path))
+    assert set(bound) == set(net.actions())
