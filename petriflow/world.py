@@ -15,6 +15,9 @@ The description is plain data (a ``world.yaml`` beside a net)::
     robots:
       - {id: red, urdf: "petriflow.agents:robots/diffdrive.urdf", position: [0, 0],
          yaw: 0, colour: red, agent: robot_red}
+      # optional: z (base height), roll and pitch (rad, about the body's x and y
+      # axes, applied after yaw): a robot that starts fallen on its side
+    meta: {}                 # free-form data the world keeps (``World.meta``) but never reads
     cameras:
       - {id: top, position: [0, 0, 6], target: [0, 0, 0], up: [0, 1, 0], fov: 60,
          width: 640, height: 480}
@@ -54,7 +57,7 @@ COLOURS = {
     "orange": (1.0, 0.55, 0.0, 1.0),
 }
 
-_KEYS = {"dt", "gravity", "plane", "boxes", "grid", "robots", "cameras"}
+_KEYS = {"dt", "gravity", "plane", "boxes", "grid", "robots", "cameras", "meta"}
 
 
 @contextlib.contextmanager
@@ -175,6 +178,11 @@ class World:
         self.agents: dict[str, str] = {}
         self.cameras: dict[str, Camera] = {}
         self.steps = 0
+        meta = description.get("meta")
+        if meta is not None and not isinstance(meta, dict):
+            self._fail(f"meta is a mapping, got {meta!r}")
+        #: Free-form data from the description's ``meta`` (kept for other components, unread here).
+        self.meta: dict[str, Any] = dict(meta or {})
         if description.get("plane", True):
             self.bodies["plane"] = self._load_urdf("pybullet_data:plane.urdf", (0, 0, 0), 0.0, fixed=True)
         for box in description.get("boxes") or []:
@@ -220,9 +228,10 @@ class World:
             self._fail(f"URDF not found: {reference!r}")
         return str(candidate)
 
-    def _load_urdf(self, reference: str, position, yaw: float, fixed: bool = False) -> int:
+    def _load_urdf(self, reference: str, position, yaw: float, fixed: bool = False,
+                   roll: float = 0.0, pitch: float = 0.0) -> int:
         p = self.p
-        orientation = p.getQuaternionFromEuler((0, 0, yaw))
+        orientation = p.getQuaternionFromEuler((roll, pitch, yaw))
         try:
             return p.loadURDF(self._resolve(reference), position, orientation, useFixedBase=fixed,
                               physicsClientId=self.client)
@@ -267,11 +276,13 @@ class World:
                              colour=grid.get("colour", "grey"))
 
     def _add_robot(self, robot: Any) -> None:
-        robot = self._checked(robot, {"id", "urdf", "position", "yaw", "colour", "agent", "z"}, "robot")
+        robot = self._checked(robot, {"id", "urdf", "position", "yaw", "roll", "pitch", "colour", "agent", "z"},
+                              "robot")
         if "id" not in robot or "urdf" not in robot:
             self._fail("a robot needs 'id' and 'urdf'")
         x, y = (float(v) for v in robot.get("position", (0, 0)))
-        body = self._load_urdf(robot["urdf"], (x, y, float(robot.get("z", 0.0))), float(robot.get("yaw", 0.0)))
+        body = self._load_urdf(robot["urdf"], (x, y, float(robot.get("z", 0.0))), float(robot.get("yaw", 0.0)),
+                               roll=float(robot.get("roll", 0.0)), pitch=float(robot.get("pitch", 0.0)))
         if robot["id"] in self.bodies:
             self._fail("duplicate body id", robot["id"])
         self.bodies[robot["id"]] = body
@@ -346,17 +357,10 @@ class World:
 
 def load_world(path: str | Path, gui: bool = False) -> World:
     """Build a :class:`World` from a YAML description file (safe loader)."""
-    import yaml
+    from petriflow.io.files import read_yaml_file
 
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise NetFormatError(f"cannot read: {exc.strerror or exc}", path=str(path)) from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise NetFormatError(f"malformed YAML: {getattr(exc, 'problem', exc)}", path=str(path),
-                             line=mark.line + 1 if mark else None) from None
+    data = read_yaml_file(path)
     if data is not None and not isinstance(data, dict):
         raise NetFormatError("a world description is a mapping", path=str(path))
     return World(data, base=path.parent, gui=gui, path=str(path))

@@ -167,15 +167,6 @@ class RunConfig:
 
 def load_config(path: str | Path) -> RunConfig:
     """Read a run configuration YAML file (safe loader)."""
-    import yaml
+    from petriflow.io.files import read_yaml_file
 
-    path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise NetFormatError(f"cannot read: {exc.strerror or exc}", path=str(path)) from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise NetFormatError(f"malformed YAML: {getattr(exc, 'problem', exc)}", path=str(path),
-                             line=mark.line + 1 if mark else None) from None
-    return RunConfig.from_dict(data, str(path))
+    return RunConfig.from_dict(read_yaml_file(path), str(path))
