@@ -167,6 +167,11 @@ class World:
         self.dt = float(description.get("dt", 1.0 / 240.0))
         if not self.dt > 0:
             self._fail(f"dt must be > 0, got {self.dt}")
+        meta = description.get("meta")
+        if meta is not None and not isinstance(meta, dict):
+            self._fail(f"meta is a mapping, got {meta!r}")
+        #: Free-form data from the description's ``meta`` (kept for other components, unread here).
+        self.meta: dict[str, Any] = dict(meta or {})
         p = self.p
         with _quiet_stdout():
             self.client = p.connect(p.GUI if gui else p.DIRECT)
@@ -178,11 +183,6 @@ class World:
         self.agents: dict[str, str] = {}
         self.cameras: dict[str, Camera] = {}
         self.steps = 0
-        meta = description.get("meta")
-        if meta is not None and not isinstance(meta, dict):
-            self._fail(f"meta is a mapping, got {meta!r}")
-        #: Free-form data from the description's ``meta`` (kept for other components, unread here).
-        self.meta: dict[str, Any] = dict(meta or {})
         if description.get("plane", True):
             self.bodies["plane"] = self._load_urdf("pybullet_data:plane.urdf", (0, 0, 0), 0.0, fixed=True)
         for box in description.get("boxes") or []:

@@ -1,0 +1,180 @@
+"""The SMART arena as the overhead camera sees it: a white floor and marker hats.
+
+A SMART robot carries a colour patch with a black and a white disc (seed 003, §2.4);
+the floor is white. A ``world.yaml`` says which robot wears which colour under its
+``meta`` key (the world keeps that data and never reads it)::
+
+    meta:
+      smart:
+        floor: white                     # the camera sees a plain white floor
+        markers:                         # one marker hat per robot
+          - {robot: robot3l, colour: yellow}
+          - {robot: robot4l, colour: red}
+
+:func:`dress` puts that on a world once: the floor turns white and each robot gets a
+hat (:func:`petriflow.vision.markers.attach_markers`) centred over its body frame
+just above its top plate, whatever pose the robot was loaded in (a fallen robot's
+hat faces sideways with its plate). The hats are light, collision-free bodies held
+by fixed constraints, so they follow the robots while the world steps; no per-step
+call is needed (``bench/smart.py`` and the tests measure how closely they follow).
+``smart.capture`` (``T0`` of ``nets/smart/smart.yaml``) dresses its world before the
+first frame; tests and scripts call :func:`dress` or :func:`load_arena`.
+
+``floor: white`` replaces pybullet's ground plane by an *unrendered* ground with the
+same collision box and friction: pybullet's CPU renderer (TinyRenderer) clears every
+frame to white (255, 255, 255), which the vision reads as floor like the paper's white
+floor, and it spends about three quarters of a 640 x 480 frame rasterising a ground
+that covers the image (measured: 110-125 ms a frame with the plane, 25-35 ms without,
+the same scene). ``floor: painted`` keeps the plane and paints it white instead
+(:func:`petriflow.vision.markers.white_floor`), the slower look-alike.
+
+Examples:
+    >>> from petriflow.world import World
+    >>> world = World({"robots": [{"id": "cat", "urdf": "petriflow.agents.legged:robots/robot3l.urdf",
+    ...                            "z": 0.08}],
+    ...                "meta": {"smart": {"markers": [{"robot": "cat", "colour": "yellow"}]}}})
+    >>> sorted(dress(world).hats)
+    ['cat']
+    >>> dress(world) is dress(world)                 # once per world
+    True
+    >>> robot_colours(world)
+    {'cat': 'yellow'}
+    >>> world.close()
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from petriflow.errors import NetFormatError
+
+__all__ = ["Arena", "colour_robots", "dress", "hat_offset", "load_arena", "robot_colours", "unrendered_ground"]
+
+#: Attribute of a world holding its :class:`Arena` once dressed.
+_ATTRIBUTE = "smart_arena"
+
+
+@dataclass
+class Arena:
+    """What :func:`dress` put on a world.
+
+    Attributes:
+        hats: ``{robot body name: MarkerHat}``.
+        colours: ``{robot body name: colour}``.
+        floor: the floor colour applied (``None``: left as it was).
+    """
+
+    hats: dict[str, Any] = field(default_factory=dict)
+    colours: dict[str, str] = field(default_factory=dict)
+    floor: str | None = None
+
+
+def _spec(world: Any) -> dict[str, Any]:
+    meta = getattr(world, "meta", None) or {}
+    spec = meta.get("smart") or {}
+    if not isinstance(spec, dict):
+        raise NetFormatError(f"meta.smart is a mapping, got {spec!r}", path=getattr(world, "path", None))
+    return spec
+
+
+def robot_colours(world: Any) -> dict[str, str]:
+    """``{robot body name: colour}`` declared under the world's ``meta.smart.markers``."""
+    colours: dict[str, str] = {}
+    for entry in _spec(world).get("markers") or []:
+        if not isinstance(entry, dict) or "robot" not in entry or "colour" not in entry:
+            raise NetFormatError(f"a marker is {{robot: NAME, colour: COLOUR}}, got {entry!r}",
+                                 path=getattr(world, "path", None))
+        colours[str(entry["robot"])] = str(entry["colour"])
+    return colours
+
+
+def colour_robots(world: Any) -> dict[str, str]:
+    """``{colour: robot body name}``, the inverse of :func:`robot_colours`."""
+    return {colour: robot for robot, colour in robot_colours(world).items()}
+
+
+def hat_offset(world: Any, body: int) -> tuple[float, float, float]:
+    """Where a hat sits in a robot base's centre-of-mass frame: over the body frame's
+    origin, 1 mm above the top plate (legged robots) or the base's top (other bodies,
+    measured as loaded, so such a body must be upright then)."""
+    p, client = world.p, world.client
+    inertial = p.getDynamicsInfo(body, -1, physicsClientId=client)[3]
+    name = p.getBodyInfo(body, physicsClientId=client)[1].decode()
+    try:
+        from petriflow.agents.legged.robots import DESIGNS
+    except ImportError:  # pragma: no cover - the legged package ships with agents
+        DESIGNS = {}
+    if name in DESIGNS:
+        plate = DESIGNS[name].plate
+        top = plate.centre[2] + plate.size[2] / 2 + 0.001
+        return (-inertial[0], -inertial[1], top - inertial[2])
+    position, _ = p.getBasePositionAndOrientation(body, physicsClientId=client)
+    top = p.getAABB(body, -1, physicsClientId=client)[1][2]
+    return (0.0, 0.0, top - position[2] + 0.001)
+
+
+def unrendered_ground(world: Any) -> int:
+    """Replace the world's ``plane`` by a ground the camera does not draw: the same
+    collision (a 200 m x 200 m x 10 m box, top face at z = 0) and friction, and a
+    1 mm visual sphere 90 m away, so the renderer never rasterises it (a body without a
+    visual shape would be drawn from its collision shape). Returns the new body id.
+    Call before the world first steps."""
+    p, client = world.p, world.client
+    old = world.bodies.get("plane")
+    friction = 1.0
+    if old is not None:
+        friction = p.getDynamicsInfo(old, -1, physicsClientId=client)[1]
+        p.removeBody(old, physicsClientId=client)
+    shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=[100.0, 100.0, 5.0], physicsClientId=client)
+    speck = p.createVisualShape(p.GEOM_SPHERE, radius=0.001, visualFramePosition=[90.0, 90.0, 0.0],
+                                rgbaColor=[1, 1, 1, 1], physicsClientId=client)
+    body = p.createMultiBody(0.0, shape, speck, [0.0, 0.0, -5.0], physicsClientId=client)
+    p.changeDynamics(body, -1, lateralFriction=friction, physicsClientId=client)
+    world.bodies["plane"] = body
+    return body
+
+
+def dress(world: Any) -> Arena:
+    """Whiten the floor and put a marker hat on every robot named in the world's
+    ``meta.smart`` (once per world: later calls return the same :class:`Arena`)."""
+    arena = getattr(world, _ATTRIBUTE, None)
+    if arena is not None:
+        return arena
+    from petriflow.vision.markers import attach_markers, white_floor
+
+    spec = _spec(world)
+    arena = Arena()
+    floor = spec.get("floor")
+    if floor is not None:
+        if floor == "white":
+            unrendered_ground(world)
+        elif floor == "painted":
+            white_floor(world)
+        else:
+            raise NetFormatError(f"meta.smart.floor: 'white' or 'painted', got {floor!r}",
+                                 path=getattr(world, "path", None))
+        arena.floor = floor
+    for robot, colour in robot_colours(world).items():
+        body = world.body(robot)
+        arena.hats[robot] = attach_markers(world, body, colour=colour, offset=hat_offset(world, body))
+        arena.colours[robot] = colour
+    setattr(world, _ATTRIBUTE, arena)
+    return arena
+
+
+def load_arena(path: str | Path, gui: bool = False, camera_size: tuple[int, int] | None = None) -> Any:
+    """Load a world file and :func:`dress` it; ``camera_size`` (width, height) resizes
+    every camera (e.g. ``(320, 240)``)."""
+    from petriflow.world import load_world
+
+    world = load_world(path, gui=gui)
+    if camera_size is not None:
+        import dataclasses
+
+        for name, camera in list(world.cameras.items()):
+            world.cameras[name] = dataclasses.replace(camera, width=int(camera_size[0]),
+                                                      height=int(camera_size[1]))
+    dress(world)
+    return world
