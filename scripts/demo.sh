@@ -1,19 +1,26 @@
 #!/usr/bin/env bash
-# The main scenario: two robots take turns through a narrow passage (nets/passage),
-# run over pybullet with trace, XES log and journal; then the net is drawn and converted.
+# The main scenario: the SMART helping task (nets/smart, seed 003) checked, run over
+# pybullet with trace, XES log and journal, and drawn; then the small passage example.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-net=nets/passage/passage.yaml
 mkdir -p out
-rm -f out/passage.sqlite out/passage.sqlite-wal out/passage.sqlite-shm
+rm -f out/smart.sqlite* out/passage.sqlite*
+
+net=nets/smart/smart.yaml
 petriflow info "$net"
 echo
-petriflow run "$net" --trace out/passage.jsonl --xes out/passage.xes --db out/passage.sqlite
+petriflow check "$net"
 echo
-petriflow replay out/passage.jsonl
+petriflow run "$net" --trace out/smart.jsonl --xes out/smart.xes --db out/smart.sqlite
+petriflow replay out/smart.jsonl > out/smart.replay.txt
+grep -vE " T[1234] " out/smart.replay.txt | grep -E "fire|stop"   # the task, without the camera loop
+petriflow export "$net" -f png -o out/smart.png
+echo
+
+net=nets/passage/passage.yaml
+petriflow run "$net" --trace out/passage.jsonl --xes out/passage.xes --db out/passage.sqlite
 petriflow export "$net" -f svg -o out/passage.svg
-petriflow export "$net" -f png -o out/passage.png
 petriflow export "$net" -f pnml -o out/passage.pnml
 petriflow export out/passage.pnml -f yaml -o out/passage.roundtrip.yaml
 echo
-echo "wrote out/passage.{jsonl,xes,sqlite,svg,png,pnml} and out/passage.roundtrip.yaml"
+echo "wrote out/smart.{jsonl,xes,sqlite,png,replay.txt} and out/passage.{jsonl,xes,sqlite,svg,pnml}, out/passage.roundtrip.yaml"
