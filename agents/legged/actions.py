@@ -347,6 +347,26 @@ class Turn(Walk):
         return (0.0, 0.0, 0.0)
 
 
+def brace_route(fallen, gap: float, approach: float) -> tuple[list[tuple], tuple[float, float, float]]:
+    """The moves that bring a helper behind a fallen robot's back, and the brace pose.
+
+    Returns:
+        ``([("goto", x, y, False), ("face", yaw), ...], (x, y, yaw))``: the approach
+        point ``gap + approach`` behind the back, facing the robot, then the brace point
+        ``gap`` from its centre, facing it.
+
+    Raises:
+        ActionFailure: the robot is not lying on a side.
+    """
+    position, rotation = fallen.frame()
+    if lying_on(rotation) not in ("left", "right"):
+        raise ActionFailure(f"robot {fallen.name!r} is not lying on a side ({lying_on(rotation)})")
+    bx, by, facing = brace_point(position, rotation, gap)
+    ax, ay, _ = brace_point(position, rotation, gap + approach)
+    items = [("goto", ax, ay, False), ("face", facing), ("goto", bx, by, False), ("face", facing)]
+    return items, (bx, by, facing)
+
+
 class Brace(Walk):
     """The helper's part of the helping task (seed 003 §5.2): walk behind a fallen
     robot lying on its side, face its back and stop there, holding it.
@@ -367,14 +387,9 @@ class Brace(Walk):
     }
 
     def _route(self, ctx: ActionContext) -> list[tuple]:
-        fallen = self._robot(self.params["target"])
-        position, rotation = fallen.frame()
-        if lying_on(rotation) not in ("left", "right"):
-            raise ActionFailure(f"robot {fallen.name!r} is not lying on a side ({lying_on(rotation)})")
-        bx, by, facing = brace_point(position, rotation, self.params["gap"])
-        ax, ay, _ = brace_point(position, rotation, self.params["gap"] + self.params["approach"])
-        self.brace = (bx, by, facing)
-        return [("goto", ax, ay, False), ("face", facing), ("goto", bx, by, False), ("face", facing)]
+        items, self.brace = brace_route(self._robot(self.params["target"]), self.params["gap"],
+                                        self.params["approach"])
+        return items
 
     def _angle_tolerance(self) -> float:
         return 0.08

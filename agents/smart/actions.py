@@ -387,16 +387,11 @@ class Follow(Walk):
         return list(self.waypoints) + list(self.tail)
 
     def _brace_items(self) -> list[tuple]:
-        from petriflow.agents.legged.righting import brace_point, lying_on
+        from petriflow.agents.legged.actions import brace_route
 
-        fallen = self._robot(self.params["brace"])
-        position, rotation = fallen.frame()
-        if lying_on(rotation) not in ("left", "right"):
-            raise ActionFailure(f"robot {fallen.name!r} is not lying on a side ({lying_on(rotation)})")
-        bx, by, facing = brace_point(position, rotation, self.params["gap"])
-        ax, ay, _ = brace_point(position, rotation, self.params["gap"] + self.params["approach"])
-        self.brace = (bx, by, facing)
-        return [("goto", ax, ay, False), ("face", facing), ("goto", bx, by, False), ("face", facing)]
+        items, self.brace = brace_route(self._robot(self.params["brace"]), self.params["gap"],
+                                        self.params["approach"])
+        return items
 
     def _angle_tolerance(self) -> float:
         return 0.08 if self.params["brace"] is not None else 0.05
