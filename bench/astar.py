@@ -44,6 +44,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from petriflow.agents.planning import astar as astar_module
+from petriflow.agents.planning import maps
 from petriflow.agents.planning.astar import astar
 from petriflow.agents.planning.mazes import Maze, all_mazes
 
@@ -54,23 +55,7 @@ PLANNERS = ("petriflow optimal", "petriflow paper", "pyastar2d", "networkx", "sc
 def grid_edges(grid: np.ndarray, cut_corners: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Directed edges (source index, target index, cost) of the 8-connected free grid,
     with petriflow's rules: √2 diagonals, no corner cutting unless ``cut_corners``."""
-    rows, cols = grid.shape
-    free = ~grid
-    index = np.arange(rows * cols).reshape(rows, cols)
-    sources, targets, costs = [], [], []
-    for dr in (-1, 0, 1):
-        for dc in (-1, 0, 1):
-            if dr == 0 and dc == 0:
-                continue
-            r0, r1 = max(0, -dr), rows - max(0, dr)
-            c0, c1 = max(0, -dc), cols - max(0, dc)
-            ok = free[r0:r1, c0:c1] & free[r0 + dr:r1 + dr, c0 + dc:c1 + dc]
-            if dr and dc and not cut_corners:
-                ok &= free[r0 + dr:r1 + dr, c0:c1] & free[r0:r1, c0 + dc:c1 + dc]
-            sources.append(index[r0:r1, c0:c1][ok])
-            targets.append(index[r0 + dr:r1 + dr, c0 + dc:c1 + dc][ok])
-            costs.append(np.full(int(ok.sum()), SQRT2 if dr and dc else 1.0))
-    return np.concatenate(sources), np.concatenate(targets), np.concatenate(costs)
+    return maps.grid_edges(grid, diagonal_cost=SQRT2, cut_corners=cut_corners)
 
 
 def euclidean_length(cells: np.ndarray) -> float:

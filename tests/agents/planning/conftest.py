@@ -18,23 +18,11 @@ def grid_distances(grid: np.ndarray, start: tuple[int, int], *, diagonal_cost: f
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import dijkstra
 
+    from petriflow.agents.planning.maps import grid_edges
+
     rows, cols = grid.shape
-    free = ~np.asarray(grid, bool)
-    index = np.arange(rows * cols).reshape(rows, cols)
-    sources, targets, costs = [], [], []
-    for dr in (-1, 0, 1):
-        for dc in (-1, 0, 1):
-            if dr == 0 and dc == 0:
-                continue
-            r0, r1 = max(0, -dr), rows - max(0, dr)
-            c0, c1 = max(0, -dc), cols - max(0, dc)
-            ok = free[r0:r1, c0:c1] & free[r0 + dr:r1 + dr, c0 + dc:c1 + dc]
-            if dr and dc and not cut_corners:
-                ok &= free[r0 + dr:r1 + dr, c0:c1] & free[r0:r1, c0 + dc:c1 + dc]
-            sources.append(index[r0:r1, c0:c1][ok])
-            targets.append(index[r0 + dr:r1 + dr, c0 + dc:c1 + dc][ok])
-            costs.append(np.full(int(ok.sum()), diagonal_cost if dr and dc else 1.0))
-    matrix = csr_matrix((np.concatenate(costs), (np.concatenate(sources), np.concatenate(targets))),
+    sources, targets, costs = grid_edges(grid, diagonal_cost=diagonal_cost, cut_corners=cut_corners)
+    matrix = csr_matrix((costs, (sources, targets)),
                         shape=(rows * cols, rows * cols))
     return dijkstra(matrix, directed=True, indices=start[0] * cols + start[1]).reshape(rows, cols)
 
