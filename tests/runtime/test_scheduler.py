@@ -233,3 +233,39 @@ def test_fire_one_refuses_a_disabled_transition():
     net = net_of("places: [a, b]\ntransitions: [{id: t, in: [a], out: [b]}]\n")
     with pytest.raises(NotEnabledError, match="a has 0, needs 1"):
         Scheduler(net).fire_one("t")
+
+
+def test_cancellation_clean_up_may_take_several_ticks():
+    """An action whose cancel() needs three ticks ends 'cancelled' only when it is done."""
+    from petriflow.runtime.action import Action
+
+    class SlowStop(Action):
+        needs_world = False
+
+        def start(self, ctx):
+            self.left = 3
+
+        def poll(self, ctx):
+            return Status.RUNNING
+
+        def cancel(self, ctx):
+            self.left -= 1
+            return self.left == 0
+
+    registry = Registry(load_plugins=False)
+    registry.register("test.slowstop", SlowStop)
+    registry.register("core.wait", default_registry.resolve("core.wait"))
+    net = net_of("""
+places: [{id: a, tokens: 1}, {id: alarm, tokens: 1}, b, stopped, s]
+transitions:
+  - {id: work, action: test.slowstop, in: [a], out: [b], outcomes: {cancelled: [stopped]}}
+  - {id: ring, action: core.wait, params: {seconds: 1}, in: [alarm], out: [s]}
+  - {id: abort, in: [s], cancels: [work]}
+""")
+    run = Scheduler(net, registry=registry)
+    events = events_of(run)
+    result = run.run(until=5)
+    end = [e for e in events if e.kind == "end" and e.transition == "work"][0]
+    assert end.data["outcome"] == "cancelled"
+    assert end.time == pytest.approx(1.02)  # abort at 1.0 s, then two more ticks of clean-up
+    assert result.marking == {"stopped": 1}
