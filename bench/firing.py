@@ -33,12 +33,17 @@ import argparse
 import json
 import platform
 import random
+import sys
 import time
+from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from petriflow.classic import dining_philosophers
 from petriflow.engine import Simulation
 from petriflow.net import Net
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench/ holds scripts, not a package
+from peers import to_pm4py  # noqa: E402
 
 ENGINES = ("petriflow", "PM4Py", "SNAKES")
 
@@ -60,31 +65,11 @@ def petriflow_game(net: Net) -> Game:
     return _timed_after(setup)
 
 
-def pm4py_net(net: Net) -> tuple[Any, Any]:
-    """The PM4Py ``(PetriNet, Marking)`` of ``net``, built with PM4Py's own classes."""
-    from pm4py.objects.petri_net.obj import Marking, PetriNet
-    from pm4py.objects.petri_net.utils import petri_utils
-
-    pnet = PetriNet(net.id)
-    nodes: dict[str, Any] = {}
-    for place in net.places:
-        nodes[place] = PetriNet.Place(place)
-        pnet.places.add(nodes[place])
-    for transition in net.transitions.values():
-        nodes[transition.id] = PetriNet.Transition(transition.id, transition.label or transition.id)
-        pnet.transitions.add(nodes[transition.id])
-    for arc in net.arcs:
-        if getattr(arc, "outcome", None) is None:
-            petri_utils.add_arc_from_to(nodes[arc.source], nodes[arc.target], pnet, weight=arc.weight)
-    marking = Marking({nodes[p]: k for p, k in net.initial_marking.items()})
-    return pnet, marking
-
-
 def pm4py_game(net: Net) -> Game:
     """PM4Py's token game with its classic semantics functions."""
     from pm4py.objects.petri_net import semantics
 
-    pnet, start = pm4py_net(net)
+    pnet, start, _ = to_pm4py(net)
     enabled_transitions, execute = semantics.enabled_transitions, semantics.execute
 
     def setup(seed: int) -> Callable[[int], int]:

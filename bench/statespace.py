@@ -46,10 +46,14 @@ import resource
 import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from petriflow.classic import dining_philosophers, producer_consumer
 from petriflow.net import Net
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench/ holds scripts, not a package
+from peers import to_pm4py  # noqa: E402
 
 #: Wall-clock budget per measurement beyond which a peer library is not run on bigger nets.
 BUDGET = {"PM4Py": 30.0, "SNAKES": 10.0}
@@ -101,20 +105,9 @@ def petriflow_explore(net: Net) -> Callable[[], tuple[int, int]]:
 
 
 def pm4py_explore(net: Net) -> Callable[[], tuple[int, int]]:
-    from pm4py.objects.petri_net.obj import Marking, PetriNet
-    from pm4py.objects.petri_net.utils import petri_utils, reachability_graph
+    from pm4py.objects.petri_net.utils import reachability_graph
 
-    pn = PetriNet(net.id)
-    places = {p: PetriNet.Place(p) for p in net.places}
-    pn.places.update(places.values())
-    for name in net.transitions:
-        transition = PetriNet.Transition(name, name)
-        pn.transitions.add(transition)
-        for place, weight in net.preset(name).items():
-            petri_utils.add_arc_from_to(places[place], transition, pn, weight=weight)
-        for place, weight in net.postset(name).items():
-            petri_utils.add_arc_from_to(transition, places[place], pn, weight=weight)
-    initial = Marking({places[p]: c for p, c in net.initial_marking.items()})
+    pn, initial, _ = to_pm4py(net)
 
     def run() -> tuple[int, int]:
         graph = reachability_graph.construct_reachability_graph(pn, initial)

@@ -12,6 +12,20 @@ REPO = Path(__file__).resolve().parents[1]
 NETS = REPO / "nets"
 ORACLE = REPO.parent / "shared" / "oracle"
 
+def bench_module(name: str):
+    """Import ``bench/NAME.py`` (bench/ is a folder of scripts, not a package)."""
+    import importlib.util
+    import sys
+
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, REPO / "bench" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
 def net_files() -> list[Path]:
     """The nets shipped under nets/ (YAML files with a 'petriflow:' version key, and PNML);
     world and run configuration files beside them are not nets."""

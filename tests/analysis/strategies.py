@@ -67,22 +67,7 @@ def reference_exploration(net: Net, start=None) -> tuple[set[Marking], int]:
 
 
 def to_pm4py(net: Net):
-    """``(pm4py PetriNet, initial Marking, place objects)`` for a plain P/T net."""
-    from pm4py.objects.petri_net.obj import Marking as PMarking
-    from pm4py.objects.petri_net.obj import PetriNet
-    from pm4py.objects.petri_net.utils import petri_utils
+    """``(pm4py PetriNet, initial Marking, place objects)``: the benchmarks' converter."""
+    from tests.conftest import bench_module
 
-    pn = PetriNet(net.id)
-    places = {}
-    for place in net.places:
-        places[place] = PetriNet.Place(place)
-        pn.places.add(places[place])
-    for transition in net.transitions:
-        pm_transition = PetriNet.Transition(transition, transition)
-        pn.transitions.add(pm_transition)
-        for place, weight in net.preset(transition).items():
-            petri_utils.add_arc_from_to(places[place], pm_transition, pn, weight=weight)
-        for place, weight in net.postset(transition).items():
-            petri_utils.add_arc_from_to(pm_transition, places[place], pn, weight=weight)
-    initial = PMarking({places[p]: c for p, c in net.initial_marking.items()})
-    return pn, initial, places
+    return bench_module("peers").to_pm4py(net)
