@@ -39,6 +39,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
@@ -47,6 +48,9 @@ from petriflow.agents.planning import astar as astar_module
 from petriflow.agents.planning import maps
 from petriflow.agents.planning.astar import astar
 from petriflow.agents.planning.mazes import Maze, all_mazes
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench/ holds scripts, not a package
+from peers import versions as peer_versions  # noqa: E402
 
 SQRT2 = math.sqrt(2.0)
 PLANNERS = ("petriflow optimal", "petriflow paper", "pyastar2d", "networkx", "scipy dijkstra")
@@ -229,16 +233,8 @@ def markdown(rows: list[dict[str, Any]], speed: list[dict[str, Any]]) -> str:
 
 
 def versions() -> dict[str, str]:
-    """Python, numpy, numba and the peers' versions."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    info = {"python": platform.python_version()}
-    for package in ("numpy", "numba", "pyastar2d", "networkx", "scipy"):
-        try:
-            info[package] = version(package)
-        except PackageNotFoundError:
-            info[package] = "not installed"
-    return info
+    """Versions of Python and the libraries measured."""
+    return peer_versions("numpy", "numba", "pyastar2d", "networkx", "scipy")
 
 
 def main(argv: Sequence[str] | None = None) -> list[dict[str, Any]]:

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import platform
 import random
 import sys
 import time
@@ -43,7 +42,7 @@ from petriflow.engine import Simulation
 from petriflow.net import Net
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # bench/ holds scripts, not a package
-from peers import to_pm4py  # noqa: E402
+from peers import to_pm4py, versions as peer_versions  # noqa: E402
 
 ENGINES = ("petriflow", "PM4Py", "SNAKES")
 
@@ -201,16 +200,8 @@ def markdown(rows: list[dict[str, Any]], firings: int, snakes_firings: int) -> s
 
 
 def versions() -> dict[str, str]:
-    """Python and library versions, for the record."""
-    from importlib.metadata import version
-
-    found = {"python": platform.python_version()}
-    for dist in ("petriflow", "pm4py", "snakes"):
-        try:
-            found[dist] = version(dist)
-        except Exception:  # pragma: no cover - not installed as a distribution
-            found[dist] = "?"
-    return found
+    """Versions of Python and the libraries measured."""
+    return peer_versions("petriflow", "pm4py", "snakes")
 
 
 def main(argv: Sequence[str] | None = None) -> list[dict[str, Any]]:

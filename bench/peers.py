@@ -6,11 +6,12 @@ PM4Py is AGPL-licensed: it is used here, beside the project, never by the
 
 from __future__ import annotations
 
+import platform
 from typing import Any
 
 from petriflow.net import Net
 
-__all__ = ["to_pm4py"]
+__all__ = ["to_pm4py", "versions"]
 
 
 def to_pm4py(net: Net) -> tuple[Any, Any, dict[str, Any]]:
@@ -35,3 +36,16 @@ def to_pm4py(net: Net) -> tuple[Any, Any, dict[str, Any]]:
             petri_utils.add_arc_from_to(nodes[arc.source], nodes[arc.target], pnet, weight=arc.weight)
     initial = Marking({nodes[p]: k for p, k in net.initial_marking.items()})
     return pnet, initial, {p: nodes[p] for p in net.places}
+
+
+def versions(*distributions: str) -> dict[str, str]:
+    """Python's version and each installed distribution's ("not installed" if absent)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    found = {"python": platform.python_version()}
+    for name in distributions:
+        try:
+            found[name] = version(name)
+        except PackageNotFoundError:
+            found[name] = "not installed"
+    return found
