@@ -92,11 +92,6 @@ __all__ = [
 #: Default limit on the number of states :func:`reachability_graph` stores.
 DEFAULT_MAX_STATES = 2_000_000
 
-_UINT = (np.uint8, np.uint16, np.uint32, np.uint64)
-_M1 = np.uint64(0xBF58476D1CE4E5B9)
-_M2 = np.uint64(0x94D049BB133111EB)
-_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-_S30, _S27, _S31 = np.uint64(30), np.uint64(27), np.uint64(31)
 
 
 class StateSpaceLimit(PetriflowError):
@@ -145,14 +140,6 @@ class UnboundedNetError(PetriflowError):
             f"net is unbounded: firing {pump} from the marking reached by {prefix} adds tokens"
             f" to {places} and can be repeated forever"
         )
-
-
-class _HashCollision(Exception):
-    """Two different markings share a 64-bit hash (restart with an exact index)."""
-
-
-class _NotSafe(Exception):
-    """A successor puts a second token in a place (leave the bitmask path)."""
 
 
 @dataclass(eq=False)
@@ -385,743 +372,27 @@ def reachability_graph(
 
 # Exploration ---------------------------------------------------------------------------
 
+#: Count rows start in the smallest of these dtypes that holds the initial marking and
+#: are widened (the exploration starts again) when a count outgrows them.
+_UINT = (np.uint8, np.uint16, np.uint32, np.uint64)
 
-def _mix(x: np.ndarray) -> np.ndarray:
-    """splitmix64's finaliser: a bijection of uint64 that spreads every input bit."""
-    x = x ^ (x >> _S30)
-    x = x * _M1
-    x = x ^ (x >> _S27)
-    x = x * _M2
-    return x ^ (x >> _S31)
-
-
-def _hash_words(words: np.ndarray) -> np.ndarray:
-    """64-bit hash of each row of a 2-D uint64 array."""
-    h = _mix(words[:, 0] + _GOLDEN)
-    for j in range(1, words.shape[1]):
-        h = _mix(h ^ words[:, j])
-    return h
+#: Count rows of nets with more places than this put the places of an incidence basis
+#: first and key states on those columns only; smaller nets key on whole rows, which is
+#: as fast and skips the elimination. (Bitmask rows do so when a whole row does not fit
+#: in one table word beside a state id.)
+_BASIS_FROM_PLACES = 16
 
 
-def _as_words(block: np.ndarray) -> np.ndarray:
-    """Rows of unsigned ints as rows of uint64 words (zero padded)."""
-    per_word = 8 // block.dtype.itemsize
-    width = max(1, -(-block.shape[1] // per_word)) * per_word
-    buffer = np.zeros((block.shape[0], width), dtype=block.dtype)
-    buffer[:, : block.shape[1]] = block
-    return buffer.view(np.uint64)
+def warm_up() -> None:
+    """Compile (or load from numba's disk cache) both exploration loops now.
 
-
-class _Growing:
-    """An array with amortised O(1) appends of blocks of rows."""
-
-    def __init__(self, first: np.ndarray, capacity: int = 1024) -> None:
-        shape = (max(capacity, len(first)),) + first.shape[1:]
-        self.data = np.empty(shape, dtype=first.dtype)
-        self.size = len(first)
-        self.data[: self.size] = first
-
-    def append(self, block: np.ndarray) -> None:
-        need = self.size + len(block)
-        if need > len(self.data):
-            bigger = np.empty((max(need, 2 * len(self.data)),) + self.data.shape[1:],
-                              dtype=self.data.dtype)
-            bigger[: self.size] = self.data[: self.size]
-            self.data = bigger
-        self.data[self.size: need] = block
-        self.size = need
-
-    def view(self) -> np.ndarray:
-        return self.data[: self.size]
-
-    def astype(self, dtype) -> None:
-        self.data = self.data.astype(dtype)
-
-
-class _VisitedIndex:
-    """Sorted arrays mapping uint64 keys to state ids, searched with ``np.searchsorted``.
-
-    Two sorted runs, like a tiny log-structured merge tree: new keys are merged into
-    the small run, which is merged into the big one once it reaches a quarter of its
-    size, so adding keys never copies the whole index on every chunk. Looking up keys
-    in increasing order keeps ``searchsorted`` cache friendly.
+    The first exploration in a process otherwise pays this (a fraction of a second from
+    the cache; several seconds the very first time after installation).
     """
+    from petriflow.classic import independent_cycles, producer_consumer
 
-    def __init__(self) -> None:
-        self.runs = [(np.zeros(0, dtype=np.uint64), np.zeros(0, dtype=np.int64))] * 2
-
-    def find(self, keys: np.ndarray) -> np.ndarray:
-        """State id of each key (keys increasing), -1 where absent.
-
-        The newest run is searched first: in a breadth-first search most successors are
-        recent states, so few keys go on to the big run.
-        """
-        result = np.full(len(keys), -1, dtype=np.int64)
-        todo = None
-        for run_keys, run_ids in reversed(self.runs):
-            if not len(run_keys):
-                continue
-            needles = keys if todo is None else keys.take(todo)
-            pos = np.searchsorted(run_keys, needles)
-            np.minimum(pos, len(run_keys) - 1, out=pos)
-            hit = run_keys.take(pos) == needles
-            where = np.flatnonzero(hit) if todo is None else todo[hit]
-            result[where] = run_ids.take(pos[hit])
-            todo = np.flatnonzero(~hit) if todo is None else todo[~hit]
-            if not todo.size:
-                break
-        return result
-
-    def add(self, keys: np.ndarray, ids: np.ndarray) -> None:
-        """Insert keys not in the index yet (increasing, distinct)."""
-        (big_keys, big_ids), (small_keys, small_ids) = self.runs
-        where = np.searchsorted(small_keys, keys)
-        small_keys, small_ids = np.insert(small_keys, where, keys), np.insert(small_ids, where, ids)
-        if 4 * len(small_keys) > len(big_keys):
-            where = np.searchsorted(big_keys, small_keys)
-            big_keys = np.insert(big_keys, where, small_keys)
-            big_ids = np.insert(big_ids, where, small_ids)
-            small_keys, small_ids = small_keys[:0], small_ids[:0]
-        self.runs = [(big_keys, big_ids), (small_keys, small_ids)]
-
-
-class _Explorer:
-    """One breadth-first exploration, on bitmask rows or on count rows.
-
-    Rows hold the places in "layout" order: first the places whose incidence columns
-    form a basis (``n_key`` of them; they determine a reachable marking), then the rest.
-    """
-
-    def __init__(self, compiled: CompiledNet, m0: np.ndarray, max_states: int,
-                 detect_unbounded: bool, bitmask: bool, exact_index: bool,
-                 bounds: np.ndarray | None, prefix: _Prefix | None = None) -> None:
-        self.compiled = compiled
-        self.prefix = prefix
-        self.max_states = max_states
-        self.bitmask = bitmask
-        self.exact_index = exact_index
-        pre, post, incidence = compiled.pre_matrix, compiled.post_matrix, compiled.incidence
-        self.n_transitions, self.n_places = pre.shape
-        resets = np.zeros(pre.shape, dtype=bool)
-        for t, places in enumerate(_resets_of(compiled)):
-            resets[t, list(places)] = True
-        self.has_resets = bool(resets.any())
-        # Reachable markings are M0 + x·C only without reset arcs; with them, keys are
-        # whole markings.
-        if self.has_resets:
-            basis = list(range(self.n_places))
-        else:
-            basis = pivot_columns(incidence) if incidence.size else []
-        in_basis = set(basis)
-        rest = [p for p in range(self.n_places) if p not in in_basis]
-        self.layout = np.array(basis + rest, dtype=np.int64)     # column -> place
-        self.column_of_place = np.argsort(self.layout)            # place -> column
-        self.n_key = len(basis)
-        # bounds: per place an upper bound proved by P-semiflows, or -1 when unknown.
-        self.bounds = None if bounds is None else bounds[self.layout]
-        proven_bounded = self.bounds is not None and bool((self.bounds >= 0).all())
-        conservative = bool((incidence.sum(axis=1) == 0).all()) if incidence.size else True
-        # Strictly covering an ancestor proves nothing once places can be reset.
-        self.check_unbounded = (detect_unbounded and not bitmask and not conservative
-                                and not proven_bounded and not self.has_resets)
-        self.proven_safe = proven_bounded and bool((self.bounds <= 1).all())
-        self.pre = pre[:, self.layout]
-        self.post = post[:, self.layout]
-        self.resets = resets[:, self.layout]
-        self.t_bits = max(1, int(self.n_transitions - 1).bit_length())
-        m0 = m0[self.layout]
-        if bitmask:
-            self._init_bitmask(m0)
-        else:
-            self._init_counts(m0)
-        if prefix is not None:              # continue a breadth-first search begun in Python
-            rows = prefix.rows[:, self.layout]
-            if bitmask:
-                self.rows = _Growing(self._words_of(rows))
-            else:
-                dtype = self.dtype
-                while int(rows.max(initial=0)) + self.max_gain > np.iinfo(dtype).max:
-                    dtype = _UINT[_UINT.index(dtype) + 1]
-                self.rows = _Growing(rows.astype(dtype))
-                self._set_dtype(dtype)
-
-    # Representations --------------------------------------------------------------------
-    def _words_of(self, matrix: np.ndarray) -> np.ndarray:
-        bits = np.zeros((matrix.shape[0], self.n_words * 64), dtype=np.uint8)
-        bits[:, : self.n_places] = matrix > 0
-        return np.packbits(bits, axis=1, bitorder="little").view("<u8").astype(np.uint64)
-
-    def _init_bitmask(self, m0: np.ndarray) -> None:
-        self.n_words = max(1, -(-self.n_places // 64))
-        pre_words, post_words = self._words_of(self.pre), self._words_of(self.post)
-        # A transition needing two tokens from a place is never enabled in a safe marking;
-        # one putting two tokens in a place makes the marking unsafe as soon as it fires.
-        self.usable = [int(t) for t in np.flatnonzero((self.pre <= 1).all(axis=1))]
-        self.doubling = (self.post > 1).any(axis=1)
-        self.tests = {t: [(w, pre_words[t, w]) for w in range(self.n_words) if pre_words[t, w]]
-                      for t in self.usable}
-        # Firing t maps m to (m & keep) ^ flip while the marking stays safe. Without reset
-        # arcs keep is all ones and flip = pre ^ post (pre is in m: xor removes it); with
-        # them keep also clears the preset and the reset places, and flip = post.
-        if self.has_resets:
-            keep_words = ~(pre_words | self._words_of(self.resets))
-            self.flip_words = post_words
-            self.keep_words = keep_words
-        else:
-            keep_words = np.full_like(pre_words, np.uint64(2**64 - 1))
-            self.flip_words = pre_words ^ post_words
-            self.keep_words = None
-        gain = post_words & keep_words & ~pre_words        # places that gain a token
-        self.gains = {t: [(w, gain[t, w]) for w in range(self.n_words) if gain[t, w]]
-                      for t in self.usable}
-        self.key_words = max(1, -(-self.n_key // 64))
-        self.key_flip = self.flip_words[:, : self.key_words].copy()
-        self.key_keep = keep_words[:, : self.key_words].copy()
-        if self.n_key <= 64:
-            self.key_bits = self.n_key
-            self.key_mask = np.uint64((1 << self.n_key) - 1 if self.n_key < 64 else 2**64 - 1)
-            self.key_flip &= self.key_mask
-            self.key_keep &= self.key_mask
-        else:
-            self.key_bits = 64
-        self.rows = _Growing(self._words_of(m0[None, :]))
-
-    def _init_counts(self, m0: np.ndarray) -> None:
-        self.usable = list(range(self.n_transitions))
-        self.delta = self.post - self.pre
-        self.max_gain = int(self.delta.max(initial=0))
-        self.tests = {t: [(int(p), int(self.pre[t, p])) for p in np.flatnonzero(self.pre[t])]
-                      for t in self.usable}
-        need = max(int(m0.max(initial=0)) + self.max_gain, int(self.pre.max(initial=0)))
-        dtype = np.uint8
-        while need > np.iinfo(dtype).max:
-            dtype = _UINT[_UINT.index(dtype) + 1]
-        self.rows = _Growing(m0[None, :].astype(dtype))
-        self._set_dtype(dtype)
-
-    def _set_dtype(self, dtype) -> None:
-        self.dtype = dtype
-        self.delta_cast = self.delta.astype(dtype)     # wraps modulo 2**bits: m + delta is exact
-        # With reset arcs: successor = (m - pre) * kept + post, kept 0 on reset places.
-        self.kept = (~self.resets).astype(dtype)
-        self.pre_cast = self.pre.astype(dtype)
-        self.post_cast = self.post.astype(dtype)
-        self.key_delta = np.ascontiguousarray(self.delta_cast[:, : self.n_key])
-        self.widths = None
-        self.key_bits = 64
-        bounds = None if self.bounds is None else self.bounds[: self.n_key]
-        if bounds is not None and (bounds >= 0).all():
-            widths = [max(1, int(b).bit_length()) for b in bounds]
-            if sum(widths) <= 64:
-                self.widths = widths
-                self.key_bits = sum(widths)
-
-    # Keys -------------------------------------------------------------------------------
-    @property
-    def exact_key(self) -> bool:
-        """Whether a key is the marking's basis part itself (no hashing, no verification)."""
-        if self.bitmask:
-            return self.n_key <= 64
-        return self.widths is not None
-
-    def _key_part(self, rows: np.ndarray) -> np.ndarray:
-        """The columns a key is made of (they determine a reachable marking)."""
-        width = self.key_words if self.bitmask else self.n_key
-        return np.ascontiguousarray(rows[:, :width])
-
-    def _key_of_part(self, part: np.ndarray) -> np.ndarray:
-        if self.bitmask:
-            if self.n_key <= 64:
-                return part[:, 0] & self.key_mask
-            return _hash_words(part)
-        if self.widths is not None:
-            key = np.zeros(part.shape[0], dtype=np.uint64)
-            shift = 0
-            for j, width in enumerate(self.widths):
-                key |= part[:, j].astype(np.uint64) << np.uint64(shift)
-                shift += width
-            return key
-        return _hash_words(_as_words(part))
-
-    def _successor_rows(self, frontier: np.ndarray, i: np.ndarray, t: np.ndarray) -> np.ndarray:
-        rows = frontier.take(i, axis=0)
-        if self.bitmask:
-            if self.keep_words is not None:
-                rows &= self.keep_words.take(t, axis=0)
-            return rows ^ self.flip_words.take(t, axis=0)
-        if self.has_resets:
-            return ((rows - self.pre_cast.take(t, axis=0)) * self.kept.take(t, axis=0)
-                    + self.post_cast.take(t, axis=0))
-        return rows + self.delta_cast.take(t, axis=0)
-
-    def _rebuild_index(self) -> None:
-        parts = self._key_part(self.rows.view())
-        if self.exact_index:
-            self.table = {parts[s].tobytes(): s for s in range(len(parts))}
-            return
-        keys = self._key_of_part(parts)
-        order = np.argsort(keys, kind="stable")
-        self.index = _VisitedIndex()
-        self.index.add(keys[order], order)
-
-    # The loop ---------------------------------------------------------------------------
-    def run(self) -> StateSpace:
-        prefix = self.prefix
-        if prefix is None:
-            self.parent = _Growing(np.array([-1], dtype=np.int64))
-            self.parent_t = _Growing(np.array([-1], dtype=np.int32))
-            head = 0
-            sources, fired, targets = [], [], []
-        else:
-            self.parent = _Growing(np.array(prefix.parent, dtype=np.int64))
-            self.parent_t = _Growing(np.array(prefix.parent_t, dtype=np.int32))
-            head = prefix.head
-            sources, fired, targets = ([np.array(prefix.sources, dtype=np.int64)],
-                                       [np.array(prefix.fired, dtype=np.int64)],
-                                       [np.array(prefix.targets, dtype=np.int64)])
-        if self.check_unbounded:
-            totals = self.rows.view().sum(axis=1, dtype=np.int64)
-            path_min = totals.copy()
-            parent = self.parent.view()
-            for state in range(1, len(totals)):          # parents come before children
-                path_min[state] = min(totals[state], path_min[parent[state]])
-            self.totals = _Growing(totals)
-            self.path_min = _Growing(path_min)
-        self._rebuild_index()
-        id_type = np.int32 if self.max_states < 2**31 else np.int64
-        t_type = np.int16 if self.n_transitions < 2**15 else np.int32
-        sources = [a.astype(id_type) for a in sources]
-        fired = [a.astype(t_type) for a in fired]
-        targets = [a.astype(id_type) for a in targets]
-        # About 2**23 (state, transition) tests a chunk: large enough that few successors
-        # are looked up twice, small enough to bound the temporaries (~100 MB at most).
-        chunk = min(1 << 18, max(64, (1 << 23) // max(1, len(self.usable))))
-        while head < self.rows.size:
-            hi = min(self.rows.size, head + chunk)
-            if not self.bitmask:
-                self._widen_if_needed(head, hi)
-            frontier = self.rows.view()[head:hi]
-            keys, parts, codes, packed = self._successors(frontier)
-            source, transition, target = self._lookup_and_add(frontier, keys, parts, codes,
-                                                              packed, head)
-            sources.append(source.astype(id_type, copy=False))
-            fired.append(transition.astype(t_type, copy=False))
-            targets.append(target.astype(id_type, copy=False))
-            head = hi
-
-        def joined(parts: list[np.ndarray], dtype) -> np.ndarray:
-            return np.concatenate(parts) if parts else np.zeros(0, dtype)
-
-        return StateSpace(
-            places=tuple(self.compiled.places),
-            transitions=tuple(self.compiled.transitions),
-            origins=_origins(self.compiled),
-            edge_source=joined(sources, id_type),
-            edge_transition=joined(fired, t_type),
-            edge_target=joined(targets, id_type),
-            parent=self.parent.view().astype(id_type),
-            parent_transition=self.parent_t.view(),
-            representation="bitmask" if self.bitmask else "counts",
-            _rows=self.rows.view(),
-            _column_of_place=self.column_of_place,
-        )
-
-    def _widen_if_needed(self, head: int, hi: int) -> None:
-        top = int(self.rows.view()[head:hi].max(initial=0))
-        if top + self.max_gain <= np.iinfo(self.dtype).max:
-            return
-        dtype = self.dtype
-        while top + self.max_gain > np.iinfo(dtype).max:
-            dtype = _UINT[_UINT.index(dtype) + 1]
-        self.rows.astype(dtype)
-        self._set_dtype(dtype)
-        self._rebuild_index()
-
-    def _successors(self, frontier: np.ndarray):
-        """Every enabled (state, transition) pair of the frontier and its successor's key.
-
-        Works transition by transition on the frontier's columns (long contiguous
-        vectors). Returns ``(keys, parts, codes, packed)``: the successor keys, their key
-        parts (``None`` when keys are exact), the pairs as codes ``row << t_bits | t``,
-        and, on the fast path, ``packed = key << code_bits | code`` in place of the three.
-        """
-        n, t_bits = frontier.shape[0], np.uint64(self.t_bits)
-        ok = np.empty(n, dtype=bool)
-        key_list, part_list, code_list, packed_list = [], [], [], []
-        rows = np.arange(n, dtype=np.uint64) << t_bits
-        code_bits = max(1, ((n - 1) << self.t_bits | (self.n_transitions - 1)).bit_length())
-        # Fast path (safe net, exact key, no reset arcs): with kshift = key << code_bits |
-        # row << t_bits, the packed successor of (row, t) is kshift[row] ^ (flip_t <<
-        # code_bits | t), since the three bit fields do not overlap: one gather, one xor.
-        fast = (self.bitmask and self.exact_key and self.keep_words is None
-                and self.key_bits + code_bits <= 64)
-        if self.bitmask:
-            missing = np.ascontiguousarray((~frontier).T)   # per word: the places without a token
-            words = np.ascontiguousarray(frontier.T)
-            acc, tmp = np.empty(n, dtype=np.uint64), np.empty(n, dtype=np.uint64)
-            if self.exact_key:
-                key_column = words[0] & self.key_mask
-                if fast:
-                    kshift = (key_column << np.uint64(code_bits)) | rows
-            else:
-                key_block = self._key_part(frontier)
-        else:
-            columns = np.ascontiguousarray(frontier.T)
-            key_block = np.ascontiguousarray(frontier[:, : self.n_key])
-        for t in self.usable:
-            tests = self.tests[t]
-            if not tests:
-                ok[:] = True
-            elif self.bitmask:
-                w, bits = tests[0]
-                np.bitwise_and(missing[w], bits, out=acc)
-                for w, bits in tests[1:]:
-                    np.bitwise_and(missing[w], bits, out=tmp)
-                    np.bitwise_or(acc, tmp, out=acc)
-                np.equal(acc, 0, out=ok)
-            else:
-                p, weight = tests[0]
-                np.greater_equal(columns[p], weight, out=ok)
-                for p, weight in tests[1:]:
-                    ok &= columns[p] >= weight
-            idx = np.flatnonzero(ok)
-            if not idx.size:
-                continue
-            if self.bitmask:
-                if not self.proven_safe:
-                    if self.doubling[t]:
-                        raise _NotSafe
-                    for w, bits in self.gains[t]:
-                        if (words[w].take(idx) & bits).any():
-                            raise _NotSafe
-                if fast:
-                    packed_list.append(kshift.take(idx) ^ np.uint64(
-                        (int(self.key_flip[t, 0]) << code_bits) | t))
-                    continue
-                if self.exact_key:
-                    column = key_column.take(idx)
-                    if self.keep_words is not None:
-                        column &= self.key_keep[t, 0]
-                    key_list.append(column ^ self.key_flip[t, 0])
-                else:
-                    block = key_block.take(idx, axis=0)
-                    if self.keep_words is not None:
-                        block &= self.key_keep[t]
-                    part_list.append(block ^ self.key_flip[t])
-            elif self.has_resets:
-                part_list.append(self._successor_rows(frontier, idx, np.full(idx.size, t))
-                                 [:, : self.n_key])
-            else:
-                part_list.append(key_block.take(idx, axis=0) + self.key_delta[t])
-            code_list.append(rows.take(idx) | np.uint64(t))
-        if packed_list:
-            return None, None, None, (np.concatenate(packed_list), code_bits)
-        if not code_list:
-            empty = np.zeros(0, dtype=np.uint64)
-            return empty, None, empty, None
-        codes = np.concatenate(code_list)
-        if key_list:
-            return np.concatenate(key_list), None, codes, None
-        parts = np.concatenate(part_list)
-        return self._key_of_part(parts), (None if self.exact_key else parts), codes, None
-
-    def _lookup_and_add(self, frontier: np.ndarray, keys, parts, codes, packed, head: int):
-        """(source, transition, target) of every enabled pair, storing the new states."""
-        t_bits, t_mask = np.uint64(self.t_bits), np.uint64((1 << self.t_bits) - 1)
-        if packed is not None:
-            packed, code_bits = packed
-            n = len(packed)
-            if self.exact_index:
-                codes = packed & np.uint64((1 << code_bits) - 1)
-                keys = packed >> np.uint64(code_bits)
-        else:
-            n = len(codes)
-            code_bits = max(1, int(codes.max(initial=0)).bit_length())
-        if n == 0:
-            empty = np.zeros(0, dtype=np.int64)
-            return empty, empty, empty
-        if self.exact_index:
-            return self._lookup_exact(frontier, keys, parts, codes, head)
-        # One sort groups equal successors; the smallest code of a group is its first
-        # discovery (lowest source state, then lowest transition).
-        if packed is not None or self.key_bits + code_bits <= 64:
-            if packed is None:
-                packed = (keys << np.uint64(code_bits)) | codes
-            packed.sort()
-            sorted_keys = packed >> np.uint64(code_bits)
-            sorted_codes = packed & np.uint64((1 << code_bits) - 1)
-            order = None
-        else:
-            order = np.argsort(keys, kind="stable")
-            sorted_keys, sorted_codes = keys.take(order), codes.take(order)
-        starts = np.flatnonzero(sorted_keys[1:] != sorted_keys[:-1]) + 1
-        starts = np.concatenate((np.zeros(1, dtype=starts.dtype), starts))
-        counts = np.diff(np.append(starts, n))
-        unique_keys = sorted_keys.take(starts)
-        first = (sorted_codes.take(starts) if order is None
-                 else np.minimum.reduceat(sorted_codes, starts))
-        if parts is not None:
-            sorted_parts = parts.take(order, axis=0)
-            if not (sorted_parts == np.repeat(sorted_parts.take(starts, axis=0), counts,
-                                              axis=0)).all():
-                raise _HashCollision
-        target_of_key = self.index.find(unique_keys)
-        hit = target_of_key >= 0
-        if parts is not None and hit.any():
-            stored = self._key_part(self.rows.view().take(target_of_key[hit], axis=0))
-            if not (stored == sorted_parts.take(starts[hit], axis=0)).all():
-                raise _HashCollision
-        fresh = np.flatnonzero(~hit)
-        if fresh.size:
-            base = self.rows.size
-            if base + fresh.size > self.max_states:
-                raise StateSpaceLimit(self.max_states, base, head)
-            discovery = np.argsort(first.take(fresh))        # new states in BFS order
-            ids = np.empty(fresh.size, dtype=np.int64)
-            ids[discovery] = np.arange(base, base + fresh.size)
-            target_of_key[fresh] = ids
-            self.index.add(unique_keys.take(fresh), ids)
-            pairs = first.take(fresh.take(discovery))
-            i = (pairs >> t_bits).astype(np.int64)
-            t = (pairs & t_mask).astype(np.int64)
-            self._store(self._successor_rows(frontier, i, t), i + head, t)
-        id_type = np.int32 if self.max_states < 2**31 else np.int64
-        source = (sorted_codes >> t_bits).astype(id_type)
-        source += head
-        transition = (sorted_codes & t_mask).astype(np.int16 if self.n_transitions < 2**15
-                                                    else np.int32)
-        return source, transition, np.repeat(target_of_key.astype(id_type), counts)
-
-    def _store(self, rows: np.ndarray, parents: np.ndarray, transitions: np.ndarray) -> None:
-        base = self.rows.size
-        self.rows.append(rows)
-        self.parent.append(parents)
-        self.parent_t.append(transitions.astype(np.int32))
-        if self.check_unbounded:
-            self._check_covering(np.arange(base, base + len(rows)), parents)
-
-    def _lookup_exact(self, frontier, keys, parts, codes, head):
-        """The slow exact index (a dict of key bytes), used after a hash collision."""
-        t_bits = np.uint64(self.t_bits)
-        i_all = (codes >> t_bits).astype(np.int64)
-        t_all = (codes & np.uint64((1 << self.t_bits) - 1)).astype(np.int64)
-        order = np.argsort(codes, kind="stable")          # handle pairs in BFS order
-        if parts is None:
-            parts = self._key_part(self._successor_rows(frontier, i_all, t_all))
-        parts = np.ascontiguousarray(parts)
-        targets = np.empty(len(codes), dtype=np.int64)
-        for e in order:
-            key = parts[e].tobytes()
-            state = self.table.get(key)
-            if state is None:
-                state = self.rows.size
-                if state + 1 > self.max_states:
-                    raise StateSpaceLimit(self.max_states, state, head)
-                self.table[key] = state
-                self._store(self._successor_rows(frontier, i_all[e: e + 1], t_all[e: e + 1]),
-                            i_all[e: e + 1] + head, t_all[e: e + 1])
-            targets[e] = state
-        return i_all + head, t_all, targets
-
-    # Unboundedness ----------------------------------------------------------------------
-    def _check_covering(self, ids: np.ndarray, parents: np.ndarray) -> None:
-        """Raise :class:`UnboundedNetError` if a new state strictly covers an ancestor."""
-        rows = self.rows.view()
-        totals = rows.take(ids, axis=0).sum(axis=1, dtype=np.int64)
-        self.totals.append(totals)
-        self.path_min.append(np.minimum(totals, self.path_min.view()[parents]))
-        all_totals, all_min, parent = self.totals.view(), self.path_min.view(), self.parent.view()
-        # Only a state with more tokens than some ancestor can strictly cover one.
-        keep = totals > all_min[parents]
-        candidates, ancestors, wanted = ids[keep], parents[keep], totals[keep]
-        while candidates.size:
-            covers = (wanted > all_totals[ancestors]) & (
-                rows.take(candidates, axis=0) >= rows.take(ancestors, axis=0)).all(axis=1)
-            if covers.any():
-                k = int(np.flatnonzero(covers)[0])
-                self._unbounded(int(candidates[k]), int(ancestors[k]))
-            ancestors = parent[ancestors]
-            alive = ancestors >= 0
-            alive[alive] = all_min[ancestors[alive]] < wanted[alive]
-            candidates, ancestors, wanted = candidates[alive], ancestors[alive], wanted[alive]
-
-    def _unbounded(self, state: int, ancestor: int) -> None:
-        compiled = self.compiled
-        rows = self.rows.view()
-        parent, parent_t = self.parent.view(), self.parent_t.view()
-
-        def walk(s: int, stop: int) -> list[str]:
-            sequence = []
-            while s != stop:
-                sequence.append(compiled.transitions[int(parent_t[s])])
-                s = int(parent[s])
-            return sequence[::-1]
-
-        def marking(s: int) -> Marking:
-            return compiled.marking([int(c) for c in rows[s][self.column_of_place]])
-
-        covered, covering = marking(ancestor), marking(state)
-        grown = [p for p in compiled.places if covering[p] > covered[p]]
-        raise UnboundedNetError(grown, walk(ancestor, 0), walk(state, ancestor), covered, covering)
-
-
-def _structural_bounds(compiled: CompiledNet, m0: np.ndarray) -> np.ndarray | None:
-    """Per place a bound proved by P-semiflows (-1 where none), or None if too costly.
-
-    ``y·M <= y·M0`` for every P-semiflow ``y`` and reachable ``M`` (equality without reset
-    arcs; resets only remove tokens), so ``M(p) <= (y·M0) // y[p]``.
-    """
-    from petriflow.analysis.invariants import DEFAULT_MAX_ROWS, InvariantLimit, _cached_semiflows
-
-    if compiled.incidence.size == 0 or compiled.incidence.size > 250_000:
-        return None
-    try:
-        flows = _cached_semiflows(compiled, "p", DEFAULT_MAX_ROWS)
-    except InvariantLimit:
-        return None
-    bounds = np.full(len(compiled.places), -1, dtype=np.int64)
-    for y in flows:
-        total = int(y @ m0)
-        support = np.flatnonzero(y)
-        limit = total // y[support]
-        current = bounds[support]
-        bounds[support] = np.where((current < 0) | (limit < current), limit, current)
-    return bounds
-
-
-@dataclass
-class _Prefix:
-    """A breadth-first search begun in plain Python, to be continued with numpy."""
-
-    rows: np.ndarray            # states so far, counts in place order
-    parent: list[int]
-    parent_t: list[int]
-    sources: list[int]
-    fired: list[int]
-    targets: list[int]
-    head: int                   # first state whose successors are not computed yet
-    complete: bool
-    safe: bool
-
-
-#: A breadth-first search stays in plain Python while its queue is shorter than this:
-#: numpy's per-call overhead only pays off on wide frontiers.
-_NUMPY_FROM_QUEUE = 512
-
-
-def _python_bfs(compiled: CompiledNet, m0: np.ndarray, max_states: int, check_unbounded: bool,
-                switch: int) -> _Prefix:
-    """Breadth-first search on tuples and a dict, until the queue grows past ``switch``.
-
-    Thin state spaces (long chains of small levels, e.g. a producer and a consumer around
-    a large buffer) never get wide enough for numpy and are explored here completely.
-    """
-    transitions = []
-    for t, resets in enumerate(_resets_of(compiled)):
-        change: dict[int, int] = {}
-        for p, w in compiled.pre[t]:
-            change[p] = change.get(p, 0) - w
-        for p, w in compiled.post[t]:
-            change[p] = change.get(p, 0) + w
-        transitions.append((t, compiled.pre[t], tuple((p, d) for p, d in change.items() if d),
-                            tuple(resets), compiled.post[t]))
-    start = tuple(int(c) for c in m0)
-    states = [start]
-    index = {start: 0}
-    parent, parent_t = [-1], [-1]
-    sources: list[int] = []
-    fired: list[int] = []
-    targets: list[int] = []
-    safe = max(start, default=0) <= 1
-    totals, path_min = [sum(start)], [sum(start)]
-    head = 0
-    while head < len(states):
-        if len(states) - head > switch:
-            break
-        marking = states[head]
-        for t, pre, change, resets, post in transitions:
-            for p, w in pre:
-                if marking[p] < w:
-                    break
-            else:
-                successor = list(marking)
-                if resets:
-                    for p, w in pre:
-                        successor[p] -= w
-                    for p in resets:
-                        successor[p] = 0
-                    for p, w in post:
-                        successor[p] += w
-                else:
-                    for p, d in change:
-                        successor[p] += d
-                key = tuple(successor)
-                target = index.get(key)
-                if target is None:
-                    target = len(states)
-                    if target + 1 > max_states:
-                        raise StateSpaceLimit(max_states, target, head)
-                    index[key] = target
-                    states.append(key)
-                    parent.append(head)
-                    parent_t.append(t)
-                    if safe and max(key) > 1:
-                        safe = False
-                    if check_unbounded:
-                        total = sum(key)
-                        totals.append(total)
-                        path_min.append(min(total, path_min[head]))
-                        if total > path_min[head]:
-                            _python_covering(compiled, states, parent, parent_t, totals,
-                                             path_min, target)
-                sources.append(head)
-                fired.append(t)
-                targets.append(target)
-        head += 1
-    rows = np.array(states, dtype=np.int64).reshape(len(states), len(start))
-    return _Prefix(rows, parent, parent_t, sources, fired, targets, head,
-                   head == len(states), safe)
-
-
-def _python_covering(compiled, states, parent, parent_t, totals, path_min, state) -> None:
-    """Raise :class:`UnboundedNetError` if ``state`` strictly covers one of its ancestors."""
-    marking, total = states[state], totals[state]
-    ancestor = parent[state]
-    while ancestor >= 0 and path_min[ancestor] < total:
-        if totals[ancestor] < total and all(a >= b for a, b in zip(marking, states[ancestor])):
-            def walk(s: int, stop: int) -> list[str]:
-                sequence = []
-                while s != stop:
-                    sequence.append(compiled.transitions[parent_t[s]])
-                    s = parent[s]
-                return sequence[::-1]
-
-            covered = compiled.marking(states[ancestor])
-            covering = compiled.marking(marking)
-            grown = [p for p in compiled.places if covering[p] > covered[p]]
-            raise UnboundedNetError(grown, walk(ancestor, 0), walk(state, ancestor),
-                                    covered, covering)
-        ancestor = parent[ancestor]
-
-
-def _space_from_prefix(compiled: CompiledNet, prefix: _Prefix, max_states: int) -> StateSpace:
-    id_type = np.int32 if max_states < 2**31 else np.int64
-    t_type = np.int16 if len(compiled.transitions) < 2**15 else np.int32
-    top = int(prefix.rows.max(initial=0))
-    dtype = next((d for d in _UINT if top <= np.iinfo(d).max), np.uint64)
-    return StateSpace(
-        places=tuple(compiled.places),
-        transitions=tuple(compiled.transitions),
-        origins=_origins(compiled),
-        edge_source=np.array(prefix.sources, dtype=id_type),
-        edge_transition=np.array(prefix.fired, dtype=t_type),
-        edge_target=np.array(prefix.targets, dtype=id_type),
-        parent=np.array(prefix.parent, dtype=id_type),
-        parent_transition=np.array(prefix.parent_t, dtype=np.int32),
-        representation="counts",
-        _rows=prefix.rows.astype(dtype),
-        _column_of_place=np.arange(len(compiled.places)),
-    )
+    reachability_graph(independent_cycles(2))
+    reachability_graph(producer_consumer(2))
 
 
 def _origins(compiled: CompiledNet) -> tuple[str, ...]:
@@ -1135,25 +406,226 @@ def _resets_of(compiled: CompiledNet) -> list[tuple[int, ...]]:
     return list(getattr(compiled, "reset", None) or [()] * len(compiled.transitions))
 
 
+def _layout(compiled: CompiledNet, has_resets: bool, threshold: int) -> tuple[list[int], int]:
+    """``(column -> place, number of key columns)``.
+
+    Without reset arcs every reachable marking is ``M0 + x·C``, so its counts on the
+    places whose incidence columns form a basis determine the rest: those come first and
+    are the key. Small nets and nets with reset arcs key on every place.
+    """
+    n_places = len(compiled.places)
+    if has_resets or n_places <= threshold or not compiled.incidence.any():
+        return list(range(n_places)), n_places
+    basis = pivot_columns(compiled.incidence)
+    chosen = set(basis)
+    return basis + [p for p in range(n_places) if p not in chosen], len(basis)
+
+
+class _Buffers:
+    """The arrays a kernel fills, owned and grown (by doubling) here.
+
+    ``state`` arrays have a row per state, ``edge`` arrays an entry per edge; ``table``
+    is the kernel's hash table (``stride`` words a slot) and is rebuilt twice as large
+    whenever it would get more than half full.
+    """
+
+    def __init__(self, kernel, row: np.ndarray, max_states: int, n_transitions: int,
+                 stride: int, id_bits: int, extra_state: tuple[type, ...] = ()) -> None:
+        self.kernel, self.stride, self.id_bits = kernel, stride, id_bits
+        id_type = np.int32 if max_states < 2**31 else np.int64
+        t_type = np.int16 if n_transitions < 2**15 else np.int32
+        states = 256
+        rows = np.empty((states, len(row)), dtype=row.dtype)
+        rows[0] = row
+        self.state = [rows, np.empty(states, dtype=id_type), np.empty(states, dtype=np.int32)]
+        self.state += [np.empty(states, dtype=d) for d in extra_state]
+        self.edge = [np.empty(1024, dtype=id_type), np.empty(1024, dtype=t_type),
+                     np.empty(1024, dtype=id_type)]
+        self.table = np.zeros(1024 * stride, dtype=np.uint64)
+        self.counters = np.zeros(5, dtype=np.int64)
+
+    def grow(self, margin: int) -> None:
+        """Make room for ``margin`` more states and edges than counted now."""
+        states, edges = int(self.counters[0]), int(self.counters[1])
+        self.state = [_grown(a, states, states + margin) for a in self.state]
+        self.edge = [_grown(a, edges, edges + margin) for a in self.edge]
+        slots = len(self.table) // self.stride
+        if 2 * (states + margin) > slots:          # at most half full
+            while 2 * (states + margin) > slots:
+                slots *= 2
+            bigger = np.zeros(slots * self.stride, dtype=np.uint64)
+            self.kernel.rehash(self.table, self.stride, self.id_bits, bigger)
+            self.table = bigger
+
+
+def _grown(array: np.ndarray, used: int, need: int) -> np.ndarray:
+    if need <= len(array):
+        return array
+    bigger = np.empty((max(need, 2 * len(array)),) + array.shape[1:], dtype=array.dtype)
+    bigger[:used] = array[:used]
+    return bigger
+
+
 def _explore(compiled: CompiledNet, m0: np.ndarray, max_states: int,
-             detect_unbounded: bool, switch: int = _NUMPY_FROM_QUEUE) -> StateSpace:
-    bounds = _structural_bounds(compiled, m0)
-    incidence = compiled.incidence
-    conservative = bool((incidence.sum(axis=1) == 0).all()) if incidence.size else True
-    proven_bounded = bounds is not None and bool((bounds >= 0).all())
-    has_resets = any(_resets_of(compiled))
-    prefix = _python_bfs(compiled, m0, max_states, detect_unbounded and not conservative
-                         and not proven_bounded and not has_resets, switch)
-    if prefix.complete:
-        return _space_from_prefix(compiled, prefix, max_states)
-    bitmask = prefix.safe
-    exact_index = False
+             detect_unbounded: bool, *, bits: bool = True,
+             basis_from: int | None = None) -> StateSpace:
+    """The exploration behind :func:`reachability_graph`.
+
+    ``bits=False`` skips the bitmask loop and ``basis_from`` overrides the place counts
+    from which keys are basis places (tests use both to reach every path on small nets).
+    """
+    from petriflow.analysis import _kernel
+
+    resets = _resets_of(compiled)
+    has_resets = any(resets)
+    if bits and int(m0.max(initial=0)) <= 1:
+        space = _explore_bits(_kernel, compiled, m0, max_states, resets, has_resets,
+                              basis_from)
+        if space is not None:
+            return space
+    return _explore_counts(_kernel, compiled, m0, max_states, resets, has_resets,
+                           detect_unbounded, basis_from)
+
+
+def _explore_bits(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int,
+                  resets: list[tuple[int, ...]], has_resets: bool,
+                  basis_from: int | None) -> StateSpace | None:
+    """Explore with bitmask rows; ``None`` when some reachable marking is not safe."""
+    # A key that fits in one table word beside the state id saves a word a slot and a
+    # read of the row: find a basis when the whole row does not fit.
+    id_bits = max(1, int(max_states).bit_length())
+    threshold = 64 - id_bits if basis_from is None else basis_from
+    layout, n_key = _layout(compiled, has_resets, threshold)
+    column = [0] * len(layout)
+    for c, p in enumerate(layout):
+        column[p] = c
+    n_words = max(1, -(-len(layout) // 64))
+    every = (1 << (64 * n_words)) - 1
+    pre_bits, post_bits, keep_bits, kind = [], [], [], []
+    for t, (pre, post) in enumerate(zip(compiled.pre, compiled.post)):
+        taken = sum(1 << column[p] for p, _ in pre)
+        pre_bits.append(taken)
+        post_bits.append(sum(1 << column[p] for p, _ in post))
+        keep_bits.append(every & ~(taken | sum(1 << column[p] for p in resets[t])))
+        kind.append(1 if any(w > 1 for _, w in pre) else 2 if any(w > 1 for _, w in post)
+                    else 0)
+    start = sum(1 << column[p] for p in np.flatnonzero(m0).tolist())
+
+    def words(values: list[int]) -> np.ndarray:
+        mask = (1 << 64) - 1
+        return np.array([[(v >> (64 * w)) & mask for w in range(n_words)] for v in values],
+                        dtype=np.uint64).reshape(len(values), n_words)
+
+    id_bits = id_bits if n_key + id_bits <= 64 else 0
+    buffers = _Buffers(kernel, words([start])[0], max_states, len(kind), 1 if id_bits else 2,
+                       id_bits)
+    fixed = (words(pre_bits), words(post_bits), words(keep_bits), np.array(kind, dtype=np.int8),
+             words([(1 << n_key) - 1])[0], id_bits, max_states)
     while True:
-        explorer = _Explorer(compiled, m0, max_states, detect_unbounded, bitmask,
-                             exact_index, bounds, prefix)
-        try:
-            return explorer.run()
-        except _NotSafe:
-            bitmask = False
-        except _HashCollision:
-            exact_index = True
+        rows, parent, parent_t = buffers.state
+        status = kernel.expand_bits(*fixed, rows, parent, parent_t, buffers.table,
+                                    *buffers.edge, buffers.counters)
+        if status != kernel.FULL:
+            break
+        buffers.grow(len(kind))
+    if status == kernel.NOT_SAFE:
+        return None
+    if status == kernel.LIMIT:
+        raise StateSpaceLimit(max_states, int(buffers.counters[0]), int(buffers.counters[2]))
+    return _space(compiled, "bitmask", buffers, column)
+
+
+def _explore_counts(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int,
+                    resets: list[tuple[int, ...]], has_resets: bool,
+                    detect_unbounded: bool, basis_from: int | None) -> StateSpace:
+    """Explore with count rows, widening their dtype whenever a count outgrows it."""
+    layout, n_key = _layout(compiled, has_resets,
+                            _BASIS_FROM_PLACES if basis_from is None else basis_from)
+    order = np.array(layout, dtype=np.int64)
+    column = np.argsort(order) if layout else np.zeros(0, dtype=np.int64)
+    col = column.tolist()
+
+    def csr(lists: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        at = np.zeros(len(lists) + 1, dtype=np.int64)
+        at[1:] = np.cumsum([len(items) for items in lists])
+        flat = [item for items in lists for item in items]
+        return (at, np.array([col[p] for p, _ in flat], dtype=np.int64),
+                np.array([w for _, w in flat], dtype=np.int64))
+
+    incidence = compiled.incidence
+    changes = [[(int(p), int(row[p])) for p in np.flatnonzero(row)] for row in incidence]
+    reset_at, reset_place, _ = csr([[(p, 0) for p in places] for places in resets])
+    conservative = bool((incidence.sum(axis=1) == 0).all()) if incidence.size else True
+    # Strictly covering an ancestor proves nothing once places can be reset.
+    check = detect_unbounded and not conservative and not has_resets
+    fixed = (*csr(compiled.pre), *csr(compiled.post), *csr(changes), reset_at, reset_place,
+             n_key)
+    n_t = len(compiled.transitions)
+    start = np.asarray(m0, dtype=np.int64)[order]
+    need = int(start.max(initial=0))
+    dtype = next((d for d in _UINT if need <= np.iinfo(d).max), np.uint64)
+    while True:
+        top = min(int(np.iinfo(dtype).max), 2**63 - 1)
+        buffers = _Buffers(kernel, start.astype(dtype), max_states, n_t, 2, 0,
+                           (np.int64, np.int64) if check else ())
+        while True:
+            rows, parent, parent_t, *sums = buffers.state
+            totals, path_min = sums if check else (parent, parent)
+            status = kernel.expand_counts(*fixed, top, check, max_states, rows, parent,
+                                          parent_t, buffers.table, *buffers.edge, totals,
+                                          path_min, buffers.counters)
+            if status != kernel.FULL:
+                break
+            buffers.grow(n_t)
+        if status == kernel.OVERFLOW and dtype is not np.uint64:
+            dtype = _UINT[_UINT.index(dtype) + 1]
+            continue
+        if status == kernel.OVERFLOW:
+            raise PetriflowError("a token count exceeds 2**63 - 1: the net is too large to"
+                                 " explore")
+        if status == kernel.LIMIT:
+            raise StateSpaceLimit(max_states, int(buffers.counters[0]),
+                                  int(buffers.counters[2]))
+        if status == kernel.UNBOUNDED:
+            _unbounded(compiled, buffers, column)
+        return _space(compiled, "counts", buffers, col)
+
+
+def _space(compiled: CompiledNet, representation: str, buffers: _Buffers,
+           column: list[int]) -> StateSpace:
+    states, edges = int(buffers.counters[0]), int(buffers.counters[1])
+    rows, parent, parent_t = buffers.state[:3]
+    e_source, e_transition, e_target = buffers.edge
+    return StateSpace(
+        places=tuple(compiled.places),
+        transitions=tuple(compiled.transitions),
+        origins=_origins(compiled),
+        edge_source=e_source[:edges],
+        edge_transition=e_transition[:edges],
+        edge_target=e_target[:edges],
+        parent=parent[:states],
+        parent_transition=parent_t[:states],
+        representation=representation,
+        _rows=rows[:states],
+        _column_of_place=np.asarray(column, dtype=np.int64),
+    )
+
+
+def _unbounded(compiled: CompiledNet, buffers: _Buffers, column: np.ndarray) -> None:
+    """Raise :class:`UnboundedNetError` from the covering pair a count exploration found."""
+    rows, parent, parent_t = buffers.state[:3]
+    state, ancestor = int(buffers.counters[3]), int(buffers.counters[4])
+
+    def walk(s: int, stop: int) -> list[str]:
+        sequence = []
+        while s != stop:
+            sequence.append(compiled.transitions[int(parent_t[s])])
+            s = int(parent[s])
+        return sequence[::-1]
+
+    def marking(s: int) -> Marking:
+        return compiled.marking([int(c) for c in rows[s][column]])
+
+    covered, covering = marking(ancestor), marking(state)
+    grown = [p for p in compiled.places if covering[p] > covered[p]]
+    raise UnboundedNetError(grown, walk(ancestor, 0), walk(state, ancestor), covered, covering)

@@ -1,9 +1,11 @@
 """The reachability graph: known state counts, witnesses, limits, and three oracles.
 
-The exploration has two engines (plain Python while the BFS queue is short, numpy
-frontiers when it is wide) and, within numpy, bitmask and count rows with exact or
-hashed keys. ``explore(net, numpy=True)`` forces the numpy engine from the first state,
-so every test that uses it covers those paths even on tiny nets.
+The exploration has two compiled loops (bitmask rows for safe markings, count rows for
+the rest) and two kinds of keys (whole rows, or the places of an incidence basis).
+``explore(net, mode=...)`` picks them: ``"default"`` as :func:`reachability_graph` does,
+``"basis"`` bitmask rows keyed on basis places even on tiny nets, ``"counts"`` count
+rows keyed on basis places even on safe nets; tests parametrised over :data:`MODES`
+cover every path on small nets.
 """
 
 from __future__ import annotations
@@ -30,16 +32,20 @@ SETTINGS = settings(max_examples=150, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow])
 
 
-def explore(net: Net, marking=None, *, numpy: bool = False, max_states: int = 10**6,
+MODES = ("default", "basis", "counts")
+
+
+def explore(net: Net, marking=None, *, mode: str = "default", max_states: int = 10**6,
             detect_unbounded: bool = True):
-    """The state space, optionally with the numpy engine from the very first state."""
-    if not numpy:
+    """The state space, through the loop and keys ``mode`` names (see the module doc)."""
+    if mode == "default":
         return reachability_graph(net, marking, max_states=max_states,
                                   detect_unbounded=detect_unbounded)
     compiled = CompiledNet(net)
     start = net.initial_marking if marking is None else marking
     m0 = np.array(compiled.vector(start), dtype=np.int64)
-    return reachability._explore(compiled, m0, max_states, detect_unbounded, switch=0)
+    return reachability._explore(compiled, m0, max_states, detect_unbounded,
+                                 bits=mode == "basis", basis_from=0)
 
 
 def lucas(n: int) -> int:
@@ -66,36 +72,36 @@ def test_philosopher_states_are_lucas_numbers(n):
     assert reachability_graph(dining_philosophers(n)).num_states == lucas(n)
 
 
-@pytest.mark.parametrize("numpy", [False, True])
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("n", [3, 5, 8])
-def test_philosopher_graph_matches_reference(n, numpy):
+def test_philosopher_graph_matches_reference(n, mode):
     """States, edges and markings equal the textbook BFS on both engines."""
     net = dining_philosophers(n)
-    space = explore(net, numpy=numpy)
+    space = explore(net, mode=mode)
     expected, edges = reference_exploration(net)
     assert {space.marking(s) for s in range(space.num_states)} == expected
     assert space.num_edges == edges
     assert_consistent(net, space)
 
 
-@pytest.mark.parametrize("numpy", [False, True])
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("n", [1, 4, 10, 13])
-def test_independent_cycles_have_two_to_the_n_states(n, numpy):
+def test_independent_cycles_have_two_to_the_n_states(n, mode):
     """n independent two-place cycles: 2**n markings, each enabling exactly n transitions."""
-    space = explore(independent_cycles(n), numpy=numpy)
+    space = explore(independent_cycles(n), mode=mode)
     assert (space.num_states, space.num_edges) == (2**n, n * 2**n)
     assert space.safe and space.max_tokens_marking == n
 
 
-@pytest.mark.parametrize("numpy", [False, True])
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("capacity,batch", [(1, 1), (3, 1), (3, 2), (10, 4), (300, 7)])
-def test_producer_consumer_counts_by_hand(capacity, batch, numpy):
+def test_producer_consumer_counts_by_hand(capacity, batch, mode):
     """Producer (2 states) x consumer (2 states) x buffer level 0..c: 4(c+1) markings.
 
     Edges: produce and consume fire in half the markings each (2(c+1) each), take
     whenever the buffer is non-empty (2c), put whenever c - b >= batch (2(c - batch + 1)).
     """
-    space = explore(producer_consumer(capacity, batch), numpy=numpy)
+    space = explore(producer_consumer(capacity, batch), mode=mode)
     assert space.num_states == 4 * (capacity + 1)
     assert space.num_edges == 8 * capacity + 6 - 2 * batch
     assert space.max_tokens_place == capacity
@@ -105,7 +111,7 @@ def test_producer_consumer_counts_by_hand(capacity, batch, numpy):
 def test_paths_and_edges_are_firings_on_a_weighted_net():
     """On a non-safe weighted net every path reaches its state and every edge fires."""
     net = producer_consumer(6, 3)
-    assert_consistent(net, explore(net, numpy=True))
+    assert_consistent(net, explore(net, mode="counts"))
     assert_consistent(net, explore(net))
 
 
@@ -149,17 +155,17 @@ def test_to_networkx_has_states_markings_and_keyed_edges():
         assert fire(net, graph.nodes[source]["marking"], key) == graph.nodes[target]["marking"]
 
 
-@pytest.mark.parametrize("numpy", [False, True])
-def test_state_limit_raises_with_count(numpy):
+@pytest.mark.parametrize("mode", MODES)
+def test_state_limit_raises_with_count(mode):
     """Exceeding max_states raises StateSpaceLimit naming the limit and the states stored."""
     with pytest.raises(StateSpaceLimit) as caught:
-        explore(dining_philosophers(12), max_states=100, numpy=numpy)
+        explore(dining_philosophers(12), max_states=100, mode=mode)
     assert caught.value.limit == 100 and caught.value.explored <= 100
     assert "max_states=100" in str(caught.value) and "states" in str(caught.value)
 
 
-def test_state_limit_on_a_wide_net_goes_through_numpy():
-    """A limit hit deep in a wide exploration (numpy frontiers) raises too."""
+def test_state_limit_deep_in_a_large_exploration():
+    """A limit hit after the buffers and the table have grown several times raises too."""
     with pytest.raises(StateSpaceLimit):
         reachability_graph(dining_philosophers(22), max_states=20_000)
 
@@ -173,12 +179,12 @@ transitions:
 """
 
 
-@pytest.mark.parametrize("numpy", [False, True])
-def test_unbounded_net_raises_with_a_pumping_witness(numpy):
+@pytest.mark.parametrize("mode", MODES)
+def test_unbounded_net_raises_with_a_pumping_witness(mode):
     """A transition that only adds tokens is found to be unbounded, with a witness."""
     net = loads_net(GENERATOR)
     with pytest.raises(UnboundedNetError) as caught:
-        explore(net, numpy=numpy)
+        explore(net, mode=mode)
     error = caught.value
     assert error.places and set(error.places) <= {"queue", "done"}
     covered = fire_sequence(net, net.initial_marking, error.prefix)
@@ -202,7 +208,7 @@ places: [p]
 transitions: [{id: make, in: [], out: [p]}]
 """)
     with pytest.raises(UnboundedNetError) as caught:
-        explore(net, numpy=True)
+        explore(net, mode="counts")
     assert caught.value.places == ["p"] and caught.value.pump == ["make"]
 
 
@@ -217,7 +223,7 @@ transitions:
   - {id: cd, in: {c: 2}, out: {d: 2}}
   - {id: back, in: {d: 2}, out: [a, b]}
 """)
-    space = explore(net, numpy=True)
+    space = explore(net, mode="counts")
     expected, edges = reference_exploration(net)
     assert {space.marking(s) for s in range(space.num_states)} == expected
     assert space.num_edges == edges and not space.safe and space.representation == "counts"
@@ -232,24 +238,59 @@ def test_more_than_64_basis_places_use_hashed_keys():
         net.add_transition(f"t{k}")
         net.add_arc(f"p{k}", f"t{k}")
         net.add_arc(f"t{k}", f"p{(k + 1) % 70}")
-    space = explore(net, numpy=True)
+    space = explore(net, mode="counts")
     assert (space.num_states, space.num_edges) == (70, 70)
     assert_consistent(net, space)
 
 
-def test_hash_collisions_restart_with_an_exact_index(monkeypatch):
-    """With a hash that collides all the time the result is still exact."""
-    monkeypatch.setattr(reachability, "_hash_words", lambda words: words[:, 0] & np.uint64(3))
-    net = Net("ring")
-    for k in range(70):
-        net.add_place(f"p{k}", tokens=int(k % 35 == 0))
-    for k in range(70):
-        net.add_transition(f"t{k}")
-        net.add_arc(f"p{k}", f"t{k}")
-        net.add_arc(f"t{k}", f"p{(k + 1) % 70}")
-    space = explore(net, numpy=True, max_states=10**5)
-    expected, edges = reference_exploration(net)
-    assert space.num_states == len(expected) and space.num_edges == edges
+def two_rings(size: int = 35) -> Net:
+    """Two rings of ``size`` places with a token each: safe, size**2 states, keys of
+    2 * size - 2 basis places (more than one word)."""
+    net = Net("two-rings")
+    for ring in "ab":
+        for k in range(size):
+            net.add_place(f"{ring}{k}", tokens=int(k == 0))
+        for k in range(size):
+            net.add_transition(f"{ring}t{k}")
+            net.add_arc(f"{ring}{k}", f"{ring}t{k}")
+            net.add_arc(f"{ring}t{k}", f"{ring}{(k + 1) % size}")
+    return net
+
+
+COLLIDING = """
+import numpy as np
+from petriflow.analysis import _kernel
+assert not _kernel.COMPILED
+_kernel._mix = lambda x: x & np.uint64(255)   # hashes collide all the time
+from petriflow.analysis import reachability
+from petriflow.engine import CompiledNet
+from tests.analysis.test_reachability import two_rings
+
+net = two_rings()
+compiled = CompiledNet(net)
+m0 = np.array(compiled.vector(net.initial_marking), dtype=np.int64)
+for bits in (True, False):
+    space = reachability._explore(compiled, m0, 10**5, True, bits=bits)
+    print(space.representation, space.num_states, space.num_edges)
+"""
+
+
+def test_hash_collisions_are_told_apart_by_the_rows():
+    """With a hash that collides all the time the result is still exact.
+
+    Runs the loops as plain Python (``NUMBA_DISABLE_JIT=1``, also the path taken where
+    numba is missing) in a subprocess, with the hash replaced by an eight-bit one.
+    """
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    done = subprocess.run([sys.executable, "-c", COLLIDING], env=env, capture_output=True,
+                          text=True, timeout=300, check=True)
+    expected, edges = reference_exploration(two_rings())
+    assert done.stdout.split() == ["bitmask", str(len(expected)), str(edges),
+                                   "counts", str(len(expected)), str(edges)]
 
 
 def test_counts_without_structural_bounds_use_hashed_keys():
@@ -263,7 +304,7 @@ transitions:
   - {id: back, in: [b], out: [a]}
 """)
     with pytest.raises(UnboundedNetError):   # back + extra pumps c
-        explore(net, numpy=True)
+        explore(net, mode="counts")
     bounded = loads_net("""
 petriflow: 1
 places: [{id: a, tokens: 3}, b, c]
@@ -271,7 +312,7 @@ transitions:
   - {id: plain, in: [a], out: [b]}
   - {id: extra, in: [a], out: [b, c]}
 """)
-    space = explore(bounded, numpy=True)
+    space = explore(bounded, mode="counts")
     expected, edges = reference_exploration(bounded)
     assert space.num_states == len(expected) and space.num_edges == edges
     assert space.max_tokens_place == 3
@@ -286,8 +327,8 @@ transitions:
   - {id: abort, in: [go], out: [stop], cancels: [work]}
   - {id: step, in: [work], out: []}
 """)
-    for numpy in (False, True):
-        space = explore(net, numpy=numpy)
+    for mode in MODES:
+        space = explore(net, mode=mode)
         markings = {space.marking(s) for s in range(space.num_states)}
         assert Marking({"stop": 1}) in markings
         assert all(not (m["stop"] and m["work"]) for m in markings)
@@ -299,8 +340,8 @@ transitions:
 def test_random_nets_match_the_reference_exploration(net):
     """Markings and edge counts equal the textbook BFS, on both engines."""
     expected, edges = reference_exploration(net)
-    for numpy in (False, True):
-        space = explore(net, numpy=numpy)
+    for mode in MODES:
+        space = explore(net, mode=mode)
         assert {space.marking(s) for s in range(space.num_states)} == expected
         assert space.num_edges == edges
 
@@ -352,13 +393,13 @@ transitions:
     assert space.path(broken) == ["grab@failed"]
 
 
-@pytest.mark.parametrize("numpy", [False, True])
-def test_degenerate_nets(numpy):
+@pytest.mark.parametrize("mode", MODES)
+def test_degenerate_nets(mode):
     """No transitions: one state; no places: one state with a self-loop per transition."""
     lonely = loads_net("petriflow: 1\nplaces: [{id: p, tokens: 2}]\n")
-    space = explore(lonely, numpy=numpy)
+    space = explore(lonely, mode=mode)
     assert (space.num_states, space.num_edges) == (1, 0)
     empty = Net("empty")
     empty.add_transition("tick")
-    space = explore(empty, numpy=numpy)
+    space = explore(empty, mode=mode)
     assert (space.num_states, space.num_edges) == (1, 1) and space.successors(0) == [("tick", 0)]
