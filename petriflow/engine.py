@@ -27,6 +27,7 @@ Examples:
 
 from __future__ import annotations
 
+import functools
 import random
 from typing import Callable, Iterable, Mapping, Sequence
 
@@ -139,23 +140,35 @@ class CompiledNet:
         self.pre: list[tuple[tuple[int, int], ...]] = []
         self.post: list[tuple[tuple[int, int], ...]] = []
         self.reset: list[tuple[int, ...]] = []
-        for t, transition in net.transitions.items():
-            pre = tuple((index[p], w) for p, w in net.preset(t).items())
-            reset = tuple(index[n] for n in transition.cancels if n in index)
-            for outcome in [None, *net.outcomes(t)]:
+        for t, transition, preset, outputs in net.firing_rules():
+            pre = tuple([(index[p], w) for p, w in preset.items()])
+            reset = tuple([index[n] for n in transition.cancels if n in index])
+            for outcome, postset in outputs:
                 self.transitions.append(variant_id(t, outcome))
                 self.origin.append((t, outcome))
                 self.pre.append(pre)
-                self.post.append(tuple((index[p], w) for p, w in net.postset(t, outcome).items()))
+                self.post.append(tuple([(index[p], w) for p, w in postset.items()]))
                 self.reset.append(reset)
         self.has_resets = any(self.reset)
         self.transition_index = {t: i for i, t in enumerate(self.transitions)}
+        shape = (len(self.transitions), len(self.places))
+        self.pre_matrix = _matrix(shape, self.pre)
+        self.post_matrix = _matrix(shape, self.post)
+        self.incidence = self.post_matrix - self.pre_matrix
+
+    @functools.cached_property
+    def consumers(self) -> list[tuple[int, ...]]:
+        """Per place, the rows that consume from it."""
         consumers: list[list[int]] = [[] for _ in self.places]
         for t, pre in enumerate(self.pre):
             for p, _ in pre:
                 consumers[p].append(t)
-        self.consumers = [tuple(c) for c in consumers]
-        self.affected: list[tuple[int, ...]] = []
+        return [tuple(c) for c in consumers]
+
+    @functools.cached_property
+    def affected(self) -> list[tuple[int, ...]]:
+        """Per row ``t``, the rows whose enabledness can change when ``t`` fires."""
+        affected = []
         for t in range(len(self.transitions)):
             change: dict[int, int] = {p: 1 for p in self.reset[t]}
             for p, w in self.pre[t]:
@@ -163,16 +176,8 @@ class CompiledNet:
             for p, w in self.post[t]:
                 change[p] = change.get(p, 0) + w
             touched = sorted({u for p, d in change.items() if d for u in self.consumers[p]})
-            self.affected.append(tuple(touched))
-        shape = (len(self.transitions), len(self.places))
-        self.pre_matrix = np.zeros(shape, dtype=np.int64)
-        self.post_matrix = np.zeros(shape, dtype=np.int64)
-        for t in range(shape[0]):
-            for p, w in self.pre[t]:
-                self.pre_matrix[t, p] = w
-            for p, w in self.post[t]:
-                self.post_matrix[t, p] = w
-        self.incidence = self.post_matrix - self.pre_matrix
+            affected.append(tuple(touched))
+        return affected
 
     def vector(self, marking: Mapping[str, int]) -> list[int]:
         """The marking as a list of counts in place-index order."""
@@ -195,6 +200,16 @@ class CompiledNet:
     def enabled(self, vector: Sequence[int]) -> list[int]:
         """Indices of the transitions enabled in ``vector``."""
         return [t for t in range(len(self.transitions)) if self.is_enabled(vector, t)]
+
+
+def _matrix(shape: tuple[int, int], arcs: list[tuple[tuple[int, int], ...]]) -> np.ndarray:
+    """The ``rows x places`` int64 matrix of per-row ``(place, weight)`` arcs."""
+    matrix = np.zeros(shape, dtype=np.int64)
+    rows = [t for t, row in enumerate(arcs) for _ in row]
+    if rows:
+        places, weights = zip(*(arc for row in arcs for arc in row))
+        matrix[rows, list(places)] = weights
+    return matrix
 
 
 FireHandler = Callable[[str, Marking], None]

@@ -347,6 +347,18 @@ class Net:
         self.transition(transition)
         return [o for o in OUTCOMES if o in self._post_outcome[transition]]
 
+    def firing_rules(self):
+        """Per transition, in order: ``(id, transition, preset, outputs)`` where
+        ``outputs`` is ``[(None, postset), (outcome, postset), ...]`` in
+        :data:`OUTCOMES` order. The dicts are the net's own (no copies, for compilers
+        that read every transition): do not modify them."""
+        for id, transition in self.transitions.items():
+            routed = self._post_outcome[id]
+            outputs = [(None, self._post[id])]
+            if routed:
+                outputs += [(o, routed[o]) for o in OUTCOMES if o in routed]
+            yield id, transition, self._pre[id], outputs
+
     def place_preset(self, place: str) -> dict[str, int]:
         """``{transition: weight}`` of the transitions that put tokens into ``place``
         (on any outcome; the largest weight when several outcomes do)."""

@@ -378,8 +378,7 @@ _UINT = (np.uint8, np.uint16, np.uint32, np.uint64)
 
 #: Count rows of nets with more places than this put the places of an incidence basis
 #: first and key states on those columns only; smaller nets key on whole rows, which is
-#: as fast and skips the elimination. (Bitmask rows do so when a whole row does not fit
-#: in one table word beside a state id.)
+#: as fast and skips the elimination. (Bitmask rows do so beyond 64 places.)
 _BASIS_FROM_PLACES = 16
 
 
@@ -391,7 +390,7 @@ def warm_up() -> None:
     """
     from petriflow.classic import independent_cycles, producer_consumer
 
-    reachability_graph(independent_cycles(2))
+    reachability_graph(independent_cycles(10))     # bitmask rows, a growing table
     reachability_graph(producer_consumer(2))
 
 
@@ -419,6 +418,14 @@ def _layout(compiled: CompiledNet, has_resets: bool, threshold: int) -> tuple[li
     basis = pivot_columns(compiled.incidence)
     chosen = set(basis)
     return basis + [p for p in range(n_places) if p not in chosen], len(basis)
+
+
+def _bit_words(bits: np.ndarray, n_words: int) -> np.ndarray:
+    """Rows of booleans (bit ``j`` = column ``j``) as rows of ``n_words`` uint64 words."""
+    padded = np.zeros((bits.shape[0], 64 * n_words), dtype=np.uint8)
+    padded[:, : bits.shape[1]] = bits
+    return np.ascontiguousarray(
+        np.packbits(padded, axis=1, bitorder="little").view("<u8").astype(np.uint64))
 
 
 class _Buffers:
@@ -491,48 +498,41 @@ def _explore_bits(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int
                   resets: list[tuple[int, ...]], has_resets: bool,
                   basis_from: int | None) -> StateSpace | None:
     """Explore with bitmask rows; ``None`` when some reachable marking is not safe."""
-    # A key that fits in one table word beside the state id saves a word a slot and a
-    # read of the row: find a basis when the whole row does not fit.
+    # Rows of more than one word are keyed on basis places: their key usually fits in
+    # one word, often beside the state id in one table slot.
     id_bits = max(1, int(max_states).bit_length())
-    threshold = 64 - id_bits if basis_from is None else basis_from
-    layout, n_key = _layout(compiled, has_resets, threshold)
-    column = [0] * len(layout)
-    for c, p in enumerate(layout):
-        column[p] = c
+    layout, n_key = _layout(compiled, has_resets, 64 if basis_from is None else basis_from)
     n_words = max(1, -(-len(layout) // 64))
-    every = (1 << (64 * n_words)) - 1
-    pre_bits, post_bits, keep_bits, kind = [], [], [], []
-    for t, (pre, post) in enumerate(zip(compiled.pre, compiled.post)):
-        taken = sum(1 << column[p] for p, _ in pre)
-        pre_bits.append(taken)
-        post_bits.append(sum(1 << column[p] for p, _ in post))
-        keep_bits.append(every & ~(taken | sum(1 << column[p] for p in resets[t])))
-        kind.append(1 if any(w > 1 for _, w in pre) else 2 if any(w > 1 for _, w in post)
-                    else 0)
-    start = sum(1 << column[p] for p in np.flatnonzero(m0).tolist())
-
-    def words(values: list[int]) -> np.ndarray:
-        mask = (1 << 64) - 1
-        return np.array([[(v >> (64 * w)) & mask for w in range(n_words)] for v in values],
-                        dtype=np.uint64).reshape(len(values), n_words)
-
+    pre, post = compiled.pre_matrix, compiled.post_matrix
+    if n_key < len(layout):                       # basis places first
+        pre, post = pre[:, layout], post[:, layout]
+    gone = pre > 0
+    for t, places in enumerate(resets):           # resets keep every place in order
+        gone[t, list(places)] = True
+    # A transition needing two tokens from a place is never enabled in a safe marking;
+    # one putting two tokens in a place makes the marking unsafe as soon as it fires.
+    kind = np.where((pre > 1).any(axis=1), 1, np.where((post > 1).any(axis=1), 2, 0))
+    key_mask = np.zeros(len(layout), dtype=bool)
+    key_mask[:n_key] = True
+    words = _bit_words(np.vstack([pre > 0, post > 0, ~gone, key_mask, m0[layout] > 0]),
+                       n_words)
+    n_t = len(kind)
     id_bits = id_bits if n_key + id_bits <= 64 else 0
-    buffers = _Buffers(kernel, words([start])[0], max_states, len(kind), 1 if id_bits else 2,
-                       id_bits)
-    fixed = (words(pre_bits), words(post_bits), words(keep_bits), np.array(kind, dtype=np.int8),
-             words([(1 << n_key) - 1])[0], id_bits, max_states)
+    buffers = _Buffers(kernel, words[-1], max_states, n_t, 1 if id_bits else 2, id_bits)
+    fixed = (words[:n_t], words[n_t: 2 * n_t], words[2 * n_t: 3 * n_t], kind.astype(np.int8),
+             words[-2], id_bits, max_states)
     while True:
         rows, parent, parent_t = buffers.state
         status = kernel.expand_bits(*fixed, rows, parent, parent_t, buffers.table,
                                     *buffers.edge, buffers.counters)
         if status != kernel.FULL:
             break
-        buffers.grow(len(kind))
+        buffers.grow(n_t)
     if status == kernel.NOT_SAFE:
         return None
     if status == kernel.LIMIT:
         raise StateSpaceLimit(max_states, int(buffers.counters[0]), int(buffers.counters[2]))
-    return _space(compiled, "bitmask", buffers, column)
+    return _space(compiled, "bitmask", buffers, np.argsort(layout))
 
 
 def _explore_counts(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int,
