@@ -466,9 +466,19 @@ class _Buffers:
 
 
 def _grown(array: np.ndarray, used: int, need: int) -> np.ndarray:
+    """``array`` with room for ``need`` rows (at least twice as many), its first
+    ``used`` rows kept.
+
+    Resized in place where possible: ``realloc`` moves large blocks by remapping their
+    pages instead of copying them, so growing touches no memory twice.
+    """
     if need <= len(array):
         return array
-    bigger = np.empty((max(need, 2 * len(array)),) + array.shape[1:], dtype=array.dtype)
+    shape = (max(need, 2 * len(array)),) + array.shape[1:]
+    if array.flags.owndata and array.base is None:
+        array.resize(shape, refcheck=False)
+        return array
+    bigger = np.empty(shape, dtype=array.dtype)
     bigger[:used] = array[:used]
     return bigger
 
