@@ -11,7 +11,8 @@ missing, with the same results, a few hundred times slower):
 * :func:`expand_counts` for every other net: a marking is a row of small unsigned
   counts; it stops with :data:`OVERFLOW` when a count would not fit the row's dtype
   (the caller widens it and starts again) and with :data:`UNBOUNDED` when a new state
-  strictly covers one of its breadth-first-tree ancestors.
+  strictly covers one of its breadth-first-tree ancestors (with reset arcs, in a place
+  no firing between them resets).
 
 Both number states in discovery order, expand them in that order and transitions in
 index order, so a state's parent edge is its first discovery: the BFS tree gives
@@ -282,6 +283,18 @@ def _hash_counts(row, key):
 
 
 @_jit
+def _reset_on_path(parent, parent_t, reset_at, reset_place, state, ancestor, place):
+    """Whether a firing on the BFS-tree path from ``ancestor`` to ``state`` resets ``place``."""
+    while state != ancestor:
+        t = parent_t[state]
+        for a in range(reset_at[t], reset_at[t + 1]):
+            if reset_place[a] == place:
+                return True
+        state = np.int64(parent[state])
+    return False
+
+
+@_jit
 def expand_counts(pre_at, pre_place, pre_weight, post_at, post_place, post_weight,
                   change_at, change_place, change_delta, reset_at, reset_place, key, top,
                   check_unbounded, max_states, rows, parent, parent_t, table, e_source,
@@ -294,7 +307,9 @@ def expand_counts(pre_at, pre_place, pre_weight, post_at, post_place, post_weigh
             net changes (place, post - pre) and the reset places.
         key: the number of leading columns that tell two states apart.
         top: the largest count the rows' dtype holds.
-        check_unbounded: look for a new state strictly covering an ancestor.
+        check_unbounded: look for a new state strictly covering an ancestor (with reset
+            arcs: in a place that no firing between the two resets, so that repeating
+            those firings grows it forever).
         max_states, rows, parent, parent_t, e_source, e_transition, e_target: as for
             :func:`expand_bits`; the table always has ``(hash, id + 1)`` slots.
         totals, path_min: per state its token total and the smallest total on its
@@ -399,6 +414,17 @@ def expand_counts(pre_at, pre_place, pre_weight, post_at, post_place, post_weigh
                                 if successor[p] < np.int64(rows[ancestor, p]):
                                     covers = False
                                     break
+                            # With reset arcs a grown place only pumps if no firing
+                            # between the two markings resets it.
+                            if covers and reset_at[n_t] > 0:
+                                covers = False
+                                for p in range(n_p):
+                                    if (successor[p] > np.int64(rows[ancestor, p])
+                                            and not _reset_on_path(parent, parent_t, reset_at,
+                                                                   reset_place, target,
+                                                                   ancestor, p)):
+                                        covers = True
+                                        break
                             if covers:
                                 counters[3], counters[4] = target, ancestor
                                 status = UNBOUNDED

@@ -7,53 +7,42 @@ edges as three arrays (source state, transition index, target state) and, per st
 the edge it was first reached by, so that a shortest firing sequence from the initial
 marking to any state can be rebuilt (:meth:`StateSpace.path`).
 
-How it is fast:
+How it is fast: the breadth-first search runs compiled by numba
+(:mod:`petriflow.analysis._kernel`), over the ids of the states found so far (the BFS
+queue is a range of ids), with no Python code per state.
 
-* **Thin start in plain Python, wide frontiers in numpy.** States are numbered in the
-  order they are found, so the BFS queue is a range of state ids. While the queue is
-  short (fewer than 512 states), a plain Python BFS on tuples and a dict is fastest;
-  once it is wide, numpy takes over and expands the queue in chunks of up to 2**23
-  (state, transition) pairs with no per-state Python code. Long thin state spaces
-  (a producer and a consumer around a large buffer) never leave the Python engine.
 * **Safe nets as bitmasks.** While every marking is safe, a marking is a row of
-  ``uint64`` words, one bit a place. For each transition ``t``, one pass over the
-  chunk's words finds the states with no input place of ``t`` missing
-  (``~m & pre[t] == 0``); the successor is ``m ^ (pre[t] ^ post[t])``. A successor that
-  would put a second token in a place (``m & post[t] & ~pre[t] != 0``) makes the
-  exploration start again with count rows, unless P-semiflows already prove the net
-  safe, in which case the check is skipped.
-* **Other bounded nets as count rows.** Small unsigned integers (uint8, widened to
-  uint16, uint32, uint64 when a count could overflow); enabled when every input place
-  holds the arc weight, successor ``m + C[t]``.
+  ``uint64`` words, one bit a place; ``t`` is enabled when ``m & pre[t] == pre[t]`` and
+  fires as ``(m & keep[t]) | post[t]``. A firing that would put a second token in a
+  place makes the exploration start again with count rows.
+* **Other bounded nets as count rows** of small unsigned integers (uint8, widened to
+  uint16, uint32, uint64, and the search started again, when a count outgrows them).
 * **Compact, exact keys.** Every reachable marking is ``M0 + x·C`` (C the incidence
   matrix), so it is fixed by its counts on the places whose incidence columns form a
   basis of C's column space (computed exactly; 30 of the 90 places of 30 philosophers).
-  Those places come first in the row. On safe nets whose basis fits in 64 bits the key
-  is those bits; on count rows it is their counts packed in the bit widths the
-  P-semiflow bounds allow. Otherwise it is a 64-bit hash and two states only count as
-  equal when their key columns are equal too; a hash collision restarts the
-  exploration with an exact dictionary index.
-* **Deduplication by one sort.** Each successor is packed as ``key << b | source << t_b
-  | t`` in one uint64 (on safe nets that is a single gather and xor per enabled pair)
-  and the chunk's array is sorted with ``ndarray.sort``: equal keys become neighbours
-  and the first of a run is the first discovery (lowest source, then transition),
-  which keeps the BFS parents, hence shortest witnesses. The distinct keys are looked
-  up with ``np.searchsorted`` in a sorted index of the states seen (two runs, newest
-  first, merged like a small log-structured merge tree).
+  On large nets those places come first in the row and only they are hashed and
+  compared. A safe key that fits in one word beside the state id is stored as that one
+  word in the open-addressing hash table; otherwise a slot is a (64-bit hash, id) pair
+  and a hash match is confirmed on the key columns, so collisions cost time, never
+  correctness.
+* **Memory latency overlapped.** The slots of all successors of a state are prefetched
+  before the first is probed; buffers are numpy arrays (huge pages) grown in place.
 
-Reset arcs (a transition's cancellation region) are honoured by both engines: the
+Reset arcs (a transition's cancellation region) are honoured by both loops: the
 successor empties those places; keys are then whole markings.
 
-Unbounded nets: the bitmask path cannot loop forever (it has at most 2^|P| states); on
-count rows, each new state is compared with the states on its BFS-tree path from M0. A
+Unbounded nets: the bitmask loop cannot run forever (at most 2^|P| states); on count
+rows, each new state is compared with the states on its BFS-tree path from M0. A
 marking that strictly covers an ancestor proves the net unbounded (the firing sequence
 between them can be repeated forever) and, by Dickson's lemma and König's lemma, some
 state of an unbounded net's BFS tree always does, so the check finds every unbounded
-net in finite time. It raises :class:`UnboundedNetError` with both firing sequences.
-Only states whose token total exceeds the smallest total on their path are compared, so
-conservative nets pay nothing, and nets covered by P-semiflows skip the check. With
-reset arcs the covering argument fails (a reset can undo the gain), so such nets are
-only stopped by ``max_states``.
+P/T net in finite time. It raises :class:`UnboundedNetError` with both firing
+sequences. Only states whose token total exceeds the smallest total on their path are
+compared, so conservative nets pay nothing. With reset arcs a covering marking only
+counts when some strictly grown place is reset by no firing between the two (then
+those firings still add the same tokens to it each time): a sound test, but an
+unbounded reset net need not show such a pair, and may only be stopped by
+``max_states``.
 
 Examples:
     >>> from petriflow.classic import dining_philosophers
@@ -566,8 +555,7 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: i
     changes = [[(int(p), int(row[p])) for p in np.flatnonzero(row)] for row in incidence]
     reset_at, reset_place, _ = csr([[(p, 0) for p in places] for places in resets])
     conservative = bool((incidence.sum(axis=1) == 0).all()) if incidence.size else True
-    # Strictly covering an ancestor proves nothing once places can be reset.
-    check = detect_unbounded and not conservative and not has_resets
+    check = detect_unbounded and not conservative
     fixed = (*csr(compiled.pre), *csr(compiled.post), *csr(changes), reset_at, reset_place,
              n_key)
     n_t = len(compiled.transitions)
@@ -637,5 +625,8 @@ def _unbounded(compiled: CompiledNet, buffers: _Buffers, column: np.ndarray) -> 
         return compiled.marking([int(c) for c in rows[s][column]])
 
     covered, covering = marking(ancestor), marking(state)
-    grown = [p for p in compiled.places if covering[p] > covered[p]]
-    raise UnboundedNetError(grown, walk(ancestor, 0), walk(state, ancestor), covered, covering)
+    pump = walk(state, ancestor)
+    resets = _resets_of(compiled)
+    reset = {compiled.places[p] for t in pump for p in resets[compiled.transitions.index(t)]}
+    grown = [p for p in compiled.places if covering[p] > covered[p] and p not in reset]
+    raise UnboundedNetError(grown, walk(ancestor, 0), pump, covered, covering)

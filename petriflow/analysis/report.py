@@ -274,11 +274,14 @@ def _unbounded_result(result, net, compiled, start, exc, max_states, soundness) 
     result.update(bounded=False, safe=False, live=None, deadlock_free=None)
     places = list(exc.places) if exc is not None else []
     try:
+        if compiled.has_resets:      # Karp-Miller does not apply: keep the witness's places
+            raise StateSpaceLimit(0, 0, 0)
         graph = coverability_graph(net, start, max_nodes=max_states, compiled=compiled)
     except StateSpaceLimit:
         graph = None
-        result["algorithm"].append("Karp-Miller coverability graph: too large, unbounded places"
-                                   " listed are those the witness pumps")
+        result["algorithm"].append("Karp-Miller coverability graph: too large or not"
+                                   " applicable (reset arcs), unbounded places listed are"
+                                   " those the witness pumps")
     if graph is not None:
         places = graph.unbounded_places
         result["dead_transitions"] = graph.dead_transitions()

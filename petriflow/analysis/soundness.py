@@ -350,7 +350,8 @@ def _unbounded(net: Net, compiled: CompiledNet, start: Marking, exc: UnboundedNe
                         " earlier one on its path (unbounded)")
     places = list(exc.places)
     try:
-        graph = coverability_graph(net, start, max_nodes=max_states, compiled=compiled)
+        graph = (None if compiled.has_resets    # Karp-Miller does not apply to reset arcs
+                 else coverability_graph(net, start, max_nodes=max_states, compiled=compiled))
     except StateSpaceLimit:
         graph = None
     if graph is not None:

@@ -335,6 +335,31 @@ transitions:
         assert space.num_states == len(reference_exploration(net)[0])
 
 
+def test_reset_net_that_resets_its_growing_place_is_bounded():
+    """t covers the start marking but resets the place it grows: two states, no error."""
+    net = loads_net("""
+petriflow: 1
+places: [{id: a, tokens: 1}, b]
+transitions: [{id: t, in: [a], out: [a, b], cancels: [b]}]
+""")
+    space = explore(net)
+    assert (space.num_states, space.num_edges) == (2, 2)
+
+
+def test_reset_net_growing_a_place_nothing_resets_is_unbounded():
+    """With a cancellation region elsewhere, a place that only grows is still caught."""
+    net = loads_net("""
+petriflow: 1
+places: [{id: a, tokens: 1}, b, c]
+transitions:
+  - {id: t, in: [a], out: [a, b, c], cancels: [c]}
+""")
+    for mode in ("default", "counts"):
+        with pytest.raises(UnboundedNetError) as caught:
+            explore(net, mode=mode)
+        assert caught.value.places == ["b"] and caught.value.pump == ["t"]
+
+
 @SETTINGS
 @given(bounded_nets())
 def test_random_nets_match_the_reference_exploration(net):
