@@ -380,7 +380,11 @@ def warm_up() -> None:
     from petriflow.classic import independent_cycles, producer_consumer
 
     reachability_graph(independent_cycles(10))     # bitmask rows, a growing table
-    reachability_graph(producer_consumer(2))
+    reachability_graph(producer_consumer(2))       # count rows, unboundedness checks
+    for tokens in (300, 70_000, 2**40):            # count rows of every wider dtype
+        net = independent_cycles(1)
+        net.add_place("stock", tokens=tokens)
+        reachability_graph(net)
 
 
 def _origins(compiled: CompiledNet) -> tuple[str, ...]:
