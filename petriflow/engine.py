@@ -140,15 +140,19 @@ class CompiledNet:
         self.pre: list[tuple[tuple[int, int], ...]] = []
         self.post: list[tuple[tuple[int, int], ...]] = []
         self.reset: list[tuple[int, ...]] = []
+        # Bound methods: this loop runs once per transition of every net analysed.
+        add_id, add_origin = self.transitions.append, self.origin.append
+        add_pre, add_post, add_reset = self.pre.append, self.post.append, self.reset.append
         for t, transition, preset, outputs in net.firing_rules():
             pre = tuple([(index[p], w) for p, w in preset.items()])
-            reset = tuple([index[n] for n in transition.cancels if n in index])
+            cancels = transition.cancels
+            reset = tuple([index[n] for n in cancels if n in index]) if cancels else ()
             for outcome, postset in outputs:
-                self.transitions.append(variant_id(t, outcome))
-                self.origin.append((t, outcome))
-                self.pre.append(pre)
-                self.post.append(tuple([(index[p], w) for p, w in postset.items()]))
-                self.reset.append(reset)
+                add_id(t if outcome is None else variant_id(t, outcome))
+                add_origin((t, outcome))
+                add_pre(pre)
+                add_post(tuple([(index[p], w) for p, w in postset.items()]))
+                add_reset(reset)
         self.has_resets = any(self.reset)
         self.transition_index = {t: i for i, t in enumerate(self.transitions)}
         shape = (len(self.transitions), len(self.places))
@@ -205,10 +209,14 @@ class CompiledNet:
 def _matrix(shape: tuple[int, int], arcs: list[tuple[tuple[int, int], ...]]) -> np.ndarray:
     """The ``rows x places`` int64 matrix of per-row ``(place, weight)`` arcs."""
     matrix = np.zeros(shape, dtype=np.int64)
-    rows = [t for t, row in enumerate(arcs) for _ in row]
-    if rows:
-        places, weights = zip(*(arc for row in arcs for arc in row))
-        matrix[rows, list(places)] = weights
+    width = shape[1]
+    flat, weights = [], []
+    for t, row in enumerate(arcs):
+        for p, w in row:
+            flat.append(t * width + p)
+            weights.append(w)
+    if flat:
+        matrix.put(flat, weights)
     return matrix
 
 

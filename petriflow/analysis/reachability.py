@@ -510,8 +510,9 @@ def _explore_bits(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int
     if n_key < len(layout):                       # basis places first
         pre, post = pre[:, layout], post[:, layout]
     gone = pre > 0
-    for t, places in enumerate(resets):           # resets keep every place in order
-        gone[t, list(places)] = True
+    if has_resets:                                # resets keep every place in order
+        for t, places in enumerate(resets):
+            gone[t, list(places)] = True
     # A transition needing two tokens from a place is never enabled in a safe marking;
     # one putting two tokens in a place makes the marking unsafe as soon as it fires.
     kind = np.where((pre > 1).any(axis=1), 1, np.where((post > 1).any(axis=1), 2, 0))
