@@ -137,7 +137,7 @@ class StateSpace:
 
     States are numbered ``0 .. num_states - 1`` in breadth-first order; state 0 is the
     initial marking, so state ids never decrease with the distance from it. Edges are
-    in exploration order (grouped by chunks of source states, not sorted);
+    in exploration order: by source state, then by transition index;
     :meth:`successors` and :meth:`out_degree` index them.
 
     Attributes:

@@ -75,13 +75,21 @@ def test_philosopher_states_are_lucas_numbers(n):
 @pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("n", [3, 5, 8])
 def test_philosopher_graph_matches_reference(n, mode):
-    """States, edges and markings equal the textbook BFS on both engines."""
+    """States, edges and markings equal the textbook BFS in every mode."""
     net = dining_philosophers(n)
     space = explore(net, mode=mode)
     expected, edges = reference_exploration(net)
     assert {space.marking(s) for s in range(space.num_states)} == expected
     assert space.num_edges == edges
     assert_consistent(net, space)
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_edges_come_by_source_then_transition(mode):
+    """The documented edge order: by source state, then transition index."""
+    space = explore(dining_philosophers(9), mode=mode)
+    order = np.lexsort((space.edge_transition, space.edge_source))
+    assert (order == np.arange(space.num_edges)).all()
 
 
 @pytest.mark.parametrize("mode", MODES)
@@ -363,7 +371,7 @@ transitions:
 @SETTINGS
 @given(bounded_nets())
 def test_random_nets_match_the_reference_exploration(net):
-    """Markings and edge counts equal the textbook BFS, on both engines."""
+    """Markings and edge counts equal the textbook BFS, in every mode."""
     expected, edges = reference_exploration(net)
     for mode in MODES:
         space = explore(net, mode=mode)
