@@ -28,6 +28,17 @@ def test_quick_run_writes_a_table_and_json(tmp_path, capsys):
     assert states[("producer/consumer, batch 3", "c=300")] == 4 * 301
 
 
+def test_repeated_runs_report_a_median_and_a_range(tmp_path, capsys):
+    """--runs 2 measures petriflow twice and prints the range beside the median."""
+    out = tmp_path / "rows.json"
+    assert load_bench().main(["--quick", "--tools", "petriflow", "--runs", "2",
+                              "--json", str(out)]) == 0
+    assert "in 2 runs)" in capsys.readouterr().out
+    for row in json.loads(out.read_text())["rows"]:
+        assert row["runs"] == 2
+        assert row["seconds_min"] <= row["seconds"] <= row["seconds_max"]
+
+
 def test_shared_buffer_is_bounded_by_its_capacity():
     """The benchmark's shared-buffer net keeps buffer + free equal to the capacity."""
     from petriflow.analysis.reachability import reachability_graph
