@@ -571,9 +571,10 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: i
         top = min(int(np.iinfo(dtype).max), 2**63 - 1)
         buffers = _Buffers(kernel, start.astype(dtype), max_states, n_t, 2, 0,
                            (np.int64, np.int64) if check else ())
+        unused = np.zeros(1, dtype=np.int64)     # same array types: one compiled loop
         while True:
             rows, parent, parent_t, *sums = buffers.state
-            totals, path_min = sums if check else (parent, parent)
+            totals, path_min = sums if check else (unused, unused)
             status = kernel.expand_counts(*fixed, top, check, max_states, rows, parent,
                                           parent_t, buffers.table, *buffers.edge, totals,
                                           path_min, buffers.counters)
