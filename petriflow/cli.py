@@ -178,8 +178,12 @@ def cmd_export(args: argparse.Namespace) -> int:
                   file=sys.stderr)
             return EXIT_PROBLEM
         witness = violations[0]
-        # outcome variants (t@failed) are drawn on their transition
-        highlight = list(dict.fromkeys(t.split("@")[0] for t in witness["transitions"]))
+        # outcome variants (t@failed) are drawn on the transition they belong to
+        from petriflow.engine import CompiledNet
+
+        compiled = CompiledNet(net)
+        origin = {row: t for row, (t, _) in zip(compiled.transitions, compiled.origin)}
+        highlight = list(dict.fromkeys(origin.get(t, t) for t in witness["transitions"]))
         highlight += [p for p in (witness.get("marking") or {}) if p in net.places]
         marking = net.check_marking(witness.get("marking") or {})
         print(witness["message"])

@@ -192,3 +192,23 @@ def test_export_draws_a_violation_witness(capsys, tmp_path):
     from petriflow.export import HIGHLIGHT_COLOUR
 
     assert out_file.read_text().count(HIGHLIGHT_COLOUR) >= 8
+
+
+def test_export_violation_maps_outcome_variants_to_their_transition(capsys, tmp_path):
+    """A witness through ``t@failed`` highlights ``t``, even when ``t``'s id has an '@'."""
+    net = tmp_path / "dock.yaml"
+    net.write_text("""petriflow: 1
+places: [{id: i, tokens: 1}, o, broken]
+final: {o: 1}
+transitions:
+  - {id: "scan@dock", in: [i], out: [o], outcomes: {failed: [broken]}}
+""")
+    out_file = tmp_path / "dock.dot"
+    code, out, _ = run(capsys, "export", str(net), "-f", "dot", "-o", str(out_file),
+                       "--violation")
+    assert code == 0 and "broken=1" in out          # the witness: scan@dock@failed
+    from petriflow.export import HIGHLIGHT_COLOUR
+
+    highlighted = [line for line in out_file.read_text().splitlines()
+                   if HIGHLIGHT_COLOUR in line]
+    assert any('"scan@dock"' in line for line in highlighted)
