@@ -25,7 +25,7 @@ id: then a slot is the one word ``key << id_bits | (id + 1)`` and nothing else i
 The safe loop first computes all successors of a state and prefetches their slots,
 then probes them, so the cache misses of one state overlap.
 
-The caller owns every array (numpy allocates them, with huge pages on big ones) and
+The caller owns every array (numpy arrays, large ones on reserved mappings) and
 grows them: a loop stops with :data:`FULL` before a state whose successors might not
 fit, and the caller doubles what is short and calls again. A loop never reassigns an
 array, which keeps numba's reference counting out of it.

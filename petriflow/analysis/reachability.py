@@ -26,7 +26,8 @@ queue is a range of ids), with no Python code per state.
   and a hash match is confirmed on the key columns, so collisions cost time, never
   correctness.
 * **Memory latency overlapped.** The slots of all successors of a state are prefetched
-  before the first is probed; buffers are numpy arrays (huge pages) grown in place.
+  before the first is probed. Buffers double while small; large ones move once to
+  reserved mappings that the system commits page by page (no copies after that).
 
 Reset arcs (a transition's cancellation region) are honoured by both loops: the
 successor empties those places; keys are then whole markings.
@@ -434,6 +435,9 @@ class _Buffers:
         self.kernel, self.stride, self.id_bits = kernel, stride, id_bits
         id_type = np.int32 if max_states < 2**31 else np.int64
         t_type = np.int16 if n_transitions < 2**15 else np.int32
+        # The most rows an array can ever need (margin included): reservations stop there.
+        self.bounds = (max_states + n_transitions,
+                       (max_states + n_transitions) * max(1, n_transitions))
         states = 256
         rows = np.empty((states, len(row)), dtype=row.dtype)
         rows[0] = row
@@ -447,8 +451,8 @@ class _Buffers:
     def grow(self, margin: int) -> None:
         """Make room for ``margin`` more states and edges than counted now."""
         states, edges = int(self.counters[0]), int(self.counters[1])
-        self.state = [_grown(a, states, states + margin) for a in self.state]
-        self.edge = [_grown(a, edges, edges + margin) for a in self.edge]
+        self.state = _grown(self.state, states, states + margin, self.bounds[0])
+        self.edge = _grown(self.edge, edges, edges + margin, self.bounds[1])
         slots = len(self.table) // self.stride
         if 2 * (states + margin) > slots:          # at most half full
             while 2 * (states + margin) > slots:
@@ -458,22 +462,57 @@ class _Buffers:
             self.table = bigger
 
 
-def _grown(array: np.ndarray, used: int, need: int) -> np.ndarray:
-    """``array`` with room for ``need`` rows (at least twice as many), its first
-    ``used`` rows kept.
+#: An array whose doubling would pass this many bytes moves to a reservation.
+_RESERVE_FROM = 32 * 2**20
+#: The largest reservation, in bytes (beyond it arrays grow by copying).
+_RESERVE_MAX = 2**33
 
-    Resized in place where possible: ``realloc`` moves large blocks by remapping their
-    pages instead of copying them, so growing touches no memory twice.
+
+def _grown(arrays: list[np.ndarray], used: int, need: int, bound: int) -> list[np.ndarray]:
+    """``arrays`` (of one length: the loops check one of them) with room for ``need``
+    rows, at least twice as many, their first ``used`` rows kept; ``bound`` is the most
+    rows they can ever need.
+
+    Small arrays double. Large ones move, once, to reservations: anonymous private
+    mappings of every row they may ever need (up to 8 GiB each), asking for huge pages,
+    whose pages the operating system only commits when the loop first writes them; from
+    then on nothing is copied or zero-filled twice.
     """
-    if need <= len(array):
-        return array
-    shape = (max(need, 2 * len(array)),) + array.shape[1:]
-    if array.flags.owndata and array.base is None:
-        array.resize(shape, refcheck=False)
-        return array
-    bigger = np.empty(shape, dtype=array.dtype)
-    bigger[:used] = array[:used]
-    return bigger
+    if need <= len(arrays[0]):
+        return arrays
+    rows = max(need, 2 * len(arrays[0]))
+    row_bytes = [a.itemsize * int(np.prod(a.shape[1:], dtype=np.int64)) for a in arrays]
+    if rows * sum(row_bytes) >= _RESERVE_FROM:
+        most = min(bound, _RESERVE_MAX // max(row_bytes))
+        reserved = [_reserve(a.dtype, a.shape[1:], b, most, need)
+                    for a, b in zip(arrays, row_bytes)]
+        if all(r is not None for r in reserved):
+            for r, a in zip(reserved, arrays):
+                r[:used] = a[:used]
+            return reserved
+    grown = []
+    for a in arrays:
+        bigger = np.empty((rows,) + a.shape[1:], dtype=a.dtype)
+        bigger[:used] = a[:used]
+        grown.append(bigger)
+    return grown
+
+
+def _reserve(dtype, tail: tuple[int, ...], row_bytes: int, rows: int,
+             need: int) -> np.ndarray | None:
+    """An uninitialised array of ``rows`` rows on a lazily committed mapping, or
+    ``None`` where the system refuses one (then the caller copies as usual)."""
+    import mmap
+
+    if rows < need:
+        return None
+    try:
+        region = mmap.mmap(-1, rows * row_bytes, flags=mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS)
+        if hasattr(mmap, "MADV_HUGEPAGE"):
+            region.madvise(mmap.MADV_HUGEPAGE)
+    except (OSError, ValueError, OverflowError, AttributeError):   # no such mapping here
+        return None
+    return np.frombuffer(region, dtype=dtype).reshape((rows,) + tail)
 
 
 def _explore(compiled: CompiledNet, m0: np.ndarray, max_states: int,

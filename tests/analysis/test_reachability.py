@@ -343,6 +343,31 @@ transitions:
         assert space.num_states == len(reference_exploration(net)[0])
 
 
+@pytest.mark.parametrize("reservations", [True, False])
+def test_large_buffers_move_to_reservations_or_copies(monkeypatch, reservations):
+    """Buffers past the reservation threshold (here tiny) keep every state and edge,
+    whether the system grants the reserved mapping or refuses it (copies then)."""
+    monkeypatch.setattr(reachability, "_RESERVE_FROM", 2**10)
+    if not reservations:
+        monkeypatch.setattr(reachability, "_reserve", lambda *args: None)
+    for mode in MODES:
+        space = explore(dining_philosophers(12), mode=mode)
+        assert (space.num_states, space.num_edges) == (lucas(12), reachability_graph(
+            dining_philosophers(12)).num_edges)
+        assert_consistent(dining_philosophers(12), space)
+        assert _on_a_mapping(space.edge_target) == reservations
+
+
+def _on_a_mapping(array) -> bool:
+    import mmap
+
+    while array is not None:
+        if isinstance(array, mmap.mmap):
+            return True
+        array = getattr(array, "base", None) if not isinstance(array, memoryview) else array.obj
+    return False
+
+
 def test_reset_net_that_resets_its_growing_place_is_bounded():
     """t covers the start marking but resets the place it grows: two states, no error."""
     net = loads_net("""
