@@ -168,7 +168,6 @@ def expand_bits(pre, post, keep, kind, key_mask, id_bits, max_states, rows, pare
         if key_mask[w] != 0:
             one_word = False
     mask = np.uint64(table.shape[0] // stride - 1)
-    successor = np.empty(n_w, dtype=np.uint64)
     states, edges, head = counters[0], counters[1], counters[2]
     if states == 0:
         parent[0] = -1

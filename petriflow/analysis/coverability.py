@@ -40,7 +40,8 @@ from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.net import Net
 
-__all__ = ["OMEGA", "CoverabilityGraph", "coverability_graph", "unbounded_places"]
+__all__ = ["OMEGA", "CoverabilityGraph", "coverability_graph", "coverability_graph_if_any",
+           "unbounded_places"]
 
 #: The ω of an ω-marking: more tokens than any bound (compares above every integer).
 OMEGA = float("inf")
@@ -198,6 +199,20 @@ def _accelerate(successor: list, node: int, markings: list[tuple], parent: list[
                         changed = True
             ancestor = parent[ancestor]
     return successor
+
+
+def coverability_graph_if_any(net: Net, marking: Mapping[str, int] | None = None, *,
+                              max_nodes: int = DEFAULT_MAX_STATES,
+                              compiled: CompiledNet | None = None) -> CoverabilityGraph | None:
+    """The Karp–Miller graph, or ``None`` where it does not apply (cancellation regions)
+    or has more than ``max_nodes`` nodes: for reports that fall back to a witness."""
+    compiled = compiled or CompiledNet(net)
+    if getattr(compiled, "has_resets", False):
+        return None
+    try:
+        return coverability_graph(net, marking, max_nodes=max_nodes, compiled=compiled)
+    except StateSpaceLimit:
+        return None
 
 
 def unbounded_places(

@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from petriflow.analysis.coverability import coverability_graph
+from petriflow.analysis.coverability import coverability_graph_if_any
 from petriflow.analysis.invariants import (
     DEFAULT_MAX_ROWS,
     InvariantLimit,
@@ -273,12 +273,8 @@ def _unbounded_result(result, net, compiled, start, exc, max_states, soundness) 
     """Fill the result for an unbounded net; returns the violation for a non-WF net."""
     result.update(bounded=False, safe=False, live=None, deadlock_free=None)
     places = list(exc.places) if exc is not None else []
-    try:
-        if compiled.has_resets:      # Karp-Miller does not apply: keep the witness's places
-            raise StateSpaceLimit(0, 0, 0)
-        graph = coverability_graph(net, start, max_nodes=max_states, compiled=compiled)
-    except StateSpaceLimit:
-        graph = None
+    graph = coverability_graph_if_any(net, start, max_nodes=max_states, compiled=compiled)
+    if graph is None:
         result["algorithm"].append("Karp-Miller coverability graph: too large or not"
                                    " applicable (reset arcs), unbounded places listed are"
                                    " those the witness pumps")

@@ -48,7 +48,7 @@ from typing import Any
 import numpy as np
 
 from petriflow.analysis._graph import can_reach
-from petriflow.analysis.coverability import coverability_graph
+from petriflow.analysis.coverability import coverability_graph_if_any
 from petriflow.analysis.properties import dead_transitions, is_live
 from petriflow.analysis.reachability import (
     DEFAULT_MAX_STATES,
@@ -349,11 +349,7 @@ def _unbounded(net: Net, compiled: CompiledNet, start: Marking, exc: UnboundedNe
     report.algorithm = ("reachability graph from [i] stopped: a marking strictly covers an"
                         " earlier one on its path (unbounded)")
     places = list(exc.places)
-    try:
-        graph = (None if compiled.has_resets    # Karp-Miller does not apply to reset arcs
-                 else coverability_graph(net, start, max_nodes=max_states, compiled=compiled))
-    except StateSpaceLimit:
-        graph = None
+    graph = coverability_graph_if_any(net, start, max_nodes=max_states, compiled=compiled)
     if graph is not None:
         places = graph.unbounded_places
         report.algorithm += "; Karp-Miller coverability graph for the unbounded places"
