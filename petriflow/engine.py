@@ -155,10 +155,23 @@ class CompiledNet:
                 add_reset(reset)
         self.has_resets = any(self.reset)
         self.transition_index = {t: i for i, t in enumerate(self.transitions)}
-        shape = (len(self.transitions), len(self.places))
-        self.pre_matrix = _matrix(shape, self.pre)
-        self.post_matrix = _matrix(shape, self.post)
-        self.incidence = self.post_matrix - self.pre_matrix
+
+    # The matrices are built on first use: the token game and the bitmask exploration
+    # of small nets read only the tuples above.
+    @functools.cached_property
+    def pre_matrix(self) -> np.ndarray:
+        """``|rows| x |P|`` int64 matrix of the weights each row consumes."""
+        return _matrix((len(self.transitions), len(self.places)), self.pre)
+
+    @functools.cached_property
+    def post_matrix(self) -> np.ndarray:
+        """``|rows| x |P|`` int64 matrix of the weights each row produces."""
+        return _matrix((len(self.transitions), len(self.places)), self.post)
+
+    @functools.cached_property
+    def incidence(self) -> np.ndarray:
+        """``post_matrix - pre_matrix`` (resets are not in it)."""
+        return self.post_matrix - self.pre_matrix
 
     @functools.cached_property
     def consumers(self) -> list[tuple[int, ...]]:

@@ -63,6 +63,16 @@ class Marking(Mapping[str, int]):
     def __contains__(self, place: object) -> bool:
         return place in self._tokens
 
+    # Read-only views of the stored dict (the Mapping defaults go through __getitem__).
+    def keys(self):  # type: ignore[override]
+        return self._tokens.keys()
+
+    def items(self):  # type: ignore[override]
+        return self._tokens.items()
+
+    def values(self):  # type: ignore[override]
+        return self._tokens.values()
+
     # Value semantics --------------------------------------------------------------
     def __hash__(self) -> int:
         if self._hash is None:

@@ -59,7 +59,7 @@ Examples:
 from __future__ import annotations
 
 import sys
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -356,8 +356,7 @@ def reachability_graph(
     start = net.initial_marking if marking is None else net.check_marking(marking)
     if max_states < 1:
         raise ValueError(f"max_states must be >= 1, got {max_states}")
-    return _explore(compiled, np.array(compiled.vector(start), dtype=np.int64), max_states,
-                    detect_unbounded)
+    return _explore(compiled, compiled.vector(start), max_states, detect_unbounded)
 
 
 # Exploration ---------------------------------------------------------------------------
@@ -414,12 +413,44 @@ def _layout(compiled: CompiledNet, has_resets: bool, threshold: int) -> tuple[li
     return basis + [p for p in range(n_places) if p not in chosen], len(basis)
 
 
-def _bit_words(bits: np.ndarray, n_words: int) -> np.ndarray:
-    """Rows of booleans (bit ``j`` = column ``j``) as rows of ``n_words`` uint64 words."""
-    padded = np.zeros((bits.shape[0], 64 * n_words), dtype=np.uint8)
-    padded[:, : bits.shape[1]] = bits
-    return np.ascontiguousarray(
-        np.packbits(padded, axis=1, bitorder="little").view("<u8").astype(np.uint64))
+def _bit_program(compiled: CompiledNet, column: list[int], resets: list[tuple[int, ...]],
+                 n_key: int, marked: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """The bitmask loop's inputs: ``(words, kind)``.
+
+    ``words`` has ``3·|rows| + 2`` rows of uint64 words (bit ``j`` of a row = column
+    ``j``; ``column[p]`` is place ``p``'s): per row its preset, its postset and the
+    columns it leaves alone (``keep``: neither consumed from nor reset), then the key
+    columns, then the initial marking (``marked``: the places holding a token). ``kind``
+    is 1 for a row needing two tokens from a place (never enabled in a safe marking), 2
+    for one putting two into a place (it makes the marking unsafe), else 0.
+
+    Built with Python integers, one per row: on small nets this set-up costs more
+    than the exploration itself.
+    """
+    bit = [1 << c for c in column]
+    every = (1 << len(column)) - 1
+    pre, post, keep, kind = [], [], [], []
+    for row_pre, row_post, row_reset in zip(compiled.pre, compiled.post, resets):
+        taken = put = k = 0
+        for p, w in row_pre:
+            taken |= bit[p]
+            if w > 1:
+                k = 1
+        for p, w in row_post:
+            put |= bit[p]
+            if w > 1 and not k:
+                k = 2
+        pre.append(taken)
+        post.append(put)
+        for p in row_reset:
+            taken |= bit[p]
+        keep.append(every ^ taken)
+        kind.append(k)
+    size = 8 * max(1, -(-len(column) // 64))
+    rows = pre + post + keep + [(1 << n_key) - 1, sum([bit[p] for p in marked])]
+    data = b"".join([r.to_bytes(size, "little") for r in rows])
+    words = np.frombuffer(data, dtype="<u8").astype(np.uint64).reshape(len(rows), size // 8)
+    return words, np.array(kind, dtype=np.int8)
 
 
 class _Buffers:
@@ -515,7 +546,7 @@ def _reserve(dtype, tail: tuple[int, ...], row_bytes: int, rows: int,
     return np.frombuffer(region, dtype=dtype).reshape((rows,) + tail)
 
 
-def _explore(compiled: CompiledNet, m0: np.ndarray, max_states: int,
+def _explore(compiled: CompiledNet, m0: Sequence[int], max_states: int,
              detect_unbounded: bool, *, bits: bool = True,
              basis_from: int | None = None) -> StateSpace:
     """The exploration behind :func:`reachability_graph`.
@@ -527,7 +558,7 @@ def _explore(compiled: CompiledNet, m0: np.ndarray, max_states: int,
 
     resets = _resets_of(compiled)
     has_resets = any(resets)
-    if bits and int(m0.max(initial=0)) <= 1:
+    if bits and max(m0, default=0) <= 1:
         space = _explore_bits(_kernel, compiled, m0, max_states, resets, has_resets,
                               basis_from)
         if space is not None:
@@ -536,7 +567,7 @@ def _explore(compiled: CompiledNet, m0: np.ndarray, max_states: int,
                            detect_unbounded, basis_from)
 
 
-def _explore_bits(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int,
+def _explore_bits(kernel, compiled: CompiledNet, m0: Sequence[int], max_states: int,
                   resets: list[tuple[int, ...]], has_resets: bool,
                   basis_from: int | None) -> StateSpace | None:
     """Explore with bitmask rows; ``None`` when some reachable marking is not safe."""
@@ -544,26 +575,16 @@ def _explore_bits(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int
     # one word, often beside the state id in one table slot.
     id_bits = max(1, int(max_states).bit_length())
     layout, n_key = _layout(compiled, has_resets, 64 if basis_from is None else basis_from)
-    n_words = max(1, -(-len(layout) // 64))
-    pre, post = compiled.pre_matrix, compiled.post_matrix
-    if n_key < len(layout):                       # basis places first
-        pre, post = pre[:, layout], post[:, layout]
-    gone = pre > 0
-    if has_resets:                                # resets keep every place in order
-        for t, places in enumerate(resets):
-            gone[t, list(places)] = True
-    # A transition needing two tokens from a place is never enabled in a safe marking;
-    # one putting two tokens in a place makes the marking unsafe as soon as it fires.
-    kind = np.where((pre > 1).any(axis=1), 1, np.where((post > 1).any(axis=1), 2, 0))
-    key_mask = np.zeros(len(layout), dtype=bool)
-    key_mask[:n_key] = True
-    words = _bit_words(np.vstack([pre > 0, post > 0, ~gone, key_mask, m0[layout] > 0]),
-                       n_words)
+    column = [0] * len(layout)
+    for col, place in enumerate(layout):
+        column[place] = col
+    words, kind = _bit_program(compiled, column, resets, n_key,
+                               [p for p, count in enumerate(m0) if count])
     n_t = len(kind)
     id_bits = id_bits if n_key + id_bits <= 64 else 0
     buffers = _Buffers(kernel, words[-1], max_states, n_t, 1 if id_bits else 2, id_bits)
-    fixed = (words[:n_t], words[n_t: 2 * n_t], words[2 * n_t: 3 * n_t], kind.astype(np.int8),
-             words[-2], id_bits, max_states)
+    fixed = (words[:n_t], words[n_t: 2 * n_t], words[2 * n_t: 3 * n_t], kind, words[-2],
+             id_bits, max_states)
     while True:
         rows, parent, parent_t = buffers.state
         status = kernel.expand_bits(*fixed, rows, parent, parent_t, buffers.table,
@@ -575,10 +596,10 @@ def _explore_bits(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int
         return None
     if status == kernel.LIMIT:
         raise StateSpaceLimit(max_states, int(buffers.counters[0]), int(buffers.counters[2]))
-    return _space(compiled, "bitmask", buffers, np.argsort(layout))
+    return _space(compiled, "bitmask", buffers, column)
 
 
-def _explore_counts(kernel, compiled: CompiledNet, m0: np.ndarray, max_states: int,
+def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states: int,
                     resets: list[tuple[int, ...]], has_resets: bool,
                     detect_unbounded: bool, basis_from: int | None) -> StateSpace:
     """Explore with count rows, widening their dtype whenever a count outgrows it."""
