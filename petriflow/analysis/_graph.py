@@ -1,59 +1,155 @@
 """Graph algorithms on edge arrays (private helpers for the analyses).
 
-Strongly connected components and multi-source reachability on graphs given as
-``(source, target)`` integer arrays. On large graphs scipy's compiled ``csgraph``
-routines are used when scipy is installed (it is not a dependency of petriflow);
-otherwise, and on small graphs, iterative pure-Python versions do the same work.
+Strongly connected components, multi-source reachability and per-component summaries
+on graphs given as ``(source, target)`` integer arrays. On large graphs (from
+:data:`COMPILED_FROM_EDGES` edges) the loops run compiled by numba, over a CSR view of
+the graph: when the edges are already grouped by source, as a
+:class:`~petriflow.analysis.reachability.StateSpace` keeps them, the neighbour array is
+``target`` itself and nothing of edge size is copied; otherwise a stable counting sort
+groups them. Small graphs, and every graph where numba is missing or disabled
+(``NUMBA_DISABLE_JIT=1``), take iterative pure-Python versions with the same results.
+
+numba is imported on the first large graph only (importing it costs a third of a
+second), and the loops are compiled then, or loaded from numba's disk cache.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["can_reach", "reachable_from", "strong_components"]
+__all__ = ["can_reach", "csr", "occurring", "reachable_from", "strong_components",
+           "terminal_summary"]
 
 
-#: Below this many edges the pure-Python versions are used: importing scipy costs more.
-SCIPY_FROM_EDGES = 200_000
+#: Below this many edges the pure-Python versions are used: loading the compiled
+#: loops (numba's import and disk cache) costs more than they save.
+COMPILED_FROM_EDGES = 30_000
+
+_LOOPS: dict | None = None
 
 
-def _scipy_csgraph(edges: int = SCIPY_FROM_EDGES):
-    if edges < SCIPY_FROM_EDGES:
+def _compiled(edges: int):
+    """The compiled loops (a dict by name), or ``None`` for a small graph or without numba."""
+    global _LOOPS
+    if edges < COMPILED_FROM_EDGES:
         return None
+    if _LOOPS is None:
+        _LOOPS = _compile()
+    return _LOOPS or None
+
+
+def _compile() -> dict:
+    """Wrap the ``_*_loop`` functions with ``numba.njit`` (an empty dict without numba)."""
     try:
-        from scipy import sparse
-        from scipy.sparse import csgraph
-    except ImportError:  # pragma: no cover - exercised with scipy hidden in tests
-        return None
-    return sparse, csgraph
+        import numba
+    except ImportError:  # pragma: no cover - exercised only where numba is missing
+        return {}
+    if numba.config.DISABLE_JIT:
+        return {}
+    # numba's on-disk cache is keyed by source file but re-imports the module by name
+    # when it loads; only the installed name caches (see petriflow/analysis/_kernel.py).
+    jit = numba.njit(cache=__name__ == "petriflow.analysis._graph", nogil=True)
+    return {name: jit(function) for name, function in _LOOP_FUNCTIONS.items()}
 
 
-def _csr(n: int, source: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(offsets, neighbours) of the graph, neighbours grouped by source."""
-    order = np.argsort(source, kind="stable")
+def _ids(values) -> np.ndarray:
+    """``values`` as an int16, int32 or int64 array, copied only when it is none of them
+    (each dtype is one more compiled version of a loop)."""
+    values = np.asarray(values)
+    if values.dtype in (np.int16, np.int32, np.int64):
+        return values
+    return values.astype(np.int64)
+
+
+def _node_dtype(n: int):
+    """The dtype of per-node scratch arrays that hold node ids and DFS indices (up to n)."""
+    return np.int32 if n < 2**31 - 1 else np.int64
+
+
+# CSR ---------------------------------------------------------------------------------
+
+def csr(n: int, source, target, *, compiled: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """``(offsets, neighbours)``: the targets of node ``u``'s edges are
+    ``neighbours[offsets[u]:offsets[u + 1]]``, in edge order.
+
+    When the edges are already grouped by source, ``neighbours`` is ``target`` itself.
+
+    Examples:
+        >>> offsets, neighbours = csr(3, np.array([2, 0, 2]), np.array([0, 1, 1]))
+        >>> offsets.tolist(), neighbours.tolist()
+        ([0, 1, 1, 3], [1, 0, 1])
+    """
+    source, target = _ids(source), _ids(target)
+    loops = _compiled(len(source)) if compiled else None
+    if loops is None:
+        order = np.argsort(source, kind="stable")
+        offsets = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(np.bincount(source, minlength=n), out=offsets[1:])
+        return offsets, target[order]
     offsets = np.zeros(n + 1, dtype=np.int64)
-    np.cumsum(np.bincount(source, minlength=n), out=offsets[1:])
-    return offsets, np.asarray(target)[order]
+    grouped = loops["offsets"](source, target, offsets)
+    if grouped < 0:
+        raise ValueError(f"edges must join nodes 0 .. {n - 1}")
+    if grouped:
+        return offsets, target
+    neighbours = np.empty_like(target)
+    loops["scatter"](source, target, offsets, neighbours)
+    return offsets, neighbours
 
 
-def strong_components(n: int, source: np.ndarray, target: np.ndarray,
-                      *, use_scipy: bool = True) -> np.ndarray:
+def _offsets_loop(keys, values, offsets):
+    """Fill ``offsets`` (zeros, length n + 1) with the cumulative counts of ``keys``;
+    return 1 when ``keys`` never decreases (the edges are grouped by key), else 0, and
+    -1 when a key or a value is not a node."""
+    n = offsets.shape[0] - 1
+    grouped = 1
+    previous = -1
+    for e in range(keys.shape[0]):
+        key = keys[e]
+        if key < 0 or key >= n or values[e] < 0 or values[e] >= n:
+            return -1
+        offsets[key + 1] += 1
+        if key < previous:
+            grouped = 0
+        previous = key
+    for u in range(1, offsets.shape[0]):
+        offsets[u] += offsets[u - 1]
+    return grouped
+
+
+def _scatter_loop(keys, values, offsets, out):
+    """Stable counting sort: ``out`` gets ``values`` grouped by ``keys`` (offsets as
+    :func:`_offsets_loop` made them)."""
+    position = offsets[:-1].copy()
+    for e in range(keys.shape[0]):
+        key = keys[e]
+        out[position[key]] = values[e]
+        position[key] += 1
+
+
+# Strongly connected components ---------------------------------------------------------
+
+def strong_components(n: int, source, target, *, compiled: bool = True) -> np.ndarray:
     """Component label of each of the ``n`` nodes (labels are 0 .. k-1).
+
+    Labels are numbered as Tarjan's algorithm completes the components, roots tried in
+    node order and edges in edge order: every edge between two components goes from a
+    higher label to a lower one. Both versions number them the same way.
 
     Examples:
         >>> labels = strong_components(4, np.array([0, 1, 2]), np.array([1, 0, 3]))
         >>> bool(labels[0] == labels[1]), bool(labels[1] == labels[2]), bool(labels[2] == labels[3])
         (True, False, False)
     """
-    source, target = np.asarray(source, dtype=np.int64), np.asarray(target, dtype=np.int64)
-    found = _scipy_csgraph(len(source)) if use_scipy else None
-    if found is not None and n:
-        sparse, csgraph = found
-        graph = sparse.csr_matrix((np.ones(len(source), dtype=np.int8), (source, target)),
-                                  shape=(n, n))
-        _, labels = csgraph.connected_components(graph, directed=True, connection="strong")
-        return labels.astype(np.int64)
-    return _tarjan(n, *_csr(n, source, target))
+    offsets, neighbours = csr(n, source, target, compiled=compiled)
+    loops = _compiled(len(neighbours)) if compiled else None
+    if loops is None:
+        return _tarjan(n, offsets, neighbours)
+    dtype = _node_dtype(n)
+    rindex, stack, path = (np.empty(n, dtype=dtype) for _ in range(3))
+    loops["pearce"](offsets, neighbours, rindex, stack, path, np.empty(n, dtype=np.int64),
+                    np.empty(n, dtype=bool))
+    return np.subtract(n - 1, rindex, dtype=np.int64)
 
 
 def _tarjan(n: int, offsets: np.ndarray, neighbours: np.ndarray) -> np.ndarray:
@@ -103,8 +199,83 @@ def _tarjan(n: int, offsets: np.ndarray, neighbours: np.ndarray) -> np.ndarray:
     return np.array(labels, dtype=np.int64)
 
 
-def reachable_from(n: int, source: np.ndarray, target: np.ndarray, starts,
-                   *, use_scipy: bool = True) -> np.ndarray:
+def _pearce_loop(offsets, neighbours, rindex, stack, path, path_edge, path_root):
+    """Pearce's iterative variant of Tarjan's algorithm; return the number of components.
+
+    One array, ``rindex``, replaces Tarjan's index, low-link and on-stack flags: a node's
+    DFS index (from 1) while its component is open, then its component number, counted
+    down from n - 1 so that it compares above every open index. Components complete in
+    Tarjan's order, so component ``n - 1 - rindex`` is :func:`_tarjan`'s label.
+    ``stack`` (open nodes that are not roots), the DFS ``path``, the next edge of each
+    node on it (``path_edge``) and whether it is still a root (``path_root``) are
+    scratch space of n entries. Pearce, "A space-efficient algorithm for finding strongly
+    connected components", Information Processing Letters 116 (2016), algorithm 3.
+    """
+    n = rindex.shape[0]
+    for u in range(n):
+        rindex[u] = 0
+    index = 1
+    component = n - 1
+    top = 0
+    for start in range(n):
+        if rindex[start] != 0:
+            continue
+        rindex[start] = index
+        index += 1
+        path[0] = start
+        path_edge[0] = offsets[start]
+        path_root[0] = True
+        depth = 1
+        while depth > 0:
+            node = path[depth - 1]
+            edge = path_edge[depth - 1]
+            end = offsets[node + 1]
+            low = rindex[node]
+            root = path_root[depth - 1]
+            descended = False
+            while edge < end:
+                nxt = neighbours[edge]
+                edge += 1
+                seen = rindex[nxt]
+                if seen == 0:
+                    rindex[node] = low
+                    path_edge[depth - 1] = edge
+                    path_root[depth - 1] = root
+                    rindex[nxt] = index
+                    index += 1
+                    path[depth] = nxt
+                    path_edge[depth] = offsets[nxt]
+                    path_root[depth] = True
+                    depth += 1
+                    descended = True
+                    break
+                if seen < low:
+                    low = seen
+                    root = False
+            if descended:
+                continue
+            depth -= 1
+            if root:
+                index -= 1
+                while top > 0 and low <= rindex[stack[top - 1]]:
+                    top -= 1
+                    rindex[stack[top]] = component
+                    index -= 1
+                rindex[node] = component
+                component -= 1
+            else:
+                rindex[node] = low
+                stack[top] = node
+                top += 1
+            if depth > 0 and rindex[node] < rindex[path[depth - 1]]:
+                rindex[path[depth - 1]] = rindex[node]
+                path_root[depth - 1] = False
+    return n - 1 - component
+
+
+# Reachability --------------------------------------------------------------------------
+
+def reachable_from(n: int, source, target, starts, *, compiled: bool = True) -> np.ndarray:
     """Boolean mask of the nodes reachable from any node in ``starts`` (included).
 
     Examples:
@@ -115,19 +286,13 @@ def reachable_from(n: int, source: np.ndarray, target: np.ndarray, starts,
     starts = np.unique(np.asarray(starts, dtype=np.int64))
     if not starts.size:
         return seen
-    source, target = np.asarray(source, dtype=np.int64), np.asarray(target, dtype=np.int64)
-    found = _scipy_csgraph(len(source)) if use_scipy else None
-    if found is not None:
-        sparse, csgraph = found
-        # One extra node pointing at every start turns many sources into one.
-        extra = np.full(starts.size, n, dtype=np.int64)
-        rows, cols = np.concatenate((source, extra)), np.concatenate((target, starts))
-        graph = sparse.csr_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)),
-                                  shape=(n + 1, n + 1))
-        order = csgraph.breadth_first_order(graph, n, directed=True, return_predecessors=False)
-        seen[order[order < n]] = True
+    if starts[0] < 0 or starts[-1] >= n:
+        raise ValueError(f"start nodes must be 0 .. {n - 1}")
+    offsets, neighbours = csr(n, source, target, compiled=compiled)
+    loops = _compiled(len(neighbours)) if compiled else None
+    if loops is not None:
+        loops["bfs"](offsets, neighbours, starts, seen, np.empty(n, dtype=_node_dtype(n)))
         return seen
-    offsets, neighbours = _csr(n, source, target)
     offsets_list, neighbours_list = offsets.tolist(), neighbours.tolist()
     seen_list = [False] * n
     queue = [int(s) for s in starts]
@@ -142,12 +307,186 @@ def reachable_from(n: int, source: np.ndarray, target: np.ndarray, starts,
     return np.array(seen_list, dtype=bool)
 
 
-def can_reach(n: int, source: np.ndarray, target: np.ndarray, goals,
-              *, use_scipy: bool = True) -> np.ndarray:
+def _bfs_loop(offsets, neighbours, starts, seen, queue):
+    """Breadth-first search from ``starts`` (distinct): mark in ``seen`` what it reaches;
+    ``queue`` is scratch space of n entries."""
+    tail = 0
+    for s in starts:
+        seen[s] = True
+        queue[tail] = s
+        tail += 1
+    head = 0
+    while head < tail:
+        node = queue[head]
+        head += 1
+        for edge in range(offsets[node], offsets[node + 1]):
+            nxt = neighbours[edge]
+            if not seen[nxt]:
+                seen[nxt] = True
+                queue[tail] = nxt
+                tail += 1
+
+
+def can_reach(n: int, source, target, goals, *, compiled: bool = True) -> np.ndarray:
     """Boolean mask of the nodes from which some node in ``goals`` is reachable.
 
     Examples:
         >>> can_reach(4, np.array([0, 1]), np.array([1, 2]), [2]).tolist()
         [True, True, True, False]
     """
-    return reachable_from(n, target, source, goals, use_scipy=use_scipy)
+    return reachable_from(n, target, source, goals, compiled=compiled)
+
+
+# Per-component summaries ---------------------------------------------------------------
+
+def terminal_summary(source, target, labels: np.ndarray, edge_label, n_labels: int,
+                     *, compiled: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(terminal, first, present)`` for the components no edge leaves.
+
+    ``terminal``: their labels, increasing; ``first``: the smallest node of each;
+    ``present``: a ``len(terminal) x n_labels`` boolean array, ``present[i, x]`` when an
+    edge inside ``terminal[i]`` carries ``edge_label`` ``x``. ``labels`` numbers the
+    components 0 .. k-1, as :func:`strong_components` does.
+
+    Examples:
+        >>> labels = strong_components(3, np.array([0, 1, 2]), np.array([1, 2, 1]))
+        >>> terminal, first, present = terminal_summary(
+        ...     np.array([0, 1, 2]), np.array([1, 2, 1]), labels, np.array([0, 1, 2]), 3)
+        >>> first.tolist(), present.tolist()
+        ([1], [[False, True, True]])
+    """
+    source, target, edge_label = _ids(source), _ids(target), _ids(edge_label)
+    labels = np.asarray(labels, dtype=np.int64)
+    components = int(labels.max(initial=-1)) + 1
+    loops = _compiled(len(source)) if compiled else None
+    if loops is None:
+        return _terminal_summary(source, target, labels, edge_label, n_labels, components)
+    if labels.size and labels.min() < 0:
+        raise ValueError("component labels must be 0 .. k-1")
+    row = np.zeros(components, dtype=np.int64)
+    terminal = np.zeros(components, dtype=np.int64)
+    if components == 1:          # a strongly connected graph: no edge can leave it
+        rows = 1
+    else:
+        rows = loops["exits"](source, target, labels, row, terminal)
+    first = np.empty(max(rows, 0), dtype=np.int64)
+    present = np.zeros((max(rows, 0), n_labels), dtype=bool)
+    if rows < 0 or not loops["presence"](source, labels, edge_label, row, first, present):
+        raise ValueError(f"edges must join nodes 0 .. {len(labels) - 1} and carry labels"
+                         f" 0 .. {n_labels - 1}")
+    return terminal[:rows].copy(), first, present
+
+
+def _terminal_summary(source, target, labels, edge_label, n_labels, components):
+    """:func:`terminal_summary` with numpy (small graphs, no numba)."""
+    from_label = labels[source]
+    leaving = from_label != labels[target]
+    exits = np.zeros(components, dtype=bool)
+    exits[from_label[leaving]] = True
+    terminal = np.flatnonzero(~exits)
+    row = np.full(components, -1, dtype=np.int64)
+    row[terminal] = np.arange(terminal.size)
+    first = np.full(components, len(labels), dtype=np.int64)
+    np.minimum.at(first, labels, np.arange(len(labels)))
+    present = np.zeros((terminal.size, n_labels), dtype=bool)
+    inside = row[from_label]
+    keep = inside >= 0
+    present[inside[keep], edge_label[keep]] = True
+    return terminal, first[terminal], present
+
+
+def _exits_loop(source, target, labels, row, terminal):
+    """Number the components no edge leaves: ``row[c]`` is c's rank among them (-1 for
+    the others) and ``terminal`` starts with their labels; return how many there are
+    (-1 when an edge end is not a node)."""
+    n = labels.shape[0]
+    leaves = np.zeros(row.shape[0], dtype=np.bool_)
+    u, c = -1, -1
+    for e in range(source.shape[0]):
+        if source[e] != u:           # edges grouped by source read each label once
+            u = source[e]
+            if u < 0 or u >= n:
+                return -1
+            c = labels[u]
+        v = target[e]
+        if v < 0 or v >= n:
+            return -1
+        if c != labels[v]:
+            leaves[c] = True
+    rows = 0
+    for c in range(row.shape[0]):
+        row[c] = -1
+        if not leaves[c]:
+            row[c] = rows
+            terminal[rows] = c
+            rows += 1
+    return rows
+
+
+def _presence_loop(source, labels, edge_label, row, first, present):
+    """Fill ``first`` (smallest node) and ``present`` (edge labels inside) per terminal
+    component, ``row`` giving each component's row (-1: not terminal); return False
+    when an edge source or label is out of range."""
+    n = labels.shape[0]
+    first[:] = -1
+    for u in range(n):
+        r = row[labels[u]]
+        if r >= 0 and first[r] == -1:
+            first[r] = u
+    size = present.shape[1]
+    u, r = -1, -1
+    for e in range(source.shape[0]):
+        if source[e] != u:           # edges grouped by source read each row once
+            u = source[e]
+            if u < 0 or u >= n:
+                return False
+            r = row[labels[u]]
+        if r >= 0:
+            x = edge_label[e]
+            if x < 0 or x >= size:
+                return False
+            present[r, x] = True
+    return True
+
+
+# Occurrences ---------------------------------------------------------------------------
+
+def occurring(values, size: int, *, compiled: bool = True) -> np.ndarray:
+    """Boolean mask of length ``size``: which of 0 .. size-1 occur in ``values``.
+
+    Examples:
+        >>> occurring(np.array([3, 0, 3], dtype=np.int16), 5).tolist()
+        [True, False, False, True, False]
+    """
+    values = _ids(values)
+    loops = _compiled(len(values)) if compiled else None
+    seen = np.zeros(size, dtype=bool)
+    if loops is None:
+        if values.size and not 0 <= values.min() <= values.max() < size:
+            raise ValueError(f"values must be 0 .. {size - 1}")
+        seen[values] = True
+    elif not loops["occurring"](values, seen):
+        raise ValueError(f"values must be 0 .. {size - 1}")
+    return seen
+
+
+def _occurring_loop(values, seen):
+    """Mark in ``seen`` the values that occur; False when one is out of range."""
+    size = seen.shape[0]
+    for e in range(values.shape[0]):
+        x = values[e]
+        if x < 0 or x >= size:
+            return False
+        seen[x] = True
+    return True
+
+
+_LOOP_FUNCTIONS = {
+    "offsets": _offsets_loop,
+    "scatter": _scatter_loop,
+    "pearce": _pearce_loop,
+    "bfs": _bfs_loop,
+    "exits": _exits_loop,
+    "presence": _presence_loop,
+    "occurring": _occurring_loop,
+}

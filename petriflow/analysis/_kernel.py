@@ -44,6 +44,8 @@ try:
     # when it loads; only the installed name caches (see agents/planning/astar.py).
     _cache = __name__ == "petriflow.analysis._kernel"
     _jit = numba.njit(cache=_cache, nogil=True)
+    # Bodies compiled into each caller (specialised there on its constant arguments).
+    _inline = numba.njit(cache=_cache, nogil=True, inline="always")
     COMPILED = not numba.config.DISABLE_JIT
 
     @intrinsic
@@ -72,6 +74,8 @@ try:
 except ImportError:  # pragma: no cover - exercised only where numba is missing
     def _jit(function):
         return function
+
+    _inline = _jit
 
     def prefetch(address):
         """No-op without numba."""
@@ -135,7 +139,6 @@ def _hash_bits(row, key_mask):
     return h
 
 
-@_jit
 def expand_bits(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
                 parent_t, table, e_source, e_transition, e_target, counters):
     """Breadth-first search over safe markings held as rows of ``uint64`` words.
@@ -159,8 +162,43 @@ def expand_bits(pre, post, keep, kind, key_mask, id_bits, max_states, rows, pare
 
     Returns:
         A status: :data:`OK`, :data:`FULL`, :data:`LIMIT` or :data:`NOT_SAFE`.
+
+    Rows of one and of two words run loops compiled for that width (their word loops
+    unrolled); wider rows share one loop.
     """
-    n_t, n_w = pre.shape
+    n_w = pre.shape[1]
+    loop = _expand_bits_1 if n_w == 1 else _expand_bits_2 if n_w == 2 else _expand_bits_n
+    return loop(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
+                parent_t, table, e_source, e_transition, e_target, counters)
+
+
+@_jit
+def _expand_bits_1(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
+                   parent_t, table, e_source, e_transition, e_target, counters):
+    return _expand_bits(1, pre, post, keep, kind, key_mask, id_bits, max_states, rows,
+                        parent, parent_t, table, e_source, e_transition, e_target, counters)
+
+
+@_jit
+def _expand_bits_2(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
+                   parent_t, table, e_source, e_transition, e_target, counters):
+    return _expand_bits(2, pre, post, keep, kind, key_mask, id_bits, max_states, rows,
+                        parent, parent_t, table, e_source, e_transition, e_target, counters)
+
+
+@_jit
+def _expand_bits_n(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
+                   parent_t, table, e_source, e_transition, e_target, counters):
+    return _expand_bits(pre.shape[1], pre, post, keep, kind, key_mask, id_bits, max_states,
+                        rows, parent, parent_t, table, e_source, e_transition, e_target,
+                        counters)
+
+
+@_inline
+def _expand_bits(n_w, pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
+                 parent_t, table, e_source, e_transition, e_target, counters):
+    """:func:`expand_bits` for rows of ``n_w`` words."""
+    n_t = pre.shape[0]
     stride = 1 if id_bits > 0 else 2
     shift = np.uint64(id_bits)
     one_word = True
@@ -183,6 +221,14 @@ def expand_bits(pre, post, keep, kind, key_mask, id_bits, max_states, rows, pare
     status = OK
     base = table.ctypes.data
     fired = np.empty(n_t, dtype=np.int64)
+    # The enabledness test runs over transitions for one word at a time (a loop the
+    # compiler vectorises): presets transposed, and a never-enabled row always missing.
+    pre_t = np.ascontiguousarray(pre.T)
+    missing = np.empty(n_t, dtype=np.uint64)
+    never = np.zeros(n_t, dtype=np.uint64)
+    for t in range(n_t):
+        if kind[t] == 1:
+            never[t] = ~np.uint64(0)
     where = np.empty(n_t, dtype=np.uint64)
     found = np.empty((n_t, n_w), dtype=np.uint64)
     hashes = np.empty(n_t, dtype=np.uint64)
@@ -195,13 +241,16 @@ def expand_bits(pre, post, keep, kind, key_mask, id_bits, max_states, rows, pare
         for w in range(n_w):
             current[w] = rows[head, w]
         # Branch-free enabledness test; the enabled transitions are collected in order.
+        for t in range(n_t):
+            missing[t] = never[t] | ((current[0] & pre_t[0, t]) ^ pre_t[0, t])
+        for w in range(1, n_w):
+            word = current[w]
+            for t in range(n_t):
+                missing[t] |= (word & pre_t[w, t]) ^ pre_t[w, t]
         count = 0
         for t in range(n_t):
-            missing = np.uint64(0)
-            for w in range(n_w):
-                missing |= (current[w] & pre[t, w]) ^ pre[t, w]
             fired[count] = t
-            count += (missing == 0) & (kind[t] != 1)
+            count += missing[t] == 0
         for c in range(count):
             t = fired[c]
             if kind[t] == 2:

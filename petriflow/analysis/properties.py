@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from petriflow.analysis._graph import strong_components
+from petriflow.analysis._graph import occurring, strong_components, terminal_summary
 from petriflow.analysis.reachability import StateSpace
 
 __all__ = [
@@ -84,7 +84,7 @@ def deadlock_witness(space: StateSpace) -> list[str] | None:
         >>> deadlock_witness(reachability_graph(net))
         ['go', 'stop']
     """
-    found = space.deadlocks()
+    found = deadlocks(space)
     return space.path(int(found[0])) if found.size else None
 
 
@@ -99,8 +99,7 @@ def dead_transitions(space: StateSpace) -> list[str]:
     (The outcome variants ``t@failed`` of a transition share its preset, so they are
     enabled exactly when it is; the answer names net transitions.)
     """
-    fired = np.zeros(len(space.transitions), dtype=bool)
-    fired[np.unique(space.edge_transition)] = True
+    fired = occurring(space.edge_transition, len(space.transitions))
     return _net_transitions(space, np.flatnonzero(~fired))
 
 
@@ -112,24 +111,14 @@ def strongly_connected_components(space: StateSpace) -> np.ndarray:
 def terminal_components(space: StateSpace, labels: np.ndarray | None = None) -> list[int]:
     """Labels of the components no edge leaves (every run ends up in one of them)."""
     labels = strongly_connected_components(space) if labels is None else labels
-    leaving = labels[space.edge_source] != labels[space.edge_target]
-    exits = np.zeros(int(labels.max(initial=-1)) + 1, dtype=bool)
-    exits[labels[space.edge_source[leaving]]] = True
-    return [int(c) for c in np.flatnonzero(~exits)]
+    return _terminal(space, labels)[0].tolist()
 
 
-def _missing_by_component(space: StateSpace, labels: np.ndarray) -> dict[int, np.ndarray]:
-    """For each terminal component, the transition indices none of its edges fire."""
-    terminal = terminal_components(space, labels)
-    n_transitions = len(space.transitions)
-    if not terminal:
-        return {}
-    is_terminal = np.zeros(int(labels.max()) + 1, dtype=bool)
-    is_terminal[terminal] = True
-    inside = is_terminal[labels[space.edge_source]]
-    present = np.zeros((len(is_terminal), n_transitions), dtype=bool)
-    present[labels[space.edge_source[inside]], space.edge_transition[inside]] = True
-    return {c: np.flatnonzero(~present[c]) for c in terminal}
+def _terminal(space: StateSpace, labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(terminal, first, present)``: the terminal components' labels, their smallest
+    states, and which transitions fire inside each (one row per component)."""
+    return terminal_summary(space.edge_source, space.edge_target, labels,
+                            space.edge_transition, len(space.transitions))
 
 
 def non_live_transitions(space: StateSpace, labels: np.ndarray | None = None) -> list[str]:
@@ -142,9 +131,7 @@ def non_live_transitions(space: StateSpace, labels: np.ndarray | None = None) ->
         []
     """
     labels = strongly_connected_components(space) if labels is None else labels
-    missing = np.zeros(len(space.transitions), dtype=bool)
-    for absent in _missing_by_component(space, labels).values():
-        missing[absent] = True
+    missing = ~_terminal(space, labels)[2].all(axis=0)
     return _net_transitions(space, np.flatnonzero(missing))
 
 
@@ -153,16 +140,12 @@ def non_live_witness(space: StateSpace, labels: np.ndarray | None = None
     """``(sequence, transitions)``: a shortest firing sequence into a terminal component
     where ``transitions`` can never fire again, or ``None`` when the net is live."""
     labels = strongly_connected_components(space) if labels is None else labels
-    best = None
-    for component, absent in _missing_by_component(space, labels).items():
-        if absent.size:
-            state = int(np.flatnonzero(labels == component)[0])
-            if best is None or state < best[0]:
-                best = (state, absent)
-    if best is None:
+    _, first, present = _terminal(space, labels)
+    lacking = np.flatnonzero(~present.all(axis=1))
+    if not lacking.size:
         return None
-    state, absent = best
-    return space.path(state), _net_transitions(space, absent)
+    row = lacking[np.argmin(first[lacking])]
+    return space.path(int(first[row])), _net_transitions(space, np.flatnonzero(~present[row]))
 
 
 def is_live(space: StateSpace, labels: np.ndarray | None = None) -> bool:

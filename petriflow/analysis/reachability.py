@@ -64,6 +64,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from petriflow.analysis._graph import occurring
 from petriflow.analysis._linear import pivot_columns
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
@@ -270,7 +271,7 @@ class StateSpace:
 
         The first one is a deadlock nearest to the initial marking (BFS numbering).
         """
-        return np.flatnonzero(self.out_degree() == 0)
+        return np.flatnonzero(~occurring(self.edge_source, self.num_states))
 
     def path(self, state: int) -> list[str]:
         """A shortest firing sequence (transition ids) from the initial marking to ``state``."""
@@ -380,6 +381,11 @@ def warm_up() -> None:
     from petriflow.classic import independent_cycles, producer_consumer
 
     reachability_graph(independent_cycles(10))     # bitmask rows, a growing table
+    for unused in (70, 140):                       # bitmask rows of two and three words
+        net = independent_cycles(1)
+        for k in range(unused):
+            net.add_place(f"unused_{k}")
+        reachability_graph(net)
     reachability_graph(producer_consumer(2))       # count rows, unboundedness checks
     for tokens in (300, 70_000, 2**40):            # count rows of every wider dtype
         net = independent_cycles(1)

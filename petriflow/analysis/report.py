@@ -52,6 +52,7 @@ from petriflow.analysis.invariants import (
 )
 from petriflow.analysis.properties import (
     dead_transitions,
+    deadlocks,
     is_reversible,
     non_live_witness,
     strongly_connected_components,
@@ -222,7 +223,7 @@ def _bounded_result(result: dict[str, Any], space, violations: list[Violation],
     bounds = space.place_bounds()
     labels = strongly_connected_components(space)
     dead = dead_transitions(space)
-    dead_states = space.deadlocks()
+    dead_states = deadlocks(space)
     # deadlock_free keeps the Model Checking Contest's strict meaning (no dead marking at
     # all); a dead marking that is the net's declared final marking is where the net is
     # meant to end, so only the other dead markings ("stuck") make a non-WF net fail

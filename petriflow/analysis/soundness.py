@@ -49,7 +49,7 @@ import numpy as np
 
 from petriflow.analysis._graph import can_reach
 from petriflow.analysis.coverability import coverability_graph_if_any
-from petriflow.analysis.properties import dead_transitions, is_live
+from petriflow.analysis.properties import dead_transitions, deadlocks, is_live
 from petriflow.analysis.reachability import (
     DEFAULT_MAX_STATES,
     StateSpace,
@@ -307,14 +307,14 @@ def check_soundness(
         space.num_states, space.edge_source, space.edge_target, [final_state])
     report.option_to_complete = not stuck.any()
     if stuck.any():
-        deadlocked = space.deadlocks()
+        deadlocked = deadlocks(space)
         # Point at a deadlock when there is one among the stuck markings: it says more
         # than the first stuck marking (which is [i] when Mf is unreachable altogether).
         stuck_deadlocks = deadlocked[stuck[deadlocked]]
         state = int(stuck_deadlocks[0] if final_state is None and stuck_deadlocks.size
                     else np.flatnonzero(stuck)[0])
         reached = space.marking(state)
-        dead_end = bool(space.out_degree()[state] == 0)
+        dead_end = bool((deadlocked == state).any())
         if final_state is None:
             why = f"the final marking {_format(final)} is not reachable from [{source}] at all"
             if dead_end:

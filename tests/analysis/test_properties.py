@@ -106,21 +106,21 @@ def test_deadlocked_net_is_not_live():
 
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(bounded_nets())
-def test_components_agree_with_networkx_with_and_without_scipy(net):
-    """Strongly connected components equal networkx's, by scipy and by pure Python."""
+def test_components_agree_with_networkx_compiled_and_pure(net):
+    """Strongly connected components equal networkx's, by the compiled loops and by pure Python."""
     space = reachability_graph(net)
     graph = to_networkx(space)
     expected = {frozenset(c) for c in nx.strongly_connected_components(graph)}
-    for use_scipy in (True, False):
-        old = _graph.SCIPY_FROM_EDGES
-        _graph.SCIPY_FROM_EDGES = 0 if use_scipy else old
+    for compiled in (True, False):
+        old = _graph.COMPILED_FROM_EDGES
+        _graph.COMPILED_FROM_EDGES = 0 if compiled else old
         try:
             labels = _graph.strong_components(space.num_states, space.edge_source,
-                                              space.edge_target, use_scipy=use_scipy)
+                                              space.edge_target, compiled=compiled)
             reach = _graph.can_reach(space.num_states, space.edge_source, space.edge_target,
-                                     [space.num_states - 1], use_scipy=use_scipy)
+                                     [space.num_states - 1], compiled=compiled)
         finally:
-            _graph.SCIPY_FROM_EDGES = old
+            _graph.COMPILED_FROM_EDGES = old
         found = {frozenset(np.flatnonzero(labels == c).tolist()) for c in np.unique(labels)}
         assert found == expected
         ancestors = nx.ancestors(graph, space.num_states - 1) | {space.num_states - 1}

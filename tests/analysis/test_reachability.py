@@ -265,6 +265,18 @@ def two_rings(size: int = 35) -> Net:
     return net
 
 
+@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("size", [20, 40, 65])
+def test_rows_of_one_two_and_three_words(size, mode):
+    """40, 80 and 130 places: bitmask rows of one, two and three words (each width has
+    its own compiled loop)."""
+    net = two_rings(size)
+    space = explore(net, mode=mode)
+    assert (space.num_states, space.num_edges) == (size**2, 2 * size**2)
+    assert space.representation == ("counts" if mode == "counts" else "bitmask")
+    assert_consistent(net, space)
+
+
 COLLIDING = """
 import numpy as np
 from petriflow.analysis import _kernel
