@@ -1,12 +1,14 @@
 """Graph algorithms on edge arrays (private helpers for the analyses).
 
 Strongly connected components, multi-source reachability and per-component summaries
-on graphs given as ``(source, target)`` integer arrays. On large graphs (from
-:data:`COMPILED_FROM_EDGES` edges) the loops run compiled by numba, over a CSR view of
-the graph: when the edges are already grouped by source, as a
-:class:`~petriflow.analysis.reachability.StateSpace` keeps them, the neighbour array is
-``target`` itself and nothing of edge size is copied; otherwise a stable counting sort
-groups them. Small graphs, and every graph where numba is missing or disabled
+on graphs in compressed-row form, ``(offsets, neighbours)`` with node ``u``'s edges at
+``offsets[u]:offsets[u + 1]``, as a :class:`~petriflow.analysis.reachability.StateSpace`
+keeps its edges (``components``, ``reachable``, ``reaching``, ``terminal_summary_csr``),
+or given as ``(source, target)`` integer arrays (``strong_components``,
+``reachable_from``, ``can_reach``, ``terminal_summary``), which :func:`csr` groups:
+edges already grouped by source are used as they are, others are grouped by a stable
+counting sort. On large graphs (from :data:`COMPILED_FROM_EDGES` edges) the loops run
+compiled by numba. Small graphs, and every graph where numba is missing or disabled
 (``NUMBA_DISABLE_JIT=1``), take iterative pure-Python versions with the same results.
 
 numba is imported on the first large graph only (importing it costs a third of a
@@ -17,8 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["can_reach", "csr", "occurring", "reachable_from", "strong_components",
-           "terminal_summary"]
+__all__ = ["can_reach", "components", "csr", "occurring", "reachable", "reachable_from",
+           "reaching", "strong_components", "terminal_summary", "terminal_summary_csr",
+           "transpose"]
 
 
 #: Below this many edges the pure-Python versions are used: loading the compiled
@@ -79,22 +82,78 @@ def csr(n: int, source, target, *, compiled: bool = True) -> tuple[np.ndarray, n
         >>> offsets.tolist(), neighbours.tolist()
         ([0, 1, 1, 3], [1, 0, 1])
     """
-    source, target = _ids(source), _ids(target)
+    offsets, (neighbours,) = _group(n, source, target, compiled=compiled)
+    return offsets, neighbours
+
+
+def _group(n: int, source, target, *more, compiled: bool = True
+           ) -> tuple[np.ndarray, list[np.ndarray]]:
+    """``(offsets, [target, *more])`` with the per-edge arrays reordered (stably) so
+    that node ``u``'s edges are ``offsets[u]:offsets[u + 1]``; arrays already grouped
+    by source are returned as they are."""
+    source, columns = _ids(source), [_ids(target), *(_ids(m) for m in more)]
     loops = _compiled(len(source)) if compiled else None
     if loops is None:
+        if source.size and not (0 <= source.min() and source.max() < n
+                                and 0 <= columns[0].min() and columns[0].max() < n):
+            raise ValueError(f"edges must join nodes 0 .. {n - 1}")
         order = np.argsort(source, kind="stable")
         offsets = np.zeros(n + 1, dtype=np.int64)
         np.cumsum(np.bincount(source, minlength=n), out=offsets[1:])
-        return offsets, target[order]
+        return offsets, [c[order] for c in columns]
     offsets = np.zeros(n + 1, dtype=np.int64)
-    grouped = loops["offsets"](source, target, offsets)
+    grouped = loops["offsets"](source, columns[0], offsets)
     if grouped < 0:
         raise ValueError(f"edges must join nodes 0 .. {n - 1}")
     if grouped:
-        return offsets, target
-    neighbours = np.empty_like(target)
-    loops["scatter"](source, target, offsets, neighbours)
-    return offsets, neighbours
+        return offsets, columns
+    reordered = []
+    for column in columns:
+        out = np.empty_like(column)
+        loops["scatter"](source, column, offsets, out)
+        reordered.append(out)
+    return offsets, reordered
+
+
+def transpose(offsets: np.ndarray, neighbours: np.ndarray, *, compiled: bool = True
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """The compressed rows of the reversed graph (each node's predecessors, increasing).
+
+    Examples:
+        >>> offsets, neighbours = transpose(np.array([0, 2, 2, 3]), np.array([1, 2, 1]))
+        >>> offsets.tolist(), neighbours.tolist()
+        ([0, 0, 2, 3], [0, 2, 0])
+    """
+    n = len(offsets) - 1
+    loops = _compiled(len(neighbours)) if compiled else None
+    if loops is None:
+        sources = np.repeat(np.arange(n, dtype=_node_dtype(n)), np.diff(offsets))
+        return csr(n, neighbours, sources, compiled=False)
+    reverse = np.zeros(n + 1, dtype=np.int64)
+    predecessors = np.empty(len(neighbours), dtype=_node_dtype(n))
+    if not loops["transpose"](offsets, neighbours, reverse, predecessors):
+        raise ValueError(f"edges must join nodes 0 .. {n - 1}")
+    return reverse, predecessors
+
+
+def _transpose_loop(offsets, neighbours, reverse, predecessors):
+    """Fill ``reverse`` (zeros, n + 1) and ``predecessors`` with the reversed graph's
+    compressed rows; False when a neighbour is not a node."""
+    n = offsets.shape[0] - 1
+    for e in range(neighbours.shape[0]):
+        v = neighbours[e]
+        if v < 0 or v >= n:
+            return False
+        reverse[v + 1] += 1
+    for v in range(1, n + 1):
+        reverse[v] += reverse[v - 1]
+    position = reverse[:-1].copy()
+    for u in range(n):
+        for e in range(offsets[u], offsets[u + 1]):
+            v = neighbours[e]
+            predecessors[position[v]] = u
+            position[v] += 1
+    return True
 
 
 def _offsets_loop(keys, values, offsets):
@@ -141,7 +200,13 @@ def strong_components(n: int, source, target, *, compiled: bool = True) -> np.nd
         >>> bool(labels[0] == labels[1]), bool(labels[1] == labels[2]), bool(labels[2] == labels[3])
         (True, False, False)
     """
-    offsets, neighbours = csr(n, source, target, compiled=compiled)
+    return components(*csr(n, source, target, compiled=compiled), compiled=compiled)
+
+
+def components(offsets: np.ndarray, neighbours: np.ndarray, *, compiled: bool = True
+               ) -> np.ndarray:
+    """:func:`strong_components` of a graph in compressed-row form (see :func:`csr`)."""
+    n = len(offsets) - 1
     loops = _compiled(len(neighbours)) if compiled else None
     if loops is None:
         return _tarjan(n, offsets, neighbours)
@@ -282,13 +347,19 @@ def reachable_from(n: int, source, target, starts, *, compiled: bool = True) -> 
         >>> reachable_from(4, np.array([0, 1]), np.array([1, 2]), [1]).tolist()
         [False, True, True, False]
     """
+    return reachable(*csr(n, source, target, compiled=compiled), starts, compiled=compiled)
+
+
+def reachable(offsets: np.ndarray, neighbours: np.ndarray, starts, *,
+              compiled: bool = True) -> np.ndarray:
+    """:func:`reachable_from` on a graph in compressed-row form (see :func:`csr`)."""
+    n = len(offsets) - 1
     seen = np.zeros(n, dtype=bool)
     starts = np.unique(np.asarray(starts, dtype=np.int64))
     if not starts.size:
         return seen
     if starts[0] < 0 or starts[-1] >= n:
         raise ValueError(f"start nodes must be 0 .. {n - 1}")
-    offsets, neighbours = csr(n, source, target, compiled=compiled)
     loops = _compiled(len(neighbours)) if compiled else None
     if loops is not None:
         loops["bfs"](offsets, neighbours, starts, seen, np.empty(n, dtype=_node_dtype(n)))
@@ -337,6 +408,13 @@ def can_reach(n: int, source, target, goals, *, compiled: bool = True) -> np.nda
     return reachable_from(n, target, source, goals, compiled=compiled)
 
 
+def reaching(offsets: np.ndarray, neighbours: np.ndarray, goals, *,
+             compiled: bool = True) -> np.ndarray:
+    """:func:`can_reach` on a graph in compressed-row form (see :func:`csr`)."""
+    return reachable(*transpose(offsets, neighbours, compiled=compiled), goals,
+                     compiled=compiled)
+
+
 # Per-component summaries ---------------------------------------------------------------
 
 def terminal_summary(source, target, labels: np.ndarray, edge_label, n_labels: int,
@@ -355,12 +433,24 @@ def terminal_summary(source, target, labels: np.ndarray, edge_label, n_labels: i
         >>> first.tolist(), present.tolist()
         ([1], [[False, True, True]])
     """
-    source, target, edge_label = _ids(source), _ids(target), _ids(edge_label)
+    offsets, (neighbours, edge_label) = _group(len(labels), source, target, edge_label,
+                                               compiled=compiled)
+    return terminal_summary_csr(offsets, neighbours, labels, edge_label, n_labels,
+                                compiled=compiled)
+
+
+def terminal_summary_csr(offsets: np.ndarray, neighbours: np.ndarray, labels: np.ndarray,
+                         edge_label, n_labels: int, *, compiled: bool = True
+                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`terminal_summary` on a graph in compressed-row form (see :func:`csr`),
+    ``edge_label`` in the same edge order as ``neighbours``."""
+    neighbours, edge_label = _ids(neighbours), _ids(edge_label)
     labels = np.asarray(labels, dtype=np.int64)
     components = int(labels.max(initial=-1)) + 1
-    loops = _compiled(len(source)) if compiled else None
+    loops = _compiled(len(neighbours)) if compiled else None
     if loops is None:
-        return _terminal_summary(source, target, labels, edge_label, n_labels, components)
+        return _terminal_summary(offsets, neighbours, labels, edge_label, n_labels,
+                                 components)
     if labels.size and labels.min() < 0:
         raise ValueError("component labels must be 0 .. k-1")
     row = np.zeros(components, dtype=np.int64)
@@ -368,19 +458,22 @@ def terminal_summary(source, target, labels: np.ndarray, edge_label, n_labels: i
     if components == 1:          # a strongly connected graph: no edge can leave it
         rows = 1
     else:
-        rows = loops["exits"](source, target, labels, row, terminal)
+        rows = loops["exits"](offsets, neighbours, labels, row, terminal)
     first = np.empty(max(rows, 0), dtype=np.int64)
     present = np.zeros((max(rows, 0), n_labels), dtype=bool)
-    if rows < 0 or not loops["presence"](source, labels, edge_label, row, first, present):
+    if rows < 0 or not loops["presence"](offsets, labels, edge_label, row, first, present):
         raise ValueError(f"edges must join nodes 0 .. {len(labels) - 1} and carry labels"
                          f" 0 .. {n_labels - 1}")
     return terminal[:rows].copy(), first, present
 
 
-def _terminal_summary(source, target, labels, edge_label, n_labels, components):
-    """:func:`terminal_summary` with numpy (small graphs, no numba)."""
+def _terminal_summary(offsets, neighbours, labels, edge_label, n_labels, components):
+    """:func:`terminal_summary_csr` with numpy (small graphs, no numba)."""
+    if edge_label.size and not 0 <= edge_label.min() <= edge_label.max() < n_labels:
+        raise ValueError(f"edge labels must be 0 .. {n_labels - 1}")
+    source = np.repeat(np.arange(len(labels)), np.diff(offsets))
     from_label = labels[source]
-    leaving = from_label != labels[target]
+    leaving = from_label != labels[neighbours]
     exits = np.zeros(components, dtype=bool)
     exits[from_label[leaving]] = True
     terminal = np.flatnonzero(~exits)
@@ -395,24 +488,20 @@ def _terminal_summary(source, target, labels, edge_label, n_labels, components):
     return terminal, first[terminal], present
 
 
-def _exits_loop(source, target, labels, row, terminal):
+def _exits_loop(offsets, neighbours, labels, row, terminal):
     """Number the components no edge leaves: ``row[c]`` is c's rank among them (-1 for
     the others) and ``terminal`` starts with their labels; return how many there are
     (-1 when an edge end is not a node)."""
     n = labels.shape[0]
     leaves = np.zeros(row.shape[0], dtype=np.bool_)
-    u, c = -1, -1
-    for e in range(source.shape[0]):
-        if source[e] != u:           # edges grouped by source read each label once
-            u = source[e]
-            if u < 0 or u >= n:
+    for u in range(n):
+        c = labels[u]
+        for e in range(offsets[u], offsets[u + 1]):
+            v = neighbours[e]
+            if v < 0 or v >= n:
                 return -1
-            c = labels[u]
-        v = target[e]
-        if v < 0 or v >= n:
-            return -1
-        if c != labels[v]:
-            leaves[c] = True
+            if c != labels[v]:
+                leaves[c] = True
     rows = 0
     for c in range(row.shape[0]):
         row[c] = -1
@@ -423,25 +512,19 @@ def _exits_loop(source, target, labels, row, terminal):
     return rows
 
 
-def _presence_loop(source, labels, edge_label, row, first, present):
+def _presence_loop(offsets, labels, edge_label, row, first, present):
     """Fill ``first`` (smallest node) and ``present`` (edge labels inside) per terminal
     component, ``row`` giving each component's row (-1: not terminal); return False
-    when an edge source or label is out of range."""
-    n = labels.shape[0]
+    when an edge label is out of range."""
     first[:] = -1
-    for u in range(n):
-        r = row[labels[u]]
-        if r >= 0 and first[r] == -1:
-            first[r] = u
     size = present.shape[1]
-    u, r = -1, -1
-    for e in range(source.shape[0]):
-        if source[e] != u:           # edges grouped by source read each row once
-            u = source[e]
-            if u < 0 or u >= n:
-                return False
-            r = row[labels[u]]
-        if r >= 0:
+    for u in range(labels.shape[0]):
+        r = row[labels[u]]
+        if r < 0:
+            continue
+        if first[r] == -1:
+            first[r] = u
+        for e in range(offsets[u], offsets[u + 1]):
             x = edge_label[e]
             if x < 0 or x >= size:
                 return False
@@ -486,6 +569,7 @@ _LOOP_FUNCTIONS = {
     "scatter": _scatter_loop,
     "pearce": _pearce_loop,
     "bfs": _bfs_loop,
+    "transpose": _transpose_loop,
     "exits": _exits_loop,
     "presence": _presence_loop,
     "occurring": _occurring_loop,

@@ -140,7 +140,7 @@ def _hash_bits(row, key_mask):
 
 
 def expand_bits(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
-                parent_t, table, e_source, e_transition, e_target, counters):
+                parent_t, first_edge, table, e_transition, e_target, counters):
     """Breadth-first search over safe markings held as rows of ``uint64`` words.
 
     Args:
@@ -155,9 +155,11 @@ def expand_bits(pre, post, keep, kind, key_mask, id_bits, max_states, rows, pare
         max_states: stop with :data:`LIMIT` beyond this many states.
         rows, parent, parent_t: per state its words, BFS parent and parent transition;
             ``rows[0]`` is the initial marking.
+        first_edge: per state, the index of its first edge (its edges are consecutive,
+            in transition order); written when the state is expanded.
         table: the visited-state hash table (zeros at first), a power-of-two number of
             slots of ``2`` words (or ``1`` with ``id_bits``).
-        e_source, e_transition, e_target: the edges.
+        e_transition, e_target: the edges (their sources are given by ``first_edge``).
         counters: ``[states, edges, expanded]``, all 0 at first; updated in place.
 
     Returns:
@@ -169,34 +171,34 @@ def expand_bits(pre, post, keep, kind, key_mask, id_bits, max_states, rows, pare
     n_w = pre.shape[1]
     loop = _expand_bits_1 if n_w == 1 else _expand_bits_2 if n_w == 2 else _expand_bits_n
     return loop(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
-                parent_t, table, e_source, e_transition, e_target, counters)
+                parent_t, first_edge, table, e_transition, e_target, counters)
 
 
 @_jit
 def _expand_bits_1(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
-                   parent_t, table, e_source, e_transition, e_target, counters):
+                   parent_t, first_edge, table, e_transition, e_target, counters):
     return _expand_bits(1, pre, post, keep, kind, key_mask, id_bits, max_states, rows,
-                        parent, parent_t, table, e_source, e_transition, e_target, counters)
+                        parent, parent_t, first_edge, table, e_transition, e_target, counters)
 
 
 @_jit
 def _expand_bits_2(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
-                   parent_t, table, e_source, e_transition, e_target, counters):
+                   parent_t, first_edge, table, e_transition, e_target, counters):
     return _expand_bits(2, pre, post, keep, kind, key_mask, id_bits, max_states, rows,
-                        parent, parent_t, table, e_source, e_transition, e_target, counters)
+                        parent, parent_t, first_edge, table, e_transition, e_target, counters)
 
 
 @_jit
 def _expand_bits_n(pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
-                   parent_t, table, e_source, e_transition, e_target, counters):
+                   parent_t, first_edge, table, e_transition, e_target, counters):
     return _expand_bits(pre.shape[1], pre, post, keep, kind, key_mask, id_bits, max_states,
-                        rows, parent, parent_t, table, e_source, e_transition, e_target,
+                        rows, parent, parent_t, first_edge, table, e_transition, e_target,
                         counters)
 
 
 @_inline
 def _expand_bits(n_w, pre, post, keep, kind, key_mask, id_bits, max_states, rows, parent,
-                 parent_t, table, e_source, e_transition, e_target, counters):
+                 parent_t, first_edge, table, e_transition, e_target, counters):
     """:func:`expand_bits` for rows of ``n_w`` words."""
     n_t = pre.shape[0]
     stride = 1 if id_bits > 0 else 2
@@ -234,10 +236,11 @@ def _expand_bits(n_w, pre, post, keep, kind, key_mask, id_bits, max_states, rows
     hashes = np.empty(n_t, dtype=np.uint64)
     current = np.empty(n_w, dtype=np.uint64)
     while head < states:
-        if (edges + n_t > e_source.shape[0] or states + n_t > rows.shape[0]
+        if (edges + n_t > e_target.shape[0] or states + n_t > rows.shape[0]
                 or 2 * (states + n_t) > table.shape[0] // stride):
             status = FULL
             break
+        first_edge[head] = edges
         for w in range(n_w):
             current[w] = rows[head, w]
         # Branch-free enabledness test; the enabled transitions are collected in order.
@@ -311,7 +314,6 @@ def _expand_bits(n_w, pre, post, keep, kind, key_mask, id_bits, max_states, rows
                     table[2 * i] = h
                     table[2 * i + 1] = np.uint64(target + 1)
                 states += 1
-            e_source[edges] = head
             e_transition[edges] = t
             e_target[edges] = target
             edges += 1
@@ -345,7 +347,7 @@ def _reset_on_path(parent, parent_t, reset_at, reset_place, state, ancestor, pla
 @_jit
 def expand_counts(pre_at, pre_place, pre_weight, post_at, post_place, post_weight,
                   change_at, change_place, change_delta, reset_at, reset_place, key, top,
-                  check_unbounded, max_states, rows, parent, parent_t, table, e_source,
+                  check_unbounded, max_states, rows, parent, parent_t, first_edge, table,
                   e_transition, e_target, totals, path_min, counters):
     """Breadth-first search over markings held as rows of unsigned counts.
 
@@ -358,7 +360,7 @@ def expand_counts(pre_at, pre_place, pre_weight, post_at, post_place, post_weigh
         check_unbounded: look for a new state strictly covering an ancestor (with reset
             arcs: in a place that no firing between the two resets, so that repeating
             those firings grows it forever).
-        max_states, rows, parent, parent_t, e_source, e_transition, e_target: as for
+        max_states, rows, parent, parent_t, first_edge, e_transition, e_target: as for
             :func:`expand_bits`; the table always has ``(hash, id + 1)`` slots.
         totals, path_min: per state its token total and the smallest total on its
             BFS-tree path (used and grown only with ``check_unbounded``).
@@ -389,11 +391,12 @@ def expand_counts(pre_at, pre_place, pre_weight, post_at, post_place, post_weigh
         states = 1
     status = OK
     while head < states:
-        if (edges + n_t > e_source.shape[0] or states + n_t > rows.shape[0]
+        if (edges + n_t > e_target.shape[0] or states + n_t > rows.shape[0]
                 or 2 * (states + n_t) > table.shape[0] // 2
                 or (check_unbounded and states + n_t > totals.shape[0])):
             status = FULL
             break
+        first_edge[head] = edges
         for t in range(n_t):
             enabled = True
             for a in range(pre_at[t], pre_at[t + 1]):
@@ -478,7 +481,6 @@ def expand_counts(pre_at, pre_place, pre_weight, post_at, post_place, post_weigh
                                 status = UNBOUNDED
                                 break
                         ancestor = np.int64(parent[ancestor])
-            e_source[edges] = head
             e_transition[edges] = t
             e_target[edges] = target
             edges += 1

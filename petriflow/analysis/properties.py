@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from petriflow.analysis._graph import occurring, strong_components, terminal_summary
+from petriflow.analysis._graph import components, occurring, terminal_summary_csr
 from petriflow.analysis.reachability import StateSpace
 
 __all__ = [
@@ -105,7 +105,7 @@ def dead_transitions(space: StateSpace) -> list[str]:
 
 def strongly_connected_components(space: StateSpace) -> np.ndarray:
     """Component label of every state (equal labels: mutually reachable states)."""
-    return strong_components(space.num_states, space.edge_source, space.edge_target)
+    return components(space.edge_offsets, space.edge_target)
 
 
 def terminal_components(space: StateSpace, labels: np.ndarray | None = None) -> list[int]:
@@ -117,8 +117,8 @@ def terminal_components(space: StateSpace, labels: np.ndarray | None = None) -> 
 def _terminal(space: StateSpace, labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(terminal, first, present)``: the terminal components' labels, their smallest
     states, and which transitions fire inside each (one row per component)."""
-    return terminal_summary(space.edge_source, space.edge_target, labels,
-                            space.edge_transition, len(space.transitions))
+    return terminal_summary_csr(space.edge_offsets, space.edge_target, labels,
+                                space.edge_transition, len(space.transitions))
 
 
 def non_live_transitions(space: StateSpace, labels: np.ndarray | None = None) -> list[str]:

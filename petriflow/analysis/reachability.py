@@ -64,7 +64,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from petriflow.analysis._graph import occurring
 from petriflow.analysis._linear import pivot_columns
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
@@ -139,8 +138,9 @@ class StateSpace:
 
     States are numbered ``0 .. num_states - 1`` in breadth-first order; state 0 is the
     initial marking, so state ids never decrease with the distance from it. Edges are
-    in exploration order: by source state, then by transition index;
-    :meth:`successors` and :meth:`out_degree` index them.
+    in exploration order: by source state, then by transition index, so the graph is
+    held in compressed-row form: state ``s``'s edges are
+    ``edge_offsets[s]:edge_offsets[s + 1]``.
 
     Attributes:
         places: place ids; column ``j`` of :attr:`markings` is ``places[j]``.
@@ -148,18 +148,22 @@ class StateSpace:
             :attr:`edge_transition` indexes: transition ids, and ``t@failed``-style ids
             for the outcome variants of transitions with routed action outcomes.
         origins: per row, the id of the net transition it belongs to.
-        edge_source: source state of each edge.
+        edge_offsets: ``num_states + 1`` edge indices: where each state's edges start
+            (and, last, the number of edges).
         edge_transition: index of the transition fired on each edge.
         edge_target: target state of each edge.
         parent: per state, the state it was first reached from (-1 for state 0).
         parent_transition: per state, the transition index of that edge (-1 for state 0).
         representation: ``"bitmask"`` (the exploration stayed safe) or ``"counts"``.
+
+    :attr:`edge_source` (the source state of each edge) is expanded from
+    ``edge_offsets`` on first use.
     """
 
     places: tuple[str, ...]
     transitions: tuple[str, ...]
     origins: tuple[str, ...]
-    edge_source: np.ndarray
+    edge_offsets: np.ndarray
     edge_transition: np.ndarray
     edge_target: np.ndarray
     parent: np.ndarray
@@ -168,7 +172,7 @@ class StateSpace:
     _rows: np.ndarray = field(repr=False)
     _column_of_place: np.ndarray = field(repr=False)
     _markings: np.ndarray | None = field(default=None, repr=False)
-    _csr: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    _edge_source: np.ndarray | None = field(default=None, repr=False)
 
     # Sizes ----------------------------------------------------------------------------
     @property
@@ -250,19 +254,21 @@ class StateSpace:
         return int(self._rows.sum(axis=1, dtype=np.int64).max())
 
     # Graph ----------------------------------------------------------------------------
+    @property
+    def edge_source(self) -> np.ndarray:
+        """Source state of each edge (expanded from :attr:`edge_offsets`, then cached)."""
+        if self._edge_source is None:
+            ids = np.arange(self.num_states, dtype=self.edge_target.dtype)
+            self._edge_source = np.repeat(ids, self.out_degree())
+        return self._edge_source
+
     def out_degree(self) -> np.ndarray:
         """Number of enabled transitions in each state."""
-        return np.bincount(self.edge_source, minlength=self.num_states)
+        return np.diff(self.edge_offsets)
 
     def successors(self, state: int) -> list[tuple[str, int]]:
         """``(transition id, target state)`` of every edge leaving ``state``, by transition."""
-        if self._csr is None:
-            order = np.lexsort((self.edge_transition, self.edge_source))
-            offsets = np.zeros(self.num_states + 1, dtype=np.int64)
-            np.cumsum(self.out_degree(), out=offsets[1:])
-            self._csr = (order, offsets)
-        order, offsets = self._csr
-        edges = order[offsets[state]: offsets[state + 1]]
+        edges = slice(self.edge_offsets[state], self.edge_offsets[state + 1])
         return [(self.transitions[t], int(s)) for t, s in
                 zip(self.edge_transition[edges], self.edge_target[edges])]
 
@@ -271,7 +277,7 @@ class StateSpace:
 
         The first one is a deadlock nearest to the initial marking (BFS numbering).
         """
-        return np.flatnonzero(~occurring(self.edge_source, self.num_states))
+        return np.flatnonzero(self.edge_offsets[1:] == self.edge_offsets[:-1])
 
     def path(self, state: int) -> list[str]:
         """A shortest firing sequence (transition ids) from the initial marking to ``state``."""
@@ -462,7 +468,9 @@ def _bit_program(compiled: CompiledNet, column: list[int], resets: list[tuple[in
 class _Buffers:
     """The arrays a kernel fills, owned and grown (by doubling) here.
 
-    ``state`` arrays have a row per state, ``edge`` arrays an entry per edge; ``table``
+    ``state`` arrays have a row per state (the row, parent, parent transition, first
+    edge, then ``extra_state``), ``edge`` arrays an entry per edge (transition, target);
+    ``table``
     is the kernel's hash table (``stride`` words a slot) and is rebuilt twice as large
     whenever it would get more than half full.
     """
@@ -478,10 +486,10 @@ class _Buffers:
         states = 256
         rows = np.empty((states, len(row)), dtype=row.dtype)
         rows[0] = row
-        self.state = [rows, np.empty(states, dtype=id_type), np.empty(states, dtype=np.int32)]
+        self.state = [rows, np.empty(states, dtype=id_type), np.empty(states, dtype=np.int32),
+                      np.empty(states, dtype=np.int64)]
         self.state += [np.empty(states, dtype=d) for d in extra_state]
-        self.edge = [np.empty(1024, dtype=id_type), np.empty(1024, dtype=t_type),
-                     np.empty(1024, dtype=id_type)]
+        self.edge = [np.empty(1024, dtype=t_type), np.empty(1024, dtype=id_type)]
         self.table = np.zeros(1024 * stride, dtype=np.uint64)
         self.counters = np.zeros(5, dtype=np.int64)
 
@@ -592,9 +600,8 @@ def _explore_bits(kernel, compiled: CompiledNet, m0: Sequence[int], max_states: 
     fixed = (words[:n_t], words[n_t: 2 * n_t], words[2 * n_t: 3 * n_t], kind, words[-2],
              id_bits, max_states)
     while True:
-        rows, parent, parent_t = buffers.state
-        status = kernel.expand_bits(*fixed, rows, parent, parent_t, buffers.table,
-                                    *buffers.edge, buffers.counters)
+        status = kernel.expand_bits(*fixed, *buffers.state, buffers.table, *buffers.edge,
+                                    buffers.counters)
         if status != kernel.FULL:
             break
         buffers.grow(n_t)
@@ -639,11 +646,10 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states
                            (np.int64, np.int64) if check else ())
         unused = np.zeros(1, dtype=np.int64)     # same array types: one compiled loop
         while True:
-            rows, parent, parent_t, *sums = buffers.state
-            totals, path_min = sums if check else (unused, unused)
-            status = kernel.expand_counts(*fixed, top, check, max_states, rows, parent,
-                                          parent_t, buffers.table, *buffers.edge, totals,
-                                          path_min, buffers.counters)
+            totals, path_min = buffers.state[4:] if check else (unused, unused)
+            status = kernel.expand_counts(*fixed, top, check, max_states, *buffers.state[:4],
+                                          buffers.table, *buffers.edge, totals, path_min,
+                                          buffers.counters)
             if status != kernel.FULL:
                 break
             buffers.grow(n_t)
@@ -664,13 +670,16 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states
 def _space(compiled: CompiledNet, representation: str, buffers: _Buffers,
            column: list[int]) -> StateSpace:
     states, edges = int(buffers.counters[0]), int(buffers.counters[1])
-    rows, parent, parent_t = buffers.state[:3]
-    e_source, e_transition, e_target = buffers.edge
+    rows, parent, parent_t, first_edge = buffers.state[:4]
+    e_transition, e_target = buffers.edge
+    offsets = np.empty(states + 1, dtype=np.int64)
+    offsets[:states] = first_edge[:states]
+    offsets[states] = edges
     return StateSpace(
         places=tuple(compiled.places),
         transitions=tuple(compiled.transitions),
         origins=_origins(compiled),
-        edge_source=e_source[:edges],
+        edge_offsets=offsets,
         edge_transition=e_transition[:edges],
         edge_target=e_target[:edges],
         parent=parent[:states],

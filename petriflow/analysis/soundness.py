@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from petriflow.analysis._graph import can_reach
+from petriflow.analysis._graph import reaching
 from petriflow.analysis.coverability import coverability_graph_if_any
 from petriflow.analysis.properties import dead_transitions, deadlocks, is_live
 from petriflow.analysis.reachability import (
@@ -303,8 +303,8 @@ def check_soundness(
             space.path(state), reached.to_dict()))
 
     final_state = space.index(final)
-    stuck = np.ones(space.num_states, dtype=bool) if final_state is None else ~can_reach(
-        space.num_states, space.edge_source, space.edge_target, [final_state])
+    stuck = np.ones(space.num_states, dtype=bool) if final_state is None else ~reaching(
+        space.edge_offsets, space.edge_target, [final_state])
     report.option_to_complete = not stuck.any()
     if stuck.any():
         deadlocked = deadlocks(space)

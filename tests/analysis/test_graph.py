@@ -98,6 +98,24 @@ def test_compiled_reachability_equals_networkx(compiled, graph, data):
                                                         compiled=use)).tolist()) == forward
         assert set(np.flatnonzero(_graph.can_reach(n, source, target, starts,
                                                    compiled=use)).tolist()) == backward
+        offsets, neighbours = _graph.csr(n, source, target, compiled=use)
+        assert set(np.flatnonzero(_graph.reaching(offsets, neighbours, starts,
+                                                  compiled=use)).tolist()) == backward
+
+
+@needs_numba
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                  HealthCheck.function_scoped_fixture])
+@given(graphs())
+def test_transpose_lists_each_node_s_predecessors_in_order(compiled, graph):
+    n, source, target = graph
+    for use in (True, False):
+        offsets, neighbours = _graph.csr(n, source, target, compiled=use)
+        reverse, predecessors = _graph.transpose(offsets, neighbours, compiled=use)
+        assert len(reverse) == n + 1
+        for v in range(n):
+            expected = sorted(source[target == v].tolist())
+            assert predecessors[reverse[v]: reverse[v + 1]].tolist() == expected
 
 
 @needs_numba

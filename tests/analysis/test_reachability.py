@@ -90,6 +90,10 @@ def test_edges_come_by_source_then_transition(mode):
     space = explore(dining_philosophers(9), mode=mode)
     order = np.lexsort((space.edge_transition, space.edge_source))
     assert (order == np.arange(space.num_edges)).all()
+    offsets = space.edge_offsets
+    assert offsets[0] == 0 and offsets[-1] == space.num_edges and len(offsets) == len(space) + 1
+    assert space.successors(7) == [(space.transitions[t], int(s)) for t, s in zip(
+        space.edge_transition[offsets[7]: offsets[8]], space.edge_target[offsets[7]: offsets[8]])]
 
 
 @pytest.mark.parametrize("mode", MODES)
