@@ -28,7 +28,7 @@ Each measurement runs in a fresh forked process, so its peak memory is its own: 
 whole process: interpreter, numpy and the imported library included), and "extra RSS"
 is that peak minus the process's resident size just before the exploration started.
 Seconds are ``time.perf_counter`` around the exploration only (building the net is not
-timed); an exploration that takes less than 0.1 s is repeated (up to 50 runs or 1 s) and
+timed); an exploration that takes less than 0.1 s is repeated (up to 1,000 runs or 1 s) and
 the best run counts, for every tool alike. Counts are checked to agree between the libraries.
 
 PM4Py is AGPL-licensed: it is imported only here and in tests, never by petriflow.
@@ -162,7 +162,7 @@ def _child(tool: str, make: Callable[[], Net], pipe) -> None:
     seconds = time.perf_counter() - start
     # Sub-0.1 s runs are noisy: repeat them (same rule for every tool) and keep the best.
     spent, runs = seconds, 1
-    while seconds < 0.1 and runs < 50 and spent < 1.0:
+    while seconds < 0.1 and runs < 1000 and spent < 1.0:
         start = time.perf_counter()
         run()
         once = time.perf_counter() - start
