@@ -31,8 +31,16 @@ from petriflow.analysis.reachability import reachability_graph
 from petriflow.classic import dining_philosophers, producer_consumer
 from petriflow.io.yaml import loads_net
 from tests.analysis.strategies import bounded_nets
+from tests.analysis.test_properties import GREEDY
 
 needs_numba = pytest.mark.skipif(not _graph._compile(), reason="numba missing or disabled")
+
+
+def examples(count: int) -> settings:
+    """Hypothesis settings for ``count`` examples (no deadline: the first compiled call
+    loads numba's cache; fixtures are per test, set up once for all examples)."""
+    return settings(max_examples=count, deadline=None, suppress_health_check=[
+        HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 
 
 @pytest.fixture
@@ -68,8 +76,7 @@ def partition(labels: np.ndarray) -> set[frozenset[int]]:
 
 
 @needs_numba
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                                  HealthCheck.function_scoped_fixture])
+@examples(300)
 @given(graphs())
 def test_compiled_components_equal_tarjan_and_networkx(compiled, graph):
     """Pearce's compiled loop gives _tarjan's labels exactly, and networkx's components."""
@@ -84,8 +91,7 @@ def test_compiled_components_equal_tarjan_and_networkx(compiled, graph):
 
 
 @needs_numba
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                                  HealthCheck.function_scoped_fixture])
+@examples(200)
 @given(graphs(), st.data())
 def test_compiled_reachability_equals_networkx(compiled, graph, data):
     n, source, target = graph
@@ -104,8 +110,7 @@ def test_compiled_reachability_equals_networkx(compiled, graph, data):
 
 
 @needs_numba
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                                  HealthCheck.function_scoped_fixture])
+@examples(200)
 @given(graphs())
 def test_transpose_lists_each_node_s_predecessors_in_order(compiled, graph):
     n, source, target = graph
@@ -119,8 +124,7 @@ def test_transpose_lists_each_node_s_predecessors_in_order(compiled, graph):
 
 
 @needs_numba
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                                  HealthCheck.function_scoped_fixture])
+@examples(200)
 @given(graphs(), st.data())
 def test_compiled_terminal_summary_equals_pure_and_condensation(compiled, graph, data):
     n, source, target = graph
@@ -142,8 +146,7 @@ def test_compiled_terminal_summary_equals_pure_and_condensation(compiled, graph,
 
 
 @needs_numba
-@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                                  HealthCheck.function_scoped_fixture])
+@examples(100)
 @given(graphs())
 def test_compiled_csr_groups_edges_stably(compiled, graph):
     """Grouped edges keep ``target`` itself as the neighbour array; others are sorted
@@ -210,19 +213,15 @@ def test_bad_edges_are_errors_not_memory_faults(compiled):
             _graph.reachable_from(2, np.array([0]), np.array([1]), [2], compiled=use)
 
 
-GREEDY = """
-petriflow: 1
-places: [{id: f1, tokens: 1}, {id: f2, tokens: 1}, {id: a, tokens: 1}, {id: b, tokens: 1},
-         a_has_1, b_has_2, a_eats, b_eats, {id: spare, tokens: 1}]
-transitions:
-  - {id: a_takes_1, in: [a, f1], out: [a_has_1]}
-  - {id: a_takes_2, in: [a_has_1, f2], out: [a_eats]}
-  - {id: a_done, in: [a_eats], out: [a, f1, f2]}
-  - {id: b_takes_2, in: [b, f2], out: [b_has_2]}
-  - {id: b_takes_1, in: [b_has_2, f1], out: [b_eats]}
-  - {id: b_done, in: [b_eats], out: [b, f1, f2]}
-  - {id: never, in: [a_eats, b_eats], out: [spare]}
-"""
+def greedy_with_a_dead_transition():
+    """test_properties' GREEDY philosophers plus a transition that never fires."""
+    net = loads_net(GREEDY)
+    net.add_place("spare", tokens=1)
+    net.add_transition("never")
+    for place in ("a_eats", "b_eats"):
+        net.add_arc(place, "never")
+    net.add_arc("never", "spare")
+    return net
 
 
 def properties_of(space):
@@ -232,28 +231,27 @@ def properties_of(space):
             non_live_witness(space, labels))
 
 
+def assert_compiled_equals_pure(net, monkeypatch) -> None:
+    space = reachability_graph(net)
+    monkeypatch.setattr(_graph, "COMPILED_FROM_EDGES", 10**12)
+    pure = properties_of(space)
+    monkeypatch.setattr(_graph, "COMPILED_FROM_EDGES", 0)
+    assert properties_of(space) == pure
+
+
 @needs_numba
-@pytest.mark.parametrize("net", [dining_philosophers(6), producer_consumer(4), loads_net(GREEDY)],
+@pytest.mark.parametrize("net", [dining_philosophers(6), producer_consumer(4),
+                                 greedy_with_a_dead_transition()],
                          ids=["philosophers", "producer_consumer", "greedy"])
 def test_properties_agree_compiled_and_pure(net, monkeypatch):
-    space = reachability_graph(net)
-    monkeypatch.setattr(_graph, "COMPILED_FROM_EDGES", 10**12)
-    pure = properties_of(space)
-    monkeypatch.setattr(_graph, "COMPILED_FROM_EDGES", 0)
-    assert properties_of(space) == pure
-    assert deadlocks(space).tolist() == space.deadlocks().tolist()
+    assert_compiled_equals_pure(net, monkeypatch)
 
 
 @needs_numba
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow,
-                                                                 HealthCheck.function_scoped_fixture])
+@examples(60)
 @given(bounded_nets())
 def test_properties_of_random_nets_agree_compiled_and_pure(monkeypatch, net):
-    space = reachability_graph(net)
-    monkeypatch.setattr(_graph, "COMPILED_FROM_EDGES", 10**12)
-    pure = properties_of(space)
-    monkeypatch.setattr(_graph, "COMPILED_FROM_EDGES", 0)
-    assert properties_of(space) == pure
+    assert_compiled_equals_pure(net, monkeypatch)
 
 
 def test_without_numba_the_pure_versions_run(monkeypatch):
