@@ -410,8 +410,9 @@ def _resets_of(compiled: CompiledNet) -> list[tuple[int, ...]]:
     return list(getattr(compiled, "reset", None) or [()] * len(compiled.transitions))
 
 
-def _layout(compiled: CompiledNet, has_resets: bool, threshold: int) -> tuple[list[int], int]:
-    """``(column -> place, number of key columns)``.
+def _layout(compiled: CompiledNet, has_resets: bool,
+            threshold: int) -> tuple[list[int], list[int], int]:
+    """``(column -> place, place -> column, number of key columns)``.
 
     Without reset arcs every reachable marking is ``M0 + x·C``, so its counts on the
     places whose incidence columns form a basis determine the rest: those come first and
@@ -419,10 +420,15 @@ def _layout(compiled: CompiledNet, has_resets: bool, threshold: int) -> tuple[li
     """
     n_places = len(compiled.places)
     if has_resets or n_places <= threshold or not compiled.incidence.any():
-        return list(range(n_places)), n_places
+        identity = list(range(n_places))
+        return identity, identity, n_places
     basis = pivot_columns(compiled.incidence)
     chosen = set(basis)
-    return basis + [p for p in range(n_places) if p not in chosen], len(basis)
+    layout = basis + [p for p in range(n_places) if p not in chosen]
+    column = [0] * n_places
+    for col, place in enumerate(layout):
+        column[place] = col
+    return layout, column, len(basis)
 
 
 def _bit_program(compiled: CompiledNet, column: list[int], resets: list[tuple[int, ...]],
@@ -588,10 +594,7 @@ def _explore_bits(kernel, compiled: CompiledNet, m0: Sequence[int], max_states: 
     # Rows of more than one word are keyed on basis places: their key usually fits in
     # one word, often beside the state id in one table slot.
     id_bits = max(1, int(max_states).bit_length())
-    layout, n_key = _layout(compiled, has_resets, 64 if basis_from is None else basis_from)
-    column = [0] * len(layout)
-    for col, place in enumerate(layout):
-        column[place] = col
+    _, column, n_key = _layout(compiled, has_resets, 64 if basis_from is None else basis_from)
     words, kind = _bit_program(compiled, column, resets, n_key,
                                [p for p, count in enumerate(m0) if count])
     n_t = len(kind)
@@ -616,11 +619,9 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states
                     resets: list[tuple[int, ...]], has_resets: bool,
                     detect_unbounded: bool, basis_from: int | None) -> StateSpace:
     """Explore with count rows, widening their dtype whenever a count outgrows it."""
-    layout, n_key = _layout(compiled, has_resets,
-                            _BASIS_FROM_PLACES if basis_from is None else basis_from)
+    layout, col, n_key = _layout(compiled, has_resets,
+                                 _BASIS_FROM_PLACES if basis_from is None else basis_from)
     order = np.array(layout, dtype=np.int64)
-    column = np.argsort(order) if layout else np.zeros(0, dtype=np.int64)
-    col = column.tolist()
 
     def csr(lists: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         at = np.zeros(len(lists) + 1, dtype=np.int64)
@@ -663,7 +664,7 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states
             raise StateSpaceLimit(max_states, int(buffers.counters[0]),
                                   int(buffers.counters[2]))
         if status == kernel.UNBOUNDED:
-            _unbounded(compiled, buffers, column)
+            _unbounded(compiled, buffers, col)
         return _space(compiled, "counts", buffers, col)
 
 
@@ -690,7 +691,7 @@ def _space(compiled: CompiledNet, representation: str, buffers: _Buffers,
     )
 
 
-def _unbounded(compiled: CompiledNet, buffers: _Buffers, column: np.ndarray) -> None:
+def _unbounded(compiled: CompiledNet, buffers: _Buffers, column: list[int]) -> None:
     """Raise :class:`UnboundedNetError` from the covering pair a count exploration found."""
     rows, parent, parent_t = buffers.state[:3]
     state, ancestor = int(buffers.counters[3]), int(buffers.counters[4])
