@@ -60,8 +60,17 @@ def _format_marking(marking: Marking) -> str:
 # Commands ----------------------------------------------------------------------------
 
 
+def _load_bound(path: str) -> Net:
+    """Load a net as a run would: its run configuration found, the configuration's action
+    modules imported, every action, parameter, port and guard bound (``file:line``
+    errors with close matches, before anything else happens)."""
+    from petriflow.runtime.session import prepare
+
+    return prepare(path).net
+
+
 def cmd_info(args: argparse.Namespace) -> int:
-    net = load_net(args.net)
+    net = _load_bound(args.net)
     info = {
         "net": net.id,
         "label": net.label,
@@ -271,9 +280,20 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from petriflow.analysis.report import cmd_check as check
+    from petriflow.analysis.reachability import DEFAULT_MAX_STATES
+    from petriflow.analysis.report import check_net, exit_code, format_report, plain
 
-    return check(args)
+    if args.max_states is not None and args.max_states < 1:
+        raise PetriflowError(f"--max-states must be >= 1, got {args.max_states}")
+    net = _load_bound(args.net)
+    result = check_net(net, max_states=args.max_states or DEFAULT_MAX_STATES)
+    if args.json:
+        _print_json(plain(result))
+    else:
+        print(format_report(result))
+    if not result["complete"]:
+        print(f"petriflow: {args.net}: {result['error']}", file=sys.stderr)
+    return exit_code(result)
 
 
 # Parser ------------------------------------------------------------------------------

@@ -41,6 +41,8 @@ __all__ = [
     "Deadlock",
     "enabled",
     "is_enabled",
+    "consume",
+    "produce",
     "fire",
     "fire_sequence",
     "CompiledNet",
@@ -63,11 +65,10 @@ def enabled(net: Net, marking: Mapping[str, int]) -> list[str]:
     return [t for t in net.transitions if is_enabled(net, marking, t)]
 
 
-def fire(net: Net, marking: Mapping[str, int], transition: str, outcome: str | None = None) -> Marking:
-    """The marking reached by firing ``transition`` in ``marking``.
-
-    The preset is consumed, the places of the transition's cancellation region are
-    emptied, then the outputs for ``outcome`` (default ``ok``) are produced.
+def consume(net: Net, marking: Mapping[str, int], transition: str) -> Marking:
+    """The marking once ``transition`` has started: its preset consumed and its
+    cancellation region's places emptied. Its outputs come later, with
+    :func:`produce`, when its action ends (at once for a plain P/T firing).
 
     Raises:
         UnknownElementError: no such transition (with a did-you-mean hint).
@@ -83,9 +84,40 @@ def fire(net: Net, marking: Mapping[str, int], transition: str, outcome: str | N
     for node in net.transitions[transition].cancels:
         if node in net.places:
             counts[node] = 0
-    for place, weight in net.postset(transition, outcome).items():
+    return Marking(counts)
+
+
+def produce(net: Net, marking: Mapping[str, int], transition: str, outcome: str | None = None) -> Marking:
+    """The marking once ``transition``'s action has ended with ``outcome`` (default
+    ``ok``): the output arcs of the outcome's route (:meth:`Net.route`) produce.
+
+    Raises:
+        UnknownElementError: no such transition.
+        PetriflowError: the net routes ``outcome`` nowhere (a failure with no
+            ``failed`` arcs): no marking follows.
+    """
+    route = net.route(transition, outcome)
+    if route is None:
+        raise PetriflowError(f"transition {transition!r} routes no {outcome!r} outcome")
+    counts = dict(marking)
+    for place, weight in net.postset(transition, route).items():
         counts[place] = counts.get(place, 0) + weight
     return Marking(counts)
+
+
+def fire(net: Net, marking: Mapping[str, int], transition: str, outcome: str | None = None) -> Marking:
+    """The marking reached by firing ``transition`` in ``marking``.
+
+    One firing is :func:`consume` then :func:`produce`: the preset is consumed, the
+    places of the transition's cancellation region are emptied, then the outputs for
+    ``outcome`` (default ``ok``) are produced. The runtime does the same two steps
+    with simulated time between them.
+
+    Raises:
+        UnknownElementError: no such transition (with a did-you-mean hint).
+        NotEnabledError: the transition is not enabled; names each short place.
+    """
+    return produce(net, consume(net, marking, transition), transition, outcome)
 
 
 def fire_sequence(net: Net, marking: Mapping[str, int], transitions: Iterable[str]) -> Marking:
@@ -155,6 +187,29 @@ class CompiledNet:
                 add_reset(reset)
         self.has_resets = any(self.reset)
         self.transition_index = {t: i for i, t in enumerate(self.transitions)}
+
+    def row(self, transition: str, outcome: str | None = None) -> int | None:
+        """The row whose outputs produce when ``transition``'s action ends with
+        ``outcome`` (the net's :meth:`~petriflow.net.Net.route`), or ``None`` when the
+        net routes that outcome nowhere. A ``cancelled`` outcome with no ``cancelled``
+        arcs has no row either: it produces nothing."""
+        route = self.net.route(transition, outcome)
+        if route is None:
+            return None
+        return self.transition_index.get(variant_id(transition, route))
+
+    def consume(self, vector: list[int], t: int) -> None:
+        """Start row ``t`` in ``vector`` (in place): consume its preset, empty its
+        cancellation region. The caller has checked :meth:`is_enabled`."""
+        for p, w in self.pre[t]:
+            vector[p] -= w
+        for p in self.reset[t]:
+            vector[p] = 0
+
+    def produce(self, vector: list[int], t: int) -> None:
+        """End row ``t`` in ``vector`` (in place): add its outputs."""
+        for p, w in self.post[t]:
+            vector[p] += w
 
     # The matrices are built on first use: the token game and the bitmask exploration
     # of small nets read only the tuples above.
@@ -305,12 +360,8 @@ class Simulation:
 
     def _fire_index(self, t: int) -> None:
         compiled, counts = self.compiled, self._counts
-        for p, w in compiled.pre[t]:
-            counts[p] -= w
-        for p in compiled.reset[t]:
-            counts[p] = 0
-        for p, w in compiled.post[t]:
-            counts[p] += w
+        compiled.consume(counts, t)
+        compiled.produce(counts, t)
         pre, is_on = compiled.pre, self._is_on
         for u in compiled.affected[t]:
             ok = True

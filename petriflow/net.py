@@ -24,14 +24,16 @@ from typing import Any, Iterator, Mapping
 
 from petriflow.errors import NetStructureError, UnknownElementError, did_you_mean
 from petriflow.marking import Marking
+from petriflow.outcome import ROUTED_OUTCOMES, Outcome
 
 __all__ = ["Place", "Transition", "Arc", "Subnet", "Operator", "Net", "OPERATOR_KINDS", "OUTCOMES"]
 
 #: The routing kinds of a WF-net operator's split or join side.
 OPERATOR_KINDS = ("and", "xor")
 
-#: Outcomes of an action that output arcs can be reserved for (plain arcs mean ``ok``).
-OUTCOMES = ("failed", "timeout", "cancelled")
+#: Outcomes of an action that output arcs can be reserved for (plain arcs mean ``ok``),
+#: as the plain strings files hold (:class:`~petriflow.outcome.Outcome` values).
+OUTCOMES = tuple(o.value for o in ROUTED_OUTCOMES)
 
 
 @dataclass(frozen=True)
@@ -173,6 +175,14 @@ class Net:
         self._initial: Marking | None = Marking()
         self.final_marking: Marking | None = None
         self.meta: dict[str, Any] = {}
+        #: The run configuration the net names (``run:`` in YAML): a file name relative
+        #: to the net's file, or the configuration itself as a mapping; ``None``: none.
+        self.run: str | dict[str, Any] | None = None
+        #: The file the net was read from, if any (errors name it).
+        self.path: str | None = None
+        #: Where the reader found each element: ``{id: line}``, and ``"id/key"`` (e.g.
+        #: ``"walk/action"``, ``"walk/params/speed"``) for a transition's keys.
+        self.lines: dict[str, int] = {}
 
     # Building -----------------------------------------------------------------------
     def _check_new_id(self, node_id: str) -> None:
@@ -347,6 +357,30 @@ class Net:
         self.transition(transition)
         return [o for o in OUTCOMES if o in self._post_outcome[transition]]
 
+    def route(self, transition: str, outcome: str | None) -> str | None:
+        """The outcome whose output arcs produce when ``transition``'s action ends with
+        ``outcome``, or ``None`` when the net routes that outcome nowhere.
+
+        ``ok`` always has a route (its plain arcs, possibly none); a ``timeout`` with no
+        ``timeout`` arcs takes the ``failed`` arcs; a ``failed`` or ``timeout`` outcome
+        with neither has no route (a run stops on it); a ``cancelled`` outcome with no
+        ``cancelled`` arcs produces nothing (``"cancelled"`` with an empty postset).
+
+        Examples:
+            >>> net = Net()
+            >>> _ = net.add_place("a"); _ = net.add_place("retry"); _ = net.add_transition("t")
+            >>> _ = net.add_arc("t", "retry", outcome="failed")
+            >>> net.route("t", "timeout"), net.route("t", "ok"), net.route("t", "cancelled")
+            ('failed', 'ok', 'cancelled')
+        """
+        routed = self._post_outcome[self.transition(transition).id]
+        outcome = Outcome(outcome or Outcome.OK)
+        if outcome is Outcome.OK or outcome is Outcome.CANCELLED or outcome.value in routed:
+            return outcome.value
+        if outcome is Outcome.TIMEOUT and Outcome.FAILED.value in routed:
+            return Outcome.FAILED.value
+        return None
+
     def firing_rules(self):
         """Per transition, in order: ``(id, transition, preset, outputs)`` where
         ``outputs`` is ``[(None, postset), (outcome, postset), ...]`` in
@@ -428,6 +462,7 @@ class Net:
             tuple(sorted((s.id, s.label, s.agent) for s in self.subnets.values())),
             tuple(self.initial_marking.items()),
             None if self.final_marking is None else tuple(self.final_marking.items()),
+            repr(self.run),
         )
 
     def copy(self) -> "Net":
@@ -445,4 +480,7 @@ class Net:
         other.initial_marking = self.initial_marking
         other.final_marking = self.final_marking
         other.meta = dict(self.meta)
+        other.run = self.run
+        other.path = self.path
+        other.lines = dict(self.lines)
         return other

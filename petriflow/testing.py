@@ -17,8 +17,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
-from petriflow.net import Net
+from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
+from petriflow.net import Net
 from petriflow.runtime.action import Action, ActionContext, Outcome, Param, Status
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.scheduler import Scheduler
@@ -176,7 +177,10 @@ def check_action(cls: type[Action], params: Mapping[str, Any] | None = None, wor
 
     Checks that parameters are declared as :class:`Param`, that the defaults (plus
     ``params``) pass the class's own check, and that one lifecycle run (setup, start,
-    poll until done, teardown) returns :class:`Status` values and ends.
+    poll until done, cancel, teardown) returns :class:`Status` values and ends. A hook
+    that raises :class:`ActionFailure` (or another petriflow error) ends the firing
+    ``failed`` as it should; any other exception is reported, since an action's
+    failures should say what failed.
     """
     problems: list[str] = []
     if not (isinstance(cls, type) and issubclass(cls, Action)):
@@ -192,10 +196,13 @@ def check_action(cls: type[Action], params: Mapping[str, Any] | None = None, wor
         return [f"parameters do not check: {exc}"]
     action = cls(checked)
     ctx = ActionContext(transition="check", agent=None, params=checked, inputs={}, world=world,
-                        seed=0, started=0.0)
+                        seed=0, started=0.0, _reader=lambda place: [])
+    hook = "setup"
     try:
         action.setup(world)
+        hook = "start"
         action.start(ctx)
+        hook = "poll"
         for poll in range(max_polls):
             ctx.now = poll * getattr(world, "dt", 0.01)
             if action.wake_at is not None:
@@ -210,9 +217,18 @@ def check_action(cls: type[Action], params: Mapping[str, Any] | None = None, wor
                 world.step()
         else:
             problems.append(f"still running after {max_polls} polls")
+    except PetriflowError:
+        pass  # a deliberate failure: the firing ends failed
+    except Exception as exc:
+        problems.append(f"{hook}() raised {type(exc).__name__}: {exc} (raise ActionFailure to fail)")
+    try:
+        hook = "cancel"
         if action.cancel(ctx) not in (True, False):
             problems.append("cancel() must return True or False")
+        hook = "teardown"
         action.teardown()
+    except PetriflowError:
+        pass
     except Exception as exc:
-        problems.append(f"lifecycle raised {type(exc).__name__}: {exc}")
+        problems.append(f"{hook}() raised {type(exc).__name__}: {exc}")
     return problems

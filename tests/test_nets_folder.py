@@ -33,4 +33,4 @@ def test_shipped_net_binds_every_action(path):
 
     net = load_net(path)
     bound = default_registry.bind(net, str(path))
-    assert set(bound) == set(net.actions())
+    assert set(bound.actions()) == set(net.actions())

@@ -179,11 +179,11 @@ def test_pnml_round_trip_keeps_semantics_only(net):
     import snakes.pnml
 
     back = from_snakes(snakes.pnml.loads(snakes.pnml.dumps(to_snakes(net))))
-    places, transitions, arcs, subnets, initial, final = net.structure()
+    places, transitions, arcs, subnets, initial, final, run = net.structure()
     got = back.structure()
     assert [p[0] for p in got[0]] == [p[0] for p in places]
     assert [t[0] for t in got[1]] == [t[0] for t in transitions]
-    assert got[2:] == (arcs, subnets, initial, final)
+    assert got[2:] == (arcs, subnets, initial, final, run)
     assert all(p[1] is None for p in got[0])
 
 

@@ -7,8 +7,9 @@ makes a copy of the camera with the same pose and field of view at the new size.
 
 ``vision.capture`` renders exactly once, when its transition fires (in
 :meth:`Capture.start`); nothing is rendered at set-up or while other transitions
-run. The frame is the data of its output tokens and is also left on the run's
-blackboard, with the camera that took it, for ``vision.locate``::
+run. The frame is the data of its output tokens: a :class:`Frame`, an image array
+that also knows the camera that took it, so ``vision.locate`` downstream measures in
+that camera's geometry with nothing shared beside the net::
 
     - {id: capture, action: vision.capture, params: {camera: top}, in: [standby], out: [captured]}
 
@@ -25,14 +26,37 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from petriflow.runtime.action import Action, ActionContext, Param, Status
+from petriflow.errors import PetriflowError
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
 
-__all__ = ["camera_for", "capture", "Capture", "FRAME_KEY", "CAMERA_KEY"]
+import numpy as np
 
-#: Blackboard key of the last captured frame.
-FRAME_KEY = "frame"
-#: Blackboard key of the camera (at the frame's size) that took it.
-CAMERA_KEY = "camera"
+__all__ = ["camera_for", "capture", "Capture", "Frame"]
+
+
+class Frame(np.ndarray):
+    """An H x W x 3 uint8 RGB image that remembers the camera that took it (``camera``).
+
+    It is an array in every other way (traces summarise it as one), so a frame token
+    can travel through any transition and still be located in world coordinates.
+
+    Examples:
+        >>> frame = Frame.of(np.zeros((2, 3, 3), np.uint8), camera="top")
+        >>> frame.shape, frame.camera, isinstance(frame, np.ndarray)
+        ((2, 3, 3), 'top', True)
+    """
+
+    camera: Any = None
+
+    @classmethod
+    def of(cls, image: np.ndarray, camera: Any) -> "Frame":
+        """``image`` (not copied) as a frame taken by ``camera``."""
+        frame = np.asarray(image).view(cls)
+        frame.camera = camera
+        return frame
+
+    def __array_finalize__(self, obj: Any) -> None:
+        self.camera = getattr(obj, "camera", None)
 
 
 def camera_for(world: Any, camera: str | None = None, width: int | None = None,
@@ -97,25 +121,16 @@ class Capture(Action):
         self._camera = None
 
     def start(self, ctx: ActionContext) -> None:
-        self._error = ""
         world = ctx.world if ctx.world is not None else self.world
         if world is None or not hasattr(world, "cameras"):
-            self._error = "vision.capture needs a world with a camera (run with --world)"
-            return
-        try:
-            if self._camera is None or self._camera.world is not world:
+            raise ActionFailure("vision.capture needs a world with a camera (run with --world)")
+        if self._camera is None or self._camera.world is not world:
+            try:
                 self._camera = camera_for(world, self.params["camera"], self.params["width"],
                                           self.params["height"])
-        except Exception as exc:  # unknown camera, bad size: a failed outcome with the reason
-            self._error = str(exc)
-            return
-        frame = self._camera.capture()
-        ctx.blackboard[FRAME_KEY] = frame
-        ctx.blackboard[CAMERA_KEY] = self._camera
-        ctx.result = frame
+            except (ValueError, PetriflowError) as exc:  # unknown camera, bad size
+                raise ActionFailure(str(exc)) from None
+        ctx.result = Frame.of(self._camera.capture(), self._camera)
 
     def poll(self, ctx: ActionContext) -> Status:
-        if self._error:
-            ctx.reason = self._error
-            return Status.FAILED
         return Status.OK

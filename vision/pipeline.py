@@ -14,8 +14,10 @@
 5. ``map``: the grey label map, obstacles plus each robot as a square of side ``L``.
 
 ``Scene.timings`` has the wall-clock seconds of each stage. ``vision.locate`` is the
-action: it takes the frame from its input token (or the blackboard, where
-``vision.capture`` leaves it) and returns the :class:`Scene` as token data::
+action: it takes the frame from its input token (a
+:class:`~petriflow.vision.capture.Frame` knows the camera that took it) and returns
+the :class:`Scene` as token data; the scene keeps that camera for the decisions made
+on it::
 
     - {id: locate, action: vision.locate, in: [captured], out: [identified]}
 
@@ -44,8 +46,8 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from petriflow.runtime.action import Action, ActionContext, Param, Status
-from petriflow.vision.capture import CAMERA_KEY, FRAME_KEY, camera_for
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+from petriflow.vision.capture import camera_for
 from petriflow.vision.markers import DEFAULT_GEOMETRY, ROBOT_COLOURS
 from petriflow.vision.pose import TINY_RENDERER_OFFSET, GroundPlane, RobotPose, find_discs, robot_pose
 from petriflow.vision.segment import (
@@ -62,12 +64,10 @@ from petriflow.vision.segment import (
     to_hsv,
 )
 
-__all__ = ["VisionConfig", "Scene", "process", "Locate", "STAGES", "SCENE_KEY"]
+__all__ = ["VisionConfig", "Scene", "process", "Locate", "STAGES"]
 
 #: The stages timed in :attr:`Scene.timings`, in order.
 STAGES = ("classify", "mode", "contours", "pose", "map")
-#: Blackboard key of the last scene.
-SCENE_KEY = "scene"
 #: Frame size the pixel-area settings of :class:`VisionConfig` are given for.
 _REFERENCE_PIXELS = 640 * 480
 
@@ -131,6 +131,7 @@ class Scene:
             straight down with ``up`` = +y (else ``None``).
         origin: world ``(x, y)`` of the centre of pixel ``(0, 0)`` on the marker plane,
             rows running toward -y (with ``metres_per_pixel``; else ``None``).
+        camera: the camera that took the frame (at its size), when known.
 
     ``label_map`` (the grey map), ``poses``, ``metres_per_pixel`` and ``origin`` are
     the names ``planning.astar`` reads from a scene.
@@ -146,6 +147,7 @@ class Scene:
     size: tuple[int, int]
     metres_per_pixel: float | None = None
     origin: tuple[float, float] | None = None
+    camera: Any = field(default=None, repr=False, compare=False)
 
     @property
     def label_map(self) -> np.ndarray:
@@ -269,7 +271,7 @@ def process(frame: np.ndarray, camera: Any = None, config: VisionConfig = DEFAUL
     timings["total"] = now - started
     scale, origin = (plane.grid or (None, None)) if plane is not None else (None, None)
     return Scene(robots, missing, grey, labels, obstacles, boxes, timings, (shape[1], shape[0]),
-                 scale, origin)
+                 scale, origin, camera)
 
 
 class Locate(Action):
@@ -288,53 +290,39 @@ class Locate(Action):
     def setup(self, world: Any) -> None:
         self.world = world
 
-    def _frame_and_camera(self, ctx: ActionContext) -> tuple[np.ndarray | None, Any]:
+    def _frame_and_camera(self, ctx: ActionContext) -> tuple[np.ndarray, Any]:
         frame = ctx.token()
-        camera = None
         if not isinstance(frame, np.ndarray):
-            frame = ctx.blackboard.get(FRAME_KEY)
-        if not isinstance(frame, np.ndarray):
-            return None, None
+            raise ActionFailure("vision.locate: no frame in the input tokens (fire vision.capture first)")
         height, width = frame.shape[:2]
         world = ctx.world if ctx.world is not None else self.world
-        if self.params["camera"] is not None:
-            camera = camera_for(world, self.params["camera"], width, height)
-        else:
-            taken = ctx.blackboard.get(CAMERA_KEY)
-            if taken is not None and (taken.width, taken.height) == (width, height):
-                camera = taken
+        taken = getattr(frame, "camera", None)
+        try:
+            if self.params["camera"] is not None:
+                camera = camera_for(world, self.params["camera"], width, height)
             elif taken is not None:
-                camera = dataclasses.replace(taken, width=width, height=height)
+                same = (taken.width, taken.height) == (width, height)
+                camera = taken if same else dataclasses.replace(taken, width=width, height=height)
             elif world is not None and len(getattr(world, "cameras", {})) == 1:
                 camera = camera_for(world, None, width, height)
-        return frame, camera
+            else:
+                camera = None
+        except Exception as exc:  # unknown camera
+            raise ActionFailure(str(exc)) from None
+        return np.asarray(frame), camera
 
     def start(self, ctx: ActionContext) -> None:
-        self._error = ""
-        try:
-            frame, camera = self._frame_and_camera(ctx)
-        except Exception as exc:  # unknown camera: a failed outcome with the reason
-            self._error = str(exc)
-            return
-        if frame is None:
-            self._error = ("vision.locate: no frame in the input token or on the blackboard "
-                           "(run vision.capture first)")
-            return
+        frame, camera = self._frame_and_camera(ctx)
         config = VisionConfig(mode_filter=self.params["mode_filter"], marker_z=self.params["marker_z"],
                               robot_side=self.params["robot_side"])
         try:
             scene = process(frame, camera, config)
         except ValueError as exc:
-            self._error = str(exc)
-            return
+            raise ActionFailure(str(exc)) from None
+        ctx.result = scene
         lost = [c for c in self.params["require"] if c not in scene.robots]
         if lost:
-            self._error = f"vision.locate: not found: {', '.join(map(str, lost))}"
-        ctx.blackboard[SCENE_KEY] = scene
-        ctx.result = scene
+            raise ActionFailure(f"vision.locate: not found: {', '.join(map(str, lost))}")
 
     def poll(self, ctx: ActionContext) -> Status:
-        if self._error:
-            ctx.reason = self._error
-            return Status.FAILED
         return Status.OK

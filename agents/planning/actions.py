@@ -7,7 +7,8 @@ simulated time) and depend on no particular robot: they read token data and, for
 ``planning.astar`` plans one robot's path on the camera's label map (seed 003 §4):
 binary map for the robot, C-space by its radius, cells of n × n pixels, A*. It reads a
 *scene*: the first input token that has a ``label_map`` (a mapping or an object), else
-``ctx.blackboard["scene"]``, else ``ctx.blackboard["label_map"]``. A scene gives
+the newest token of the place its ``scene`` port names (a place the camera loop keeps
+the latest scene in). A scene gives
 
 * ``label_map``: ``uint8`` array, 0 floor, 1 obstacle, 2..5 red, blue, yellow, green;
 * ``metres_per_pixel`` and ``origin`` (world ``[x, y]`` of the centre of pixel
@@ -58,7 +59,7 @@ from petriflow.agents.planning.maps import (
     robot_label,
 )
 from petriflow.agents.planning.tracking import check_track
-from petriflow.runtime.action import Action, ActionContext, Param, Status
+from petriflow.runtime.action import Action, ActionContext, Param, Port, Status
 
 __all__ = ["PlanPath", "TrackPath", "plan_world_path", "scene_frame", "find_scene"]
 
@@ -103,15 +104,15 @@ def _for_robot(value: Any, robot: str | int) -> Any:
 
 
 def find_scene(ctx: ActionContext) -> Any:
-    """The scene an action plans in: an input token with a ``label_map``, else the
-    blackboard's ``scene``, else its ``label_map``; ``None`` if there is none."""
+    """The scene an action plans in: the first input token with a ``label_map``, else
+    the newest token of its ``scene`` port's place if it has one; ``None`` if neither."""
     for data in _tokens(ctx):
         if _field(data, "label_map") is not None:
             return data
-    if ctx.blackboard.get("scene") is not None:
-        return ctx.blackboard["scene"]
-    if ctx.blackboard.get("label_map") is not None:
-        return {"label_map": ctx.blackboard["label_map"]}
+    if "scene" in ctx.params:
+        latest = ctx.latest("scene")
+        if latest is not None and _field(latest, "label_map") is not None:
+            return latest
     return None
 
 
@@ -210,23 +211,19 @@ def plan_world_path(label_map: np.ndarray, frame: GridFrame, robot: str | int, g
 
 class _Instant(Action):
     """An action that does its work in :meth:`start` and ends at the first poll; a
-    :class:`PlanningError` becomes the ``failed`` outcome with its message as reason."""
+    :class:`PlanningError` (raised from :meth:`run`) is the ``failed`` outcome with its
+    message as reason."""
 
     needs_world = False
 
     def start(self, ctx: ActionContext) -> None:
-        self._failed = False
-        try:
-            ctx.result = self.run(ctx)
-        except PlanningError as exc:
-            ctx.reason = str(exc)
-            self._failed = True
+        ctx.result = self.run(ctx)
 
     def run(self, ctx: ActionContext) -> Any:  # pragma: no cover - overridden
         raise NotImplementedError
 
     def poll(self, ctx: ActionContext) -> Status:
-        return Status.FAILED if self._failed else Status.OK
+        return Status.OK
 
 
 class PlanPath(_Instant):
@@ -248,6 +245,7 @@ class PlanPath(_Instant):
         "metres_per_pixel": Param(_OPTIONAL_FLOAT, None, "pixel size (m) when the scene gives none"),
         "origin": Param(_OPTIONAL_LIST, None, "world [x, y] of pixel (0, 0) when the scene gives none"),
         "report_ms": Param(bool, False, "add the search's wall-clock ms to the result (traces then differ)"),
+        "scene": Port("place holding the latest scene, read when no input token has one"),
     }
 
     def run(self, ctx: ActionContext) -> dict[str, Any]:
@@ -258,7 +256,7 @@ class PlanPath(_Instant):
         colour = _colour(robot)
         scene = find_scene(ctx)
         if scene is None:
-            raise PlanningError("no scene: no input token has a label_map and the blackboard holds none")
+            raise PlanningError("no scene: no input token (nor the scene port's place) has a label_map")
         label_map = np.asarray(_field(scene, "label_map"))
         if label_map.ndim != 2:
             raise PlanningError(f"the label map must be 2-D, got shape {label_map.shape}")

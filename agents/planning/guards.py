@@ -1,13 +1,13 @@
 """Guards that route a ``planning.track`` result: on track, reinsert, or re-plan.
 
-A guard is a predicate ``f(tokens, params, blackboard)`` over the tokens a firing would
+A guard is a predicate ``f(tokens, params)`` over the tokens a firing would
 consume (``{place: [data, ...]}``); these look at the ``decision`` that
 ``planning.track`` put in its output token, so three transitions sharing that place
 split the flow three ways (an XOR-split decided by data).
 
 Examples:
     >>> tokens = {"checked": [{"decision": "reinsert", "point": [0.5, 0.0]}]}
-    >>> on_track(tokens, {}, {}), reinsert(tokens, {}, {}), replan(tokens, {}, {})
+    >>> on_track(tokens, {}), reinsert(tokens, {}), replan(tokens, {})
     (False, True, False)
 """
 
@@ -29,17 +29,17 @@ def _decided(tokens: Tokens, decision: str) -> bool:
     return False
 
 
-def on_track(tokens: Tokens, params: Mapping[str, Any], blackboard: Mapping[str, Any]) -> bool:
+def on_track(tokens: Tokens, params: Mapping[str, Any]) -> bool:
     """A consumed token says the robot is on its path."""
     return _decided(tokens, "on_track")
 
 
-def reinsert(tokens: Tokens, params: Mapping[str, Any], blackboard: Mapping[str, Any]) -> bool:
+def reinsert(tokens: Tokens, params: Mapping[str, Any]) -> bool:
     """A consumed token says the robot must return to its path (reinsertion)."""
     return _decided(tokens, "reinsert")
 
 
-def replan(tokens: Tokens, params: Mapping[str, Any], blackboard: Mapping[str, Any]) -> bool:
+def replan(tokens: Tokens, params: Mapping[str, Any]) -> bool:
     """A consumed token says the robot is too far from its path: stop and plan again."""
     return _decided(tokens, "replan")
 

@@ -11,7 +11,7 @@ Examples:
     >>> register(registry)
     >>> [name for name in registry.names() if name.startswith("planning.")]
     ['planning.astar', 'planning.track']
-    >>> registry.guard("planning.replan")({"p": [{"decision": "replan"}]}, {}, {})
+    >>> registry.guard("planning.replan")({"p": [{"decision": "replan"}]}, {})
     True
 """
 

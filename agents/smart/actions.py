@@ -16,9 +16,12 @@
   (``planning.track``'s rule: on track, reinsertion at the farthest reachable path
   point, or stop and re-plan), and the decision maker's collision orders (hold,
   re-plan) are obeyed; optionally it ends bracing a fallen robot (``gait.brace``).
+  The latest scene and the standing orders are token data in places of the net,
+  which the walk reads through its ports ``scene`` and ``orders``.
 * ``smart.avoid``: collision detection and avoidance in the decision loop (§4.2):
   after every image, robots closer than two standard steps stop; the higher-priority
-  one re-plans, the other holds until the first has passed.
+  one re-plans, the other holds until the first has passed. The orders are the
+  token of a place the decision maker takes and gives back updated (port ``orders``).
 * ``smart.push``: a disturbance: an external force on a robot for a while.
 
 Every frame sent is in the action's result (``frames``: hex bytes and the decoded
@@ -34,15 +37,12 @@ from typing import Any, ClassVar
 from petriflow.agents.legged.actions import Walk
 from petriflow.agents.smart import messages
 from petriflow.agents.smart.decision import LABELS, assess, draw_obstacle, robot_id
-from petriflow.vision.capture import CAMERA_KEY
 from petriflow.vision.capture import Capture as _VisionCapture
 
 from petriflow.errors import NetFormatError
-from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Port, Status
 
 __all__ = [
-    "AVOIDANCE_KEY",
-    "ORDERS_KEY",
     "Avoid",
     "Capture",
     "Dispatch",
@@ -52,11 +52,6 @@ __all__ = [
     "frame_record",
     "simplify",
 ]
-
-#: Blackboard key of the decision maker's standing orders ``{colour: {...}}``.
-ORDERS_KEY = "smart.orders"
-#: Blackboard key of the shared :class:`~petriflow.agents.planning.avoidance.CollisionAvoidance`.
-AVOIDANCE_KEY = "smart.avoidance"
 
 _STR_OR_NONE = (str, type(None))
 _FLOAT_OR_NONE = (float, type(None))
@@ -111,17 +106,20 @@ class Capture(_VisionCapture):
             try:
                 dress(world)
             except Exception as exc:  # a malformed meta.smart: a failed outcome with the reason
-                self._error = f"smart.capture: {getattr(exc, 'message', None) or exc}"
-                return
+                raise ActionFailure(f"smart.capture: {getattr(exc, 'message', None) or exc}") from None
         super().start(ctx)
+
+
+def _is_scene(data: Any) -> bool:
+    return data is not None and _field(data, "label_map") is not None and _field(data, "robots") is not None
 
 
 def _scene_of(ctx: ActionContext) -> Any:
     for place in sorted(ctx.inputs):
         for data in ctx.inputs[place]:
-            if data is not None and _field(data, "label_map") is not None and _field(data, "robots") is not None:
+            if _is_scene(data):
                 return data
-    return ctx.blackboard.get("scene")
+    return None
 
 
 class Dispatch(Action):
@@ -145,19 +143,15 @@ class Dispatch(Action):
         self.world = world
 
     def start(self, ctx: ActionContext) -> None:
-        self._error = ""
-        try:
-            ctx.result = self._decide(ctx)
-        except ActionFailure as exc:
-            self._error = str(exc)
+        ctx.result = self._decide(ctx)
 
     def _decide(self, ctx: ActionContext) -> dict[str, Any]:
         params = self.params
         scene = _scene_of(ctx)
         if scene is None:
-            raise ActionFailure("smart.dispatch: no scene in the input token or on the blackboard")
+            raise ActionFailure("smart.dispatch: no scene in the input tokens")
         world = _world(ctx, self)
-        camera = ctx.blackboard.get(CAMERA_KEY)
+        camera = _field(scene, "camera")
         if camera is None and world is not None and len(getattr(world, "cameras", {})) == 1:
             camera = next(iter(world.cameras.values()))
         size = _field(scene, "size")
@@ -209,9 +203,6 @@ class Dispatch(Action):
         }
 
     def poll(self, ctx: ActionContext) -> Status:
-        if self._error:
-            ctx.reason = self._error
-            return Status.FAILED
         return Status.OK
 
 
@@ -292,8 +283,12 @@ class Follow(Walk):
     robot (``colour``), ``dc`` decides: on track; reinsertion (the robot heads for the
     farthest path point within ``reach``, then on along the path); or, farther than
     ``radius``, the action fails with ``decision: replan`` so the net can plan again.
-    A ``hold`` order on the blackboard (``smart.avoid``) keeps the robot standing
-    until released; a ``replan`` order fails the action the same way.
+
+    Two ports name places the walk reads while it runs: ``scene``, the place holding
+    the camera's latest scene (for the tracking), and ``orders``, the place holding
+    the decision maker's standing orders (``smart.avoid``): a ``hold`` order for its
+    colour keeps the robot standing until released; a ``replan`` order (each has an
+    ``id``; the walk obeys one once) fails the action the same way.
     """
 
     params: ClassVar[dict[str, Param]] = {
@@ -314,7 +309,13 @@ class Follow(Walk):
         "tolerance": Param(float, 0.03, "arrival distance (m)"),
         "resolution": Param(float, _CELLS["resolution"], "size of a command's coordinate cell (m)"),
         "origin": Param(list, list(_CELLS["origin"]), "world [x, y] of command cell (0, 0)"),
+        "scene": Port("place holding the camera's latest scene (read for vision tracking)"),
+        "orders": Port("place holding the decision maker's standing orders (read: hold, re-plan)"),
     }
+
+    def setup(self, world: Any) -> None:
+        super().setup(world)
+        self.obeyed: set[Any] = set()  # ids of the re-plan orders obeyed, across this transition's firings
 
     @classmethod
     def check_params(cls, given: dict[str, Any], where: str) -> dict[str, Any]:
@@ -411,8 +412,8 @@ class Follow(Walk):
         if mode == "world":
             x, y, _ = self.robot.pose()
             return (x, y)
-        scene = ctx.blackboard.get("scene")
-        if scene is None or scene is self._last_scene or self.colour is None:
+        scene = ctx.latest("scene")
+        if not _is_scene(scene) or scene is self._last_scene or self.colour is None:
             return None
         self._last_scene = scene
         pose = (_field(scene, "robots") or {}).get(self.colour)
@@ -451,8 +452,8 @@ class Follow(Walk):
         self.best, self.stalled = math.inf, 0
 
     def _orders(self, ctx: ActionContext) -> dict[str, Any] | None:
-        orders = ctx.blackboard.get(ORDERS_KEY) or {}
-        return orders.get(self.colour)
+        orders = ctx.latest("orders")
+        return orders.get(self.colour) if isinstance(orders, Mapping) else None
 
     def poll(self, ctx: ActionContext) -> Status:
         if self._holding is not None:
@@ -465,8 +466,8 @@ class Follow(Walk):
         boundary = self.posture is None and (self.plan is None or self.plan_time >= self.plan.duration - 1e-9)
         if boundary and self._on_path():
             order = self._orders(ctx)
-            if order is not None and order.get("order") == "replan":
-                order["order"] = "replanning"
+            if order is not None and order.get("order") == "replan" and order.get("id") not in self.obeyed:
+                self.obeyed.add(order.get("id"))
                 ctx.result = {"decision": "replan", "robot": self.robot.name, "colour": self.colour,
                               "others": order.get("others", []), "checks": self.checks}
                 raise ActionFailure(f"robot {self.robot.name!r}: collision ahead with "
@@ -489,45 +490,60 @@ class Follow(Walk):
 class Avoid(Action):
     """Collision detection in the decision loop (§4.2): after every image, robots
     closer than ``steps`` standard steps stop; the higher-priority one re-plans with
-    the other as a fixed obstacle, the other holds until it has passed. Orders go to
-    the blackboard (``smart.orders``) for ``smart.follow``; a ``STOP`` frame goes to
-    a robot told to hold. The scene is passed on as the result."""
+    the other as a fixed obstacle, the other holds until it has passed.
+
+    The standing orders ``{colour: {"order": "go" | "hold" | "replan", "others": [...],
+    "t": time, "id": n}}`` are the token of the place the ``orders`` port names: the
+    transition takes it and gives it back updated (that place is one of its inputs
+    and outputs), and ``smart.follow`` reads it. A ``replan`` order stands until
+    another order replaces it; each one has a new ``id`` so a walk obeys it once. A
+    ``STOP`` frame goes to a robot told to hold. The scene is passed on to the other
+    outputs."""
 
     params: ClassVar[dict[str, Param]] = {
         "priorities": Param(dict, doc="{colour: priority}, higher goes first"),
         "step": Param(float, 0.08, "standard step (m)"),
         "radius": Param(float, 0.13, "robot radius (m): distances are gaps between discs"),
         "steps": Param(float, 2.0, "a conflict is a gap under this many standard steps"),
+        "orders": Port("place of the standing orders (an input and output of the transition)"),
     }
     needs_world = False
 
-    def start(self, ctx: ActionContext) -> None:
+    def setup(self, world: Any) -> None:
         from petriflow.agents.planning.avoidance import CollisionAvoidance
 
+        self.avoidance = CollisionAvoidance(dict(self.params["priorities"]), step=self.params["step"],
+                                            radius=self.params["radius"], steps=self.params["steps"])
+        self.issued = 0
+
+    def start(self, ctx: ActionContext) -> None:
+        place = self.params["orders"]
+        standing = ctx.inputs.get(place, [None])[0] if place is not None else None
+        orders = {colour: dict(order) for colour, order in standing.items()} if isinstance(standing, Mapping) else {}
         scene = _scene_of(ctx)
         ctx.result = scene
+        if place is not None:
+            ctx.put(place, orders)
         if scene is None:
             return
-        avoidance = ctx.blackboard.get(AVOIDANCE_KEY)
-        if avoidance is None:
-            avoidance = ctx.blackboard[AVOIDANCE_KEY] = CollisionAvoidance(
-                dict(self.params["priorities"]), step=self.params["step"], radius=self.params["radius"],
-                steps=self.params["steps"])
         robots = _field(scene, "robots") or {}
         positions = {colour: tuple(robots[colour].position) for colour in self.params["priorities"]
                      if colour in robots and getattr(robots[colour], "position", None) is not None}
-        orders = ctx.blackboard.setdefault(ORDERS_KEY, {})
         commands = []
-        for colour, directive in avoidance.update(positions).items():
+        for colour, directive in self.avoidance.update(positions).items():
             previous = orders.get(colour, {}).get("order")
             order = directive.order.value
             if previous == "replan" and order == "go":
-                continue  # the robot has not taken its re-plan order yet
-            if order != ("go" if previous in (None, "replanning") else previous):
+                continue  # a re-plan order stands until another order replaces it
+            if order == "replan" or order != (previous or "go"):
                 ctx.emit("smart.order", robot=colour, order=order, others=list(directive.others))
                 if order == "hold":
                     commands.append(messages.Command(messages.ActionId.STOP, robot_id(colour)))
-            orders[colour] = {"order": order, "others": list(directive.others), "t": round(ctx.now, 4)}
+            entry = {"order": order, "others": list(directive.others), "t": round(ctx.now, 4)}
+            if order == "replan":
+                self.issued += 1
+                entry["id"] = self.issued
+            orders[colour] = entry
         if commands:
             _send(ctx, commands)
 

@@ -1,13 +1,13 @@
 """Guards of the SMART nets (registered by ``petriflow.agents.plugin``).
 
-A guard is ``f(tokens, params, blackboard) -> bool`` over the tokens a firing would
+A guard is ``f(tokens, params) -> bool`` over the tokens a firing would
 take; ``params`` are the guarded transition's. ``smart.help_needed`` lets the
 decision maker's AND-split (``T5``) fire only on a scene in which the helper stands
 and the robot to help is seen down; otherwise the camera is asked for a new image
 (``T2``). It reads the transition's own ``helper`` and ``fallen`` colours.
 
 Examples:
-    >>> help_needed({"P6": [None]}, {"helper": "yellow", "fallen": "red"}, {})
+    >>> help_needed({"P6": [None]}, {"helper": "yellow", "fallen": "red"})
     False
 """
 
@@ -27,8 +27,7 @@ def _scenes(tokens: Mapping[str, list[Any]]):
                 yield data
 
 
-def help_needed(tokens: Mapping[str, list[Any]], params: Mapping[str, Any],
-                blackboard: Mapping[str, Any]) -> bool:
+def help_needed(tokens: Mapping[str, list[Any]], params: Mapping[str, Any]) -> bool:
     """A consumed scene shows the ``helper`` upright and the ``fallen`` robot down."""
     from petriflow.agents.smart.decision import assess
 

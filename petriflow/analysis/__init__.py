@@ -45,7 +45,7 @@ from petriflow.analysis.reachability import (
     reachability_graph,
     to_networkx,
 )
-from petriflow.analysis.report import check_net, cmd_check, exit_code, format_report
+from petriflow.analysis.report import check_net, exit_code, format_report
 from petriflow.analysis.soundness import (
     SoundnessReport,
     Violation,
@@ -58,7 +58,7 @@ from petriflow.analysis.soundness import (
 __all__ = [
     "DEFAULT_MAX_STATES", "OMEGA", "CoverabilityGraph", "InvariantLimit", "SoundnessReport",
     "StateSpace", "StateSpaceLimit", "UnboundedNetError", "Violation", "WorkflowStructure",
-    "check_net", "check_soundness", "cmd_check", "coverability_graph", "dead_transitions",
+    "check_net", "check_soundness", "coverability_graph", "dead_transitions",
     "deadlock_witness", "deadlocks", "exit_code", "format_report", "is_covered_by_p_semiflows",
     "is_free_choice", "is_live", "is_reversible", "is_safe", "non_live_transitions",
     "p_semiflows", "place_bounds", "reachability_graph", "structural_bounds", "t_semiflows",

@@ -35,9 +35,6 @@ Examples:
 
 from __future__ import annotations
 
-import argparse
-import json
-import sys
 from typing import Any
 
 import numpy as np
@@ -78,9 +75,9 @@ __all__ = [
     "EXIT_PROBLEM",
     "EXIT_UNDECIDED",
     "check_net",
-    "cmd_check",
     "exit_code",
     "format_report",
+    "plain",
 ]
 
 EXIT_OK, EXIT_PROBLEM, EXIT_UNDECIDED = 0, 1, 2
@@ -372,42 +369,12 @@ def format_report(result: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def cmd_check(args: argparse.Namespace) -> int:
-    """The ``petriflow check NET [--json] [--max-states N]`` command; returns its exit code.
-
-    Args:
-        args: a namespace with ``net`` (path), ``json`` (bool) and ``max_states``
-            (int or ``None`` for the default).
-
-    Raises:
-        PetriflowError: bad input (unreadable net, ``--max-states`` below 1); the command
-            line prints it as one line and exits 2.
-    """
-    from petriflow.errors import PetriflowError
-    from petriflow.io import load_net
-
-    limit = getattr(args, "max_states", None)
-    if limit is not None and limit < 1:
-        raise PetriflowError(f"--max-states must be >= 1, got {limit}")
-    net = load_net(args.net)
-    limit = limit or DEFAULT_MAX_STATES
-    result = check_net(net, max_states=limit)
-    if getattr(args, "json", False):
-        json.dump(_plain(result), sys.stdout, indent=2)
-        sys.stdout.write("\n")
-    else:
-        print(format_report(result))
-    if not result["complete"]:
-        print(f"petriflow: {args.net}: {result['error']}", file=sys.stderr)
-    return exit_code(result)
-
-
-def _plain(value: Any) -> Any:
-    """JSON-safe copy (numpy scalars to Python numbers)."""
+def plain(value: Any) -> Any:
+    """A JSON-safe copy of a :func:`check_net` result (numpy scalars to Python numbers)."""
     if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
+        return {str(k): plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [plain(v) for v in value]
     if isinstance(value, np.generic):
         return value.item()
     return value

@@ -415,6 +415,9 @@ class _Reader:
         if "label" in data:
             self.net.label = data["label"]
         self.net.meta = dict(data.get("meta", {}))
+        if "run" in data:
+            self.net.run = data["run"]
+            self.net.lines["run"] = data["run_line"]
         variables = _child(net_element, "variables")
         if variables is not None and len(variables):
             names = ", ".join(
@@ -444,6 +447,7 @@ class _Reader:
                                subnet=data.get("subnet"), meta=meta, channel=data.get("channel"))
         except PetriflowError as exc:
             self.fail(str(exc), element, node)
+        self.net.lines[node] = _line(element)
 
     def read_transition(self, element: Element) -> None:
         node = str(element.get("id"))
@@ -484,6 +488,9 @@ class _Reader:
             self.net.add_transition(node, **attributes)
         except PetriflowError as exc:
             self.fail(str(exc), element, node)
+        self.net.lines[node] = _line(element)
+        for key, line in data.get("lines", {}).items():
+            self.net.lines[f"{node}/{key}"] = line
 
     def woped_operator(self, found: tuple[str, str | None, Element], element: Element,
                        node: str) -> Operator | None:
@@ -590,8 +597,20 @@ class _Reader:
                 self.outcome_arcs.append((str(node), child))
             elif name in ("action", "guard") and kind == "transition":
                 found[name] = text
+                found.setdefault("lines", {})[name] = _line(child)
             elif name == "params" and kind == "transition":
                 found["params"] = self.json_of(child, dict, "params", node)
+                found.setdefault("lines", {})[name] = _line(child)
+            elif name == "run" and kind == "net":
+                try:
+                    run = json.loads(text)
+                except json.JSONDecodeError as exc:
+                    self.fail(f"petriflow run is not valid JSON: {exc.msg}", child, node)
+                if not isinstance(run, (str, dict)):
+                    self.fail("petriflow run must be a JSON string (a file) or object (the configuration)",
+                              child, node)
+                found["run"] = run
+                found["run_line"] = _line(child)
             elif name == "priority" and kind == "transition":
                 if not re.fullmatch(r"\s*[+-]?\d+\s*", text):
                     self.fail(f"priority must be a whole number, got {text!r}", child, node)
@@ -840,7 +859,9 @@ def _loads(data: str | bytes, path: str | None, stacklevel: int) -> Net:
         raise NetFormatError(f"PNML must be text or bytes, got {type(data).__name__}", path=path)
     root = _parse_xml(data, path)
     # warnings point at the caller of the public function: +1 for emit, read, _loads
-    return _Reader(root, path, stacklevel + 2).read()
+    net = _Reader(root, path, stacklevel + 2).read()
+    net.path = path
+    return net
 
 
 def load_pnml(path: str | Path) -> Net:

@@ -118,6 +118,11 @@ class _Writer:
                  label=self.check(subnet.label, "subnet label", subnet.id),
                  agent=self.check(subnet.agent, "subnet agent", subnet.id))
         self.meta(tool, net.meta, f"net {net.id!r}")
+        if net.run is not None:
+            run = _json_exact(net.run)
+            if run is None:
+                raise NetFormatError("the run configuration cannot be written as JSON", element=net.id)
+            _sub(tool, "run", run)
         if len(tool):
             net_element.append(tool)
         page = _sub(net_element, "page", id=self.fresh_id("page"))

@@ -4,8 +4,10 @@ The format is the constructor in data: every key maps onto an argument of
 :meth:`Net.add_place`, :meth:`Net.add_transition`, :meth:`Net.add_arc` or
 :func:`~petriflow.workflow.add_operator`. See ``docs/yaml-format.md``.
 
-Files are parsed with a safe loader (no Python tags) that records line numbers, so an
-error names the line: ``nets/relay.yaml:14: 't9': unknown place 'p9'``.
+Files are parsed with a safe loader (no Python tags; libyaml's C parser when PyYAML
+has it) into containers that record line numbers, so an error names the line:
+``nets/relay.yaml:14: 't9': unknown place 'p9'``. The reader keeps those lines on the
+net (:attr:`Net.lines`) for the errors found later, when actions are bound.
 
 Examples:
     >>> net = loads_net('''
@@ -37,7 +39,7 @@ __all__ = ["FORMAT_VERSION", "load_yaml", "loads_net", "dumps_net", "save_yaml",
 #: The version of the YAML format this module reads and writes.
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"petriflow", "net", "label", "subnets", "places", "transitions", "arcs", "final", "meta"}
+_TOP_KEYS = {"petriflow", "net", "label", "subnets", "places", "transitions", "arcs", "final", "meta", "run"}
 _SUBNET_KEYS = {"id", "label", "agent", "places", "transitions"}
 _PLACE_KEYS = {"id", "label", "tokens", "channel", "meta"}
 _TRANSITION_KEYS = {
@@ -48,37 +50,78 @@ _ARC_KEYS = {"from", "to", "weight", "id", "when"}
 
 
 class _LineDict(dict):
+    """A mapping that remembers its line and the line of each key."""
+
     line: int = 0
+    key_lines: dict[Any, int] = {}
 
 
 class _LineList(list):
     line: int = 0
 
 
-class _Loader(yaml.SafeLoader):
-    """SafeLoader that records line numbers and rejects duplicate keys."""
+_Composer = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+_STR = "tag:yaml.org,2002:str"
+_SEQ = "tag:yaml.org,2002:seq"
+_MAP = "tag:yaml.org,2002:map"
+_MERGE = "tag:yaml.org,2002:merge"
 
 
-def _construct_mapping(loader: _Loader, node: yaml.MappingNode) -> _LineDict:
-    loader.flatten_mapping(node)
-    result = _LineDict()
-    result.line = node.start_mark.line + 1
-    for key_node, value_node in node.value:
-        key = loader.construct_object(key_node, deep=True)
-        if key in result:
-            raise NetFormatError(f"duplicate key {key!r}", line=key_node.start_mark.line + 1)
-        result[key] = loader.construct_object(value_node, deep=True)
-    return result
+class _Builder:
+    """Turns composed YAML nodes into plain data with line numbers.
+
+    Composing is libyaml's (fast); building is this small walk: strings are taken as
+    they are, other scalars through PyYAML's safe constructor; a node reached twice
+    through an alias is built once and shared, so aliases never multiply work.
+    """
+
+    def __init__(self) -> None:
+        self.scalars = yaml.SafeLoader("")
+        self.built: dict[int, Any] = {}
+
+    def build(self, node: yaml.Node) -> Any:
+        kind = node.__class__
+        if kind is yaml.ScalarNode:
+            return node.value if node.tag == _STR else self.scalars.construct_object(node)
+        done = self.built.get(id(node))
+        if done is not None:
+            return done
+        if node.tag not in (_SEQ, _MAP):  # !!set, !!omap...: PyYAML's safe constructor, or its error
+            return self.scalars.construct_object(node, deep=True)
+        if kind is yaml.SequenceNode:
+            result = self.built[id(node)] = _LineList()
+            result.line = node.start_mark.line + 1
+            result.extend(self.build(child) for child in node.value)
+            return result
+        if kind is not yaml.MappingNode:  # pragma: no cover - the composer makes only these
+            raise NetFormatError(f"unexpected YAML node {node.tag}", line=node.start_mark.line + 1)
+        if any(key.tag == _MERGE for key, _ in node.value):
+            self.scalars.flatten_mapping(node)
+        mapping = self.built[id(node)] = _LineDict()
+        mapping.line = node.start_mark.line + 1
+        mapping.key_lines = {}
+        for key_node, value_node in node.value:
+            key = self.build(key_node)
+            try:
+                hash(key)
+            except TypeError:
+                raise NetFormatError("a mapping key must be a plain value", line=key_node.start_mark.line + 1) from None
+            if key in mapping:
+                raise NetFormatError(f"duplicate key {key!r}", line=key_node.start_mark.line + 1)
+            mapping.key_lines[key] = key_node.start_mark.line + 1
+            mapping[key] = self.build(value_node)
+        return mapping
 
 
-def _construct_sequence(loader: _Loader, node: yaml.SequenceNode) -> _LineList:
-    result = _LineList(loader.construct_object(child, deep=True) for child in node.value)
-    result.line = node.start_mark.line + 1
-    return result
+def parse_yaml(text: str) -> Any:
+    """Parse YAML text safely into data whose mappings and lists know their lines.
 
-
-_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
-_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _construct_sequence)
+    Raises:
+        yaml.YAMLError: malformed YAML.
+        NetFormatError: a duplicate key (with its line).
+    """
+    node = yaml.compose(text, Loader=_Composer)  # noqa: S506 - a safe composer: no tags are run
+    return None if node is None else _Builder().build(node)
 
 
 def _line(item: Any, default: int | None = None) -> int | None:
@@ -119,6 +162,13 @@ class _Reader:
             self.net.id = str(data["net"])
         self.net.label = data.get("label")
         self.net.meta = _plain(data.get("meta") or {})
+        if data.get("run") is not None:
+            run = data["run"]
+            if not isinstance(run, (str, dict)):
+                self.fail("'run' must name a run configuration file or be one (a mapping)", data,
+                          line=data.key_lines.get("run"))
+            self.net.run = _plain(run)
+            self.net.lines["run"] = data.key_lines.get("run", data.line)
         for subnet in self.as_list(data.get("subnets"), "subnets", data):
             self.read_subnet(subnet)
         places = self.as_list(data.get("places"), "places", data)
@@ -180,6 +230,7 @@ class _Reader:
             self.fail("'channel' must be a channel name (a string)", item, pid)
         self.net.add_place(pid, tokens=tokens, label=item.get("label"), subnet=subnet,
                            meta=_plain(item.get("meta") or {}), channel=channel)
+        self.net.lines[pid] = item.line
 
     def read_branches(self, value: Any, item: Any, tid: str, key: str) -> dict[str, int]:
         if value is None:
@@ -220,6 +271,7 @@ class _Reader:
         params = item.get("params") or {}
         if not isinstance(params, dict):
             self.fail("'params' must be a mapping", item, tid)
+        self.record_lines(tid, item, params)
         priority = item.get("priority", 0)
         if isinstance(priority, bool) or not isinstance(priority, int):
             self.fail(f"priority must be a whole number, got {priority!r}", item, tid)
@@ -289,6 +341,17 @@ class _Reader:
         except PetriflowError as exc:
             self.fail(str(exc), item, tid)
 
+    def record_lines(self, tid: str, item: Any, params: Any) -> None:
+        """Remember where the transition, its action, guard and parameters are written."""
+        lines = self.net.lines
+        lines[tid] = item.line
+        key_lines = getattr(item, "key_lines", {})
+        for key in ("action", "guard", "params"):
+            if key in key_lines:
+                lines[f"{tid}/{key}"] = key_lines[key]
+        for key, line in getattr(params, "key_lines", {}).items():
+            lines[f"{tid}/params/{key}"] = line
+
     def read_arc(self, item: Any) -> None:
         if isinstance(item, list) and len(item) in (2, 3):
             source, target = str(item[0]), str(item[1])
@@ -356,8 +419,9 @@ def loads_net(text: str, *, path: str | None = None, name: str | None = None) ->
     """
     default = name or (Path(path).stem if path else "net")
     try:
-        data = yaml.load(text, Loader=_Loader)  # noqa: S506 - _Loader is a SafeLoader
-        return _Reader(data, default).read()
+        net = _Reader(parse_yaml(text), default).read()
+        net.path = path
+        return net
     except NetFormatError as exc:
         raise exc.at(path) if path else exc from None
     except yaml.MarkedYAMLError as exc:
@@ -518,6 +582,8 @@ def net_to_dict(net: Net) -> dict[str, Any]:
         data["final"] = net.final_marking.to_dict()
     if net.meta:
         data["meta"] = net.meta
+    if net.run is not None:
+        data["run"] = net.run
     return data
 
 

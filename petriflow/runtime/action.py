@@ -1,15 +1,19 @@
 """What an action is: one lifecycle, a status enum, declared parameters.
 
 An action is what a transition does when it fires at run time. Its lifecycle follows
-py_trees and Petri Net Plans:
+py_trees and Petri Net Plans (each hook's docstring on :class:`Action` says when it is
+called and what raising or returning means):
 
-* ``setup(world)`` once per run, before the first start (open a camera, load a URDF);
+* ``setup(world)`` once per run, for every bound transition, before the first firing;
 * ``start(ctx)`` when the transition fires (its input tokens are already consumed);
-* ``poll(ctx) -> Status`` every scheduler tick until it returns ``OK`` or ``FAILED``
-  (non-blocking; the action reads the world and commands it, never sleeps);
-* ``cancel(ctx) -> bool`` when a cancellation region or a fault stops it; return
+* ``poll(ctx) -> Status`` until it returns ``OK`` or ``FAILED`` (non-blocking; the
+  action reads the world and commands it, never sleeps);
+* ``cancel(ctx) -> bool`` when a cancellation region, a timeout or a fault stops it;
   ``False`` while clean-up still needs more ticks, ``True`` once it is done;
 * ``teardown()`` once at the end of the run.
+
+An exception from any hook is never lost: it ends the firing with the ``failed``
+outcome and the exception as its reason, which the net routes like any failure.
 
 Most actions are easier to write as a generator function; :func:`generator_action`
 wraps one. It ``yield``\\ s to wait one world step, ``yield seconds`` to wait simulated
@@ -37,15 +41,16 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar, Generator
 
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
+from petriflow.outcome import Outcome
 
 __all__ = [
     "Status",
     "Outcome",
     "Param",
+    "Port",
     "Action",
     "ActionContext",
     "ActionFailure",
-    "ActionFailed",
     "generator_action",
     "REQUIRED",
 ]
@@ -55,17 +60,11 @@ class Status(enum.Enum):
     """What :meth:`Action.poll` returns."""
 
     RUNNING = "running"
+    """Not done yet: poll again later."""
     OK = "ok"
+    """Done: the transition's plain output arcs produce."""
     FAILED = "failed"
-
-
-class Outcome(str, enum.Enum):
-    """How a started action ended; selects the output arcs that produce tokens."""
-
-    OK = "ok"
-    FAILED = "failed"
-    TIMEOUT = "timeout"
-    CANCELLED = "cancelled"
+    """Failed: the ``failed`` arcs produce (``ctx.reason`` says why)."""
 
 
 REQUIRED = object()
@@ -74,7 +73,7 @@ REQUIRED = object()
 
 @dataclass(frozen=True)
 class Param:
-    """A declared action parameter, checked when a net is loaded.
+    """A declared action parameter, checked when a net is bound (loaded to run).
 
     Attributes:
         type: a type or tuple of types the value must have (``float`` accepts ints).
@@ -102,23 +101,58 @@ class Param:
         return value
 
 
+class Port(Param):
+    """A parameter naming a place whose tokens the action reads while it runs.
+
+    This is how an action shares state with others, as BehaviorTree.CPP's ports do:
+    the state is token data in a place of the net (written by the transitions that
+    produce into it), and the action declares that it reads it. Binding checks that
+    the place exists, so a typo fails before anything moves; :meth:`ActionContext.read`
+    and :meth:`ActionContext.latest` return what the place holds at that moment
+    without consuming it. A port left at ``None`` reads nothing.
+
+    Args:
+        doc: one line for ``petriflow actions``.
+        required: the net must name a place (default: a port may stay unconnected).
+
+    Examples:
+        >>> Port("the latest scene").check("scene", "S", where="walk")
+        'S'
+    """
+
+    def __init__(self, doc: str = "", *, required: bool = False) -> None:
+        super().__init__((str, type(None)), REQUIRED if required else None, doc)
+
+
 class ActionFailure(PetriflowError):
-    """Raised inside an action to end it with the ``failed`` outcome."""
+    """Raise it inside an action to end the firing with the ``failed`` outcome.
 
+    The message is the failure's reason (in the trace and in ``ctx.reason``). The
+    runtime raises it too, naming the net, transition and action, when a failure has
+    no ``failed`` arcs to take it and the run must stop.
 
-class ActionFailed(PetriflowError):
-    """An action failed and the net has no ``failed`` arcs to route the failure."""
+    Examples:
+        >>> str(ActionFailure("gripper jammed"))
+        'gripper jammed'
+        >>> str(ActionFailure("gripper jammed", net="cell", transition="grab", action="arm.pick"))
+        "net 'cell': transition 'grab': action 'arm.pick' failed: gripper jammed"
+    """
 
-    def __init__(self, net: str, transition: str, action: str, reason: str) -> None:
+    def __init__(self, reason: str = "", *, net: str | None = None, transition: str | None = None,
+                 action: str | None = None) -> None:
+        self.reason = reason
+        self.net = net
         self.transition = transition
         self.action = action
-        self.reason = reason
-        super().__init__(f"net {net!r}: transition {transition!r}: action {action!r} failed: {reason}")
+        if transition is None:
+            super().__init__(reason)
+        else:
+            super().__init__(f"net {net!r}: transition {transition!r}: action {action or '-'!r} failed: {reason}")
 
 
-@dataclass
+@dataclass(eq=False, slots=True)
 class ActionContext:
-    """What an action sees while it runs.
+    """What an action sees during one firing.
 
     Attributes:
         transition: id of the fired transition.
@@ -126,15 +160,15 @@ class ActionContext:
         params: the checked parameters.
         inputs: ``{place id: [token data, ...]}`` consumed by the firing.
         world: the world the run steps (``None`` in a world-less run).
-        rng: a random generator seeded from the run seed and the firing number
-            (made on first use from ``seed``).
+        seed: seed of this firing's :attr:`rng` (the run seed and the firing number).
         started: simulated time the action started.
-        now: current simulated time (updated by the scheduler before each poll).
+        now: current simulated time (updated by the scheduler before each call).
         result: data given to the output tokens (one value for all outputs, or a
             ``{place: data}`` dict when ``per_place`` is set).
         per_place: whether ``result`` maps output places to their token data.
+        outputs: ``{place: data}`` for output places whose tokens get other data than
+            ``result`` (see :meth:`put`).
         reason: why the action failed, when it did.
-        blackboard: run-wide shared dict (e.g. the last camera frame).
     """
 
     transition: str
@@ -147,10 +181,11 @@ class ActionContext:
     now: float = 0.0
     result: Any = None
     per_place: bool = False
+    outputs: dict[str, Any] | None = None
     reason: str = ""
-    blackboard: dict[str, Any] = field(default_factory=dict)
-    emitted: list[tuple[str, dict[str, Any]]] = field(default_factory=list)
-    _rng: random.Random | None = field(default=None, repr=False, compare=False)
+    emitted: list[tuple[str, dict[str, Any]]] | None = None
+    _rng: random.Random | None = field(default=None, repr=False)
+    _reader: Callable[[str], list[Any]] | None = field(default=None, repr=False)
 
     @property
     def rng(self) -> random.Random:
@@ -174,19 +209,53 @@ class ActionContext:
                     return data
         return None
 
+    def read(self, port: str) -> list[Any]:
+        """The data of the tokens now in the place the :class:`Port` ``port`` names
+        (oldest first; empty when the port names no place or the place is empty).
+
+        Raises:
+            PetriflowError: ``port`` is not a port the action declares.
+        """
+        place = self.params.get(port)
+        if place is None:
+            return []
+        if self._reader is None:
+            raise PetriflowError(f"{self.transition!r}: no run to read port {port!r} from")
+        return self._reader(place)
+
+    def latest(self, port: str, default: Any = None) -> Any:
+        """The data of the newest token in the port's place, or ``default``."""
+        tokens = self.read(port)
+        return tokens[-1] if tokens else default
+
+    def put(self, place: str, data: Any) -> None:
+        """Give the tokens this firing produces in ``place`` the data ``data`` instead
+        of :attr:`result` (e.g. a state token taken and given back updated)."""
+        if self.outputs is None:
+            self.outputs = {}
+        self.outputs[place] = data
+
     def emit(self, kind: str, **data: Any) -> None:
-        """Record a custom event (it goes into the run's trace)."""
+        """Record a custom event (it goes into the run's trace when the firing ends)."""
+        if self.emitted is None:
+            self.emitted = []
         self.emitted.append((kind, data))
 
 
 class Action:
-    """Base class of class-style actions. Subclasses override the lifecycle methods.
+    """Base class of class-style actions: override the lifecycle hooks you need.
+
+    The scheduler makes one instance per bound transition per run, so an instance may
+    keep what it learns across that transition's firings (a robot handle, a counter);
+    what it shares with other transitions goes into tokens.
 
     Attributes:
-        params: class attribute ``{name: Param}`` declaring the parameters; on an
-            instance, the checked values.
-        needs_world: whether the action must be polled every world step (True) or
+        params: class attribute ``{name: Param}`` declaring the parameters (and
+            :class:`Port`\\ s); on an instance, the checked values.
+        needs_world: whether the action must be polled at every world step (True) or
             only at the times it asks for through :attr:`wake_at` (False).
+        wake_at: for ``needs_world = False``: the simulated time of the next poll
+            (``None``: the next tick).
     """
 
     params: ClassVar[dict[str, Param]] = {}
@@ -206,13 +275,17 @@ class Action:
         declared = cls.params
         checked: dict[str, Any] = {}
         for name, value in given.items():
-            if name not in declared:
-                raise NetFormatError(
-                    f"action has no parameter {name!r}{did_you_mean(name, declared)}"
-                    f" (it takes: {', '.join(declared) or 'none'})",
-                    element=where,
-                )
-            checked[name] = declared[name].check(name, value, where)
+            try:
+                if name not in declared:
+                    raise NetFormatError(
+                        f"action has no parameter {name!r}{did_you_mean(name, declared)}"
+                        f" (it takes: {', '.join(declared) or 'none'})",
+                        element=where,
+                    )
+                checked[name] = declared[name].check(name, value, where)
+            except NetFormatError as exc:
+                exc.param = name  # so binding can name the parameter's line
+                raise
         for name, param in declared.items():
             if name not in checked:
                 if param.default is REQUIRED:
@@ -220,22 +293,70 @@ class Action:
                 checked[name] = param.default
         return checked
 
+    @classmethod
+    def ports(cls) -> list[str]:
+        """Names of the declared :class:`Port` parameters."""
+        return [name for name, param in cls.params.items() if isinstance(param, Port)]
+
     def setup(self, world: Any) -> None:
-        """Prepare once per run (the world exists, nothing has fired yet)."""
+        """Prepare, once per run, before the first firing of any transition.
+
+        Called for every bound transition when the run starts, with the run's world
+        (``None`` in a world-less run): open devices, look up bodies, check that the
+        world has what the action needs. Nothing has fired yet and simulated time is 0.
+
+        Raising (e.g. :class:`ActionFailure` "needs a world") does not stop the run:
+        each later firing of this transition ends at once with the ``failed``
+        outcome and this reason, and the net routes it.
+        """
 
     def start(self, ctx: ActionContext) -> None:
-        """Begin; the transition's input tokens are already consumed."""
+        """Begin one firing; called when the transition fires.
+
+        The input tokens are already consumed (``ctx.inputs``) and the cancellation
+        region already applied. Set ``ctx.result`` here for an action that is done at
+        once; :meth:`poll` is called right after, in the same instant.
+
+        Raising ends the firing with the ``failed`` outcome and the exception as its
+        reason (``ctx.reason``); :meth:`poll` is then not called.
+        """
 
     def poll(self, ctx: ActionContext) -> Status:
-        """Advance one tick and say whether the action is done."""
+        """Advance the action and say whether it is done.
+
+        Called right after :meth:`start` (in the same instant; for an action with
+        ``needs_world`` unset whose :meth:`start` set :attr:`wake_at` ahead, first at
+        that time), then at every world step while ``needs_world`` is set, else when
+        :attr:`wake_at` comes (or the next tick if it is ``None``). ``ctx.now`` is the
+        current simulated time. Never block or sleep: command the world and return.
+
+        Returns:
+            ``Status.RUNNING`` to be polled again, ``Status.OK`` when done (set
+            ``ctx.result`` for the output tokens' data), ``Status.FAILED`` to fail
+            (set ``ctx.reason``). Anything else, or raising, fails the firing with
+            the reason.
+        """
         return Status.OK
 
     def cancel(self, ctx: ActionContext) -> bool:
-        """Stop; return False while clean-up needs more ticks."""
+        """Stop: a cancellation region, the transition's timeout or a fault (an agent
+        killed) ends the firing early.
+
+        Called instead of :meth:`poll` until it returns ``True``, once per tick: return
+        ``False`` while clean-up (e.g. bringing a robot to rest) needs more ticks. The
+        firing then ends with the ``cancelled`` (or ``timeout``) outcome.
+
+        Raising ends the clean-up at once with the ``failed`` outcome and the
+        exception as its reason.
+        """
         return True
 
     def teardown(self) -> None:
-        """Release what :meth:`setup` took."""
+        """Release what :meth:`setup` took; once, when the run ends (however it ends).
+
+        Raising does not change how the run ended: the error is recorded in the run's
+        ``stop`` event (``teardown_errors``) and the other actions are still torn down.
+        """
 
 
 def generator_action(

@@ -38,7 +38,7 @@ def set_data(ctx) -> Any:
     return ctx.params["value"]
 
 
-def has_data(tokens, params, blackboard) -> bool:
+def has_data(tokens, params) -> bool:
     """Guard: every consumed token carries data (is not a plain black token)."""
     return all(data is not None for items in tokens.values() for data in items)
 

@@ -2,8 +2,15 @@
 
 A place with ``channel: NAME`` stands for messages between agents. When a transition
 puts a token there, the run's channel model for ``NAME`` decides whether the message
-arrives and after how long; the token appears in the place only on delivery. Models
-are plain classes with one method, so scenarios can bring their own:
+arrives and after how long; the token appears in the place only on delivery.
+:class:`Channels` is the run's component that does this: it asks the model, records
+the message's fate, and schedules a :class:`Delivery` event on the run's kernel.
+
+The sender is the agent of the transition that produced the token; the receiver is
+the agent of the transitions that consume from the place (when they all belong to
+one agent), else the agent of the place's own subnet.
+
+Models are plain classes with one method, so scenarios can bring their own:
 
 * :class:`IdealChannel`: every message arrives after a fixed latency;
 * :class:`RangeChannel`: radio with a log-distance path-loss model; a message is
@@ -22,21 +29,40 @@ Examples:
 
 from __future__ import annotations
 
+import enum
 import math
+import random
 from dataclasses import dataclass
 from typing import Any, Callable
 
 from petriflow.errors import NetFormatError, did_you_mean
+from petriflow.net import Net
+from petriflow.runtime.kernel import APPLY, Scheduled
 
 __all__ = [
     "Message",
+    "Fate",
     "ChannelModel",
     "IdealChannel",
     "RangeChannel",
     "BusChannel",
     "CHANNEL_MODELS",
     "build_channel",
+    "Channels",
+    "Delivery",
+    "receivers",
 ]
+
+
+class Fate(str, enum.Enum):
+    """What became of a message (the ``fate`` of a ``message`` event)."""
+
+    SENT = "sent"
+    DELIVERED = "delivered"
+    LOST = "lost"
+
+    def __str__(self) -> str:
+        return self.value
 
 
 @dataclass
@@ -173,3 +199,117 @@ def build_channel(name: str, spec: dict[str, Any], where: str = "channels") -> C
     except TypeError as exc:
         raise NetFormatError(f"bad parameters for channel model {model!r}: {exc}",
                              element=f"{where}.{name}") from None
+
+
+def receivers(net: Net) -> dict[str, str | None]:
+    """``{channel place: receiving agent}``: the agent of the transitions that take from
+    the place when they all belong to one, else the agent of the place's subnet.
+
+    Examples:
+        >>> from petriflow.io.yaml import loads_net
+        >>> net = loads_net('''
+        ... petriflow: 1
+        ... subnets:
+        ...   - {id: a, places: [{id: out, channel: radio}], transitions: [{id: send, out: [out]}]}
+        ...   - {id: b, transitions: [{id: take, in: [out]}]}
+        ... ''')
+        >>> receivers(net)
+        {'out': 'b'}
+    """
+    agent_of = {s.id: s.agent or s.id for s in net.subnets.values()}
+    found: dict[str, str | None] = {}
+    for place in net.places.values():
+        if place.channel is None:
+            continue
+        takers = {agent_of[net.transitions[t].subnet] if net.transitions[t].subnet else None
+                  for t in net.place_postset(place.id)}
+        takers.discard(None)
+        if len(takers) == 1:
+            found[place.id] = takers.pop()
+        else:
+            found[place.id] = agent_of.get(place.subnet) if place.subnet else None
+    return found
+
+
+class Delivery(Scheduled):
+    """A message arrives in its channel place (scheduled by :meth:`Channels.send`)."""
+
+    __slots__ = ("channels", "place", "data", "sender")
+    phase = APPLY
+
+    def __init__(self, channels: "Channels", place: str, data: Any, sender: str | None) -> None:
+        self.channels = channels
+        self.place = place
+        self.data = data
+        self.sender = sender
+
+    def apply(self, tick: int) -> None:
+        self.channels.arrive(self)
+
+
+def _size(data: Any) -> int:
+    """Bytes a message counts: the data's ``size`` (attribute or key), else 16."""
+    if isinstance(data, dict):
+        size = data.get("size")
+        return size if isinstance(size, int) and not isinstance(size, bool) and size > 0 else 16
+    if isinstance(data, list):
+        return 16
+    size = getattr(data, "size", 0)
+    return int(size) if isinstance(size, (int, float)) and size > 0 else 16
+
+
+class Channels:
+    """A run's channel places: every token put into one is a message that a model
+    delivers after a delay, or loses.
+
+    Args:
+        run: the scheduler (its ``kernel``, ``world``, ``faults``, ``emit`` and
+            ``deliver`` are used).
+        models: ``{channel name: ChannelModel}``; a channel with none is ideal.
+        seed: the run seed (losses are drawn from a generator of their own).
+    """
+
+    def __init__(self, run: Any, models: dict[str, ChannelModel], seed: Any) -> None:
+        self.run = run
+        self.models = dict(models)
+        self.rng = random.Random(f"{seed}:channels")
+        self.receiver = receivers(run.net)
+        self.channel = {p.id: p.channel for p in run.net.places.values() if p.channel is not None}
+
+    def send(self, place: str, data: Any, sender: str | None) -> None:
+        """Put a message into ``place``: record it and schedule its delivery, or its loss."""
+        run = self.run
+        channel = self.channel[place]
+        receiver = self.receiver[place]
+        model = self.models.get(channel)
+        if model is None:
+            model = self.models[channel] = IdealChannel()
+        distance = None
+        world = run.world
+        if sender and receiver and hasattr(world, "distance"):
+            distance = world.distance(sender, receiver)
+        now = run.kernel.now
+        message = Message(place, sender, receiver, data, now, _size(data), distance)
+        faults = run.faults
+        if faults.link_down(sender, receiver):
+            delay, why = None, "link down"
+        elif receiver is not None and not faults.alive(receiver):
+            delay, why = None, "receiver not running"
+        else:
+            delay, why = model.deliver(message, self.rng), "channel model"
+        info: dict[str, Any] = {"place": place, "channel": channel, "receiver": receiver, "size": message.size}
+        if distance is not None:
+            info["distance"] = round(distance, 6)
+        if delay is None:
+            run.emit("message", None, sender, fate=Fate.LOST.value, why=why, **info)
+            return
+        kernel = run.kernel
+        arrival = kernel.ticks_at(now + delay)
+        run.emit("message", None, sender, fate=Fate.SENT.value, arrival=round(arrival * kernel.dt, 9), **info)
+        kernel.schedule(arrival, Delivery(self, place, data, sender))
+
+    def arrive(self, delivery: Delivery) -> None:
+        """A message reaches its place: the token appears there."""
+        self.run.deliver(delivery.place, delivery.data)
+        self.run.emit("message", None, delivery.sender, fate=Fate.DELIVERED.value, place=delivery.place,
+                      channel=self.channel[delivery.place])

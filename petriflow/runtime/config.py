@@ -1,11 +1,13 @@
 """The run configuration: seed, limits, channel models, injected faults, world file.
 
-Written as YAML (``run.yaml`` beside a net) or built in code::
+Written as YAML (a file the net names with ``run: FILE``, ``run.yaml`` beside a net,
+or the net's own ``run:`` mapping) or built in code::
 
     seed: 1
     until: 120          # simulated seconds
     dt: 0.01            # tick when no world sets one
     world: world.yaml   # relative to this file
+    actions: [my_actions]   # modules that register actions: beside this file or importable
     channels:
       radio: {model: range, threshold_dbm: -63.4375}
     faults:
@@ -21,6 +23,9 @@ Examples:
 
 from __future__ import annotations
 
+import enum
+import importlib
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,10 +34,28 @@ from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.channels import ChannelModel, build_channel
 
-__all__ = ["RunConfig", "Fault", "load_config"]
+__all__ = ["RunConfig", "Fault", "FaultKind", "load_config"]
 
-_KEYS = {"seed", "until", "dt", "world", "channels", "faults"}
-_FAULT_KINDS = ("kill", "join", "drop_link")
+_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions"}
+
+
+class FaultKind(str, enum.Enum):
+    """The faults a run configuration can inject."""
+
+    KILL = "kill"
+    """The agent stops: its running actions are cancelled, its transitions never fire again."""
+    JOIN = "join"
+    """The agent only starts at the fault's time (a late joiner)."""
+    DROP_LINK = "drop_link"
+    """Messages between the two agents are lost from ``at`` until ``until``."""
+    RESTORE_LINK = "restore_link"
+    """In traces only: a dropped link works again (at its ``until``)."""
+
+    def __str__(self) -> str:
+        return self.value
+
+
+_FAULT_KINDS = (FaultKind.KILL.value, FaultKind.JOIN.value, FaultKind.DROP_LINK.value)
 
 
 @dataclass(frozen=True)
@@ -40,9 +63,10 @@ class Fault:
     """A fault injected at simulated time ``at``.
 
     Attributes:
-        kind: ``kill`` (the agent stops and its running actions are cancelled),
-            ``join`` (the agent only starts at ``at``), or ``drop_link`` (messages
-            between the two agents of ``link`` are lost from ``at`` to ``until``).
+        kind: a :class:`FaultKind` value: ``kill`` (the agent stops and its running
+            actions are cancelled), ``join`` (the agent only starts at ``at``), or
+            ``drop_link`` (messages between the two agents of ``link`` are lost from
+            ``at`` to ``until``).
     """
 
     kind: str
@@ -54,7 +78,20 @@ class Fault:
 
 @dataclass
 class RunConfig:
-    """Everything about a run that is not the net."""
+    """Everything about a run that is not the net.
+
+    Attributes:
+        seed: the run seed.
+        until: simulated-time limit in seconds (``None``: none).
+        dt: seconds per tick when the world sets none.
+        world: the world file (resolved against the configuration's folder).
+        channels: ``{channel: model spec}``.
+        faults: the faults to inject.
+        path: the configuration's file, named in errors.
+        actions: modules that register the actions the net uses, imported before
+            binding (:meth:`import_actions`): absolute ``.py`` paths (modules found
+            beside the configuration) or importable module names.
+    """
 
     seed: int = 0
     until: float | None = None
@@ -63,13 +100,22 @@ class RunConfig:
     channels: dict[str, dict[str, Any]] = field(default_factory=dict)
     faults: list[Fault] = field(default_factory=list)
     path: str | None = None
+    actions: list[str] = field(default_factory=list)
 
     @classmethod
-    def from_dict(cls, data: Any, path: str | None = None) -> "RunConfig":
-        """Build from parsed YAML; errors name ``path`` and the bad key."""
+    def from_dict(cls, data: Any, path: str | None = None, *, base: str | None = None) -> "RunConfig":
+        """Build from parsed YAML; errors name ``path`` and the bad key.
+
+        Args:
+            data: the parsed configuration.
+            path: its file (named in errors).
+            base: the folder relative paths resolve against (default: ``path``'s).
+        """
 
         def fail(message: str, element: str | None = None):
             raise NetFormatError(message, path=path, element=element)
+
+        folder = Path(base) if base is not None else (Path(path).parent if path is not None else None)
 
         if data is None:
             data = {}
@@ -92,12 +138,35 @@ class RunConfig:
             fail("channels must map a channel name to its model, e.g. {radio: {model: range}}")
         faults = [cls._fault(entry, fail) for entry in data.get("faults") or []]
         world = data.get("world")
-        if world is not None and path is not None:
-            world = str(Path(path).parent / world)
+        if world is not None and not isinstance(world, str):
+            fail(f"world must be a file name, got {world!r}")
+        if world is not None and folder is not None:
+            world = str(folder / world)
+        actions = data.get("actions") or []
+        if isinstance(actions, str):
+            actions = [actions]
+        if not isinstance(actions, list) or not all(isinstance(a, str) and a.strip() for a in actions):
+            fail(f"actions must list modules (names or .py files), got {actions!r}")
         config = cls(seed, None if until is None else float(until), float(dt), world,
-                     {str(k): dict(v) for k, v in channels.items()}, faults, path)
+                     {str(k): dict(v) for k, v in channels.items()}, faults, path,
+                     [_locate_module(a, folder) for a in actions])
         config.channel_models()  # fail early on a bad model
         return config
+
+    def import_actions(self) -> None:
+        """Import the modules of :attr:`actions` (each registers its actions when
+        imported; one already imported is not imported again).
+
+        Raises:
+            NetFormatError: a module cannot be found or fails to import, naming the
+                configuration and the import error.
+        """
+        for entry in self.actions:
+            try:
+                _import_module(entry)
+            except Exception as exc:
+                raise NetFormatError(f"cannot import action module {entry!r}: {type(exc).__name__}: {exc}",
+                                     path=self.path, element="actions") from None
 
     @staticmethod
     def _fault(entry: Any, fail) -> Fault:
@@ -162,7 +231,47 @@ class RunConfig:
                 entry["until"] = f.until
             faults.append(entry)
         return {"seed": self.seed, "until": self.until, "dt": self.dt, "world": self.world,
-                "channels": self.channels, "faults": faults}
+                "channels": self.channels, "faults": faults, "actions": list(self.actions)}
+
+
+def _locate_module(entry: str, folder: Path | None) -> str:
+    """An action module entry as stored: an absolute path when it is a ``.py`` file or
+    a module (file or package) found in ``folder``, else the module name as given."""
+    entry = entry.strip()
+    if entry.endswith(".py"):
+        file = Path(entry) if folder is None or Path(entry).is_absolute() else folder / entry
+        return str(file.resolve())
+    if folder is not None and entry.isidentifier():
+        if (folder / f"{entry}.py").is_file():
+            return str((folder / f"{entry}.py").resolve())
+        if (folder / entry / "__init__.py").is_file():
+            return str((folder / entry).resolve())
+    return entry
+
+
+def _import_module(entry: str) -> None:
+    """Import an action module: a file or package folder path, or a module name."""
+    path = Path(entry)
+    if entry.endswith(".py") or path.is_absolute():
+        folder, name = (path.parent, path.stem) if entry.endswith(".py") else (path.parent, path.name)
+        if not (path.is_file() or (path / "__init__.py").is_file()):
+            raise FileNotFoundError(f"no such file: {entry}")
+        loaded = sys.modules.get(name)
+        if loaded is not None:
+            where = Path(getattr(loaded, "__file__", "") or "").resolve()
+            if where not in (path.resolve(), (path / "__init__.py").resolve()):
+                raise ImportError(f"another module named {name!r} is already imported (from {where})")
+            return
+        sys.path.insert(0, str(folder))
+        try:
+            importlib.import_module(name)
+        finally:
+            try:
+                sys.path.remove(str(folder))
+            except ValueError:
+                pass
+        return
+    importlib.import_module(entry)
 
 
 def load_config(path: str | Path) -> RunConfig:

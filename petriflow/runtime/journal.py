@@ -75,30 +75,45 @@ class Journal:
                 raise JournalError(f"{self.path}: not a petriflow journal (no run inputs)")
             self.inputs = json.loads(rows["inputs"])
             self.finished = rows.get("finished") == "1"
-            self._lines = [line for (line,) in self._db.execute("SELECT line FROM event ORDER BY seq")]
+            self.journaled = self._db.execute("SELECT count(*) FROM event").fetchone()[0]
         else:
             self.inputs = inputs
             self.finished = False
-            self._lines = []
+            self.journaled = 0
             with self._db:
                 self._db.execute("BEGIN")
                 self._db.execute("INSERT INTO run VALUES ('inputs', ?)", (json.dumps(inputs, sort_keys=True),))
-        self.journaled = len(self._lines)
+        # Re-executed events are checked against the journal in chunks read on demand,
+        # so neither a new run nor a resumed one holds the whole journal in memory.
+        self._chunk: list[str] = []
+        self._chunk_start = 0
 
     def events(self) -> list[Event]:
         """The events in the journal (committed ones only)."""
-        return [Event.from_dict(json.loads(line)) for line in self._lines]
+        return [Event.from_dict(json.loads(line))
+                for (line,) in self._db.execute("SELECT line FROM event ORDER BY seq")]
+
+    def _journaled_line(self, seq: int) -> str:
+        offset = seq - self._chunk_start
+        if not 0 <= offset < len(self._chunk):
+            self._chunk_start = seq
+            self._chunk = [line for (line,) in self._db.execute(
+                "SELECT line FROM event WHERE seq >= ? ORDER BY seq LIMIT 4096", (seq,))]
+            offset = 0
+        return self._chunk[offset]
 
     def record(self, event: Event) -> None:
         """Check a re-executed event against the journal, or buffer a new one."""
         line = event.to_json()
         if event.seq < self.journaled:
-            if self._lines[event.seq] != line:
+            journaled = self._journaled_line(event.seq)
+            if journaled != line:
                 raise ResumeMismatch(
                     f"{self.path}: event {event.seq} differs on re-execution:\n"
-                    f"  journal: {self._lines[event.seq]}\n  now:     {line}"
+                    f"  journal: {journaled}\n  now:     {line}"
                 )
             return
+        self._chunk = []
         self._pending.append(event)
 
     def commit(self) -> None:
@@ -111,8 +126,7 @@ class Journal:
                 "INSERT INTO event (seq, line) VALUES (?, ?)",
                 [(e.seq, e.to_json()) for e in self._pending],
             )
-        self._lines.extend(e.to_json() for e in self._pending)
-        self.journaled = len(self._lines)
+        self.journaled += len(self._pending)
         self._pending.clear()
 
     def finish(self) -> None:

@@ -9,8 +9,9 @@ never names code. Names resolve only through a :class:`Registry`, which knows:
   registers its package's actions; ``petriflow.agents`` and ``petriflow.vision`` ship
   one). So the core finds robot actions without importing robotics code.
 
-Binding is checked when a net is loaded (:meth:`Registry.bind`): an unknown action, a
-misspelt parameter or a missing guard fails before anything moves.
+A net is bound against a registry when it is loaded to run, check or show
+(:func:`petriflow.runtime.binding.bind`): an unknown action, a misspelt parameter or a
+missing guard fails before anything moves, naming the file and line.
 
 Examples:
     >>> registry = Registry(load_plugins=False)
@@ -33,11 +34,12 @@ from dataclasses import dataclass
 from importlib.metadata import entry_points
 from typing import Any, Callable
 
-from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
+from petriflow.errors import PetriflowError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, Param, generator_action
 
-__all__ = ["Registry", "ActionSpec", "UnknownActionError", "default_registry", "ENTRY_POINT_GROUP"]
+__all__ = ["Registry", "ActionSpec", "UnknownActionError", "default_registry", "ENTRY_POINT_GROUP", "action",
+           "guard"]
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +47,8 @@ log = logging.getLogger(__name__)
 ENTRY_POINT_GROUP = "petriflow.actions"
 
 Predicate = Callable[..., bool]
+"""A guard: ``f(tokens, params) -> bool`` over ``{place: [data, ...]}`` of the tokens a
+firing would take and the guarded transition's parameters."""
 
 
 class UnknownActionError(PetriflowError):
@@ -86,6 +90,8 @@ class Registry:
         self._actions: dict[str, ActionSpec] = {}
         self._predicates: dict[str, Predicate] = {}
         self._plugins_pending = load_plugins
+        #: ``{entry point: error}`` of the plugins that failed to load.
+        self.broken: dict[str, str] = {}
 
     # Registering --------------------------------------------------------------------
     def register(self, name: str, target: type[Action] | str, *, doc: str = "",
@@ -109,9 +115,11 @@ class Registry:
         return decorate
 
     def predicate(self, name: str, *, replace: bool = False) -> Callable[[Predicate], Predicate]:
-        """Decorator registering a guard predicate ``f(tokens, params, blackboard) -> bool``.
+        """Decorator registering a guard predicate ``f(tokens, params) -> bool``.
 
-        ``tokens`` is ``{place: [data, ...]}`` of the tokens the firing would consume.
+        ``tokens`` is ``{place: [data, ...]}`` of the tokens the firing would consume
+        and ``params`` the guarded transition's parameters. A guard sees nothing else:
+        what it decides on travels in tokens, so the net shows it.
         """
 
         def decorate(function: Predicate) -> Predicate:
@@ -131,7 +139,17 @@ class Registry:
             try:
                 entry.load()(self)
             except Exception as exc:  # a broken plugin must not hide the others
+                self.broken[entry.name] = f"{type(exc).__name__}: {exc}"
                 log.warning("action plugin %s failed to load: %s", entry.name, exc)
+
+    def _unknown(self, kind: str, name: str, known) -> UnknownActionError:
+        """The error for an unknown name: close matches, and any plugin that failed to
+        load (its names may be the one asked for)."""
+        message = f"unknown {kind} {name!r}{did_you_mean(name, known)}"
+        if self.broken:
+            failed = "; ".join(f"plugin {plugin!r} failed to load: {why}" for plugin, why in self.broken.items())
+            message += f" ({failed})"
+        return UnknownActionError(message)
 
     def names(self) -> list[str]:
         """Registered action names, sorted."""
@@ -152,40 +170,21 @@ class Registry:
         self._load_plugins()
         spec = self._actions.get(name)
         if spec is None:
-            raise UnknownActionError(f"unknown action {name!r}{did_you_mean(name, self._actions)}")
+            raise self._unknown("action", name, self._actions)
         return spec.load()
 
     def guard(self, name: str) -> Predicate:
         """The predicate registered as ``name`` (UnknownActionError with hints if none)."""
         self._load_plugins()
         if name not in self._predicates:
-            raise UnknownActionError(f"unknown guard {name!r}{did_you_mean(name, self._predicates)}")
+            raise self._unknown("guard", name, self._predicates)
         return self._predicates[name]
 
-    def bind(self, net: Net, path: str | None = None) -> dict[str, tuple[type[Action], dict[str, Any]]]:
-        """Resolve every bound transition of ``net`` and check its parameters.
+    def bind(self, net: Net, path: str | None = None):
+        """Bind ``net``'s transitions to this registry (:func:`petriflow.runtime.binding.bind`)."""
+        from petriflow.runtime.binding import bind
 
-        Returns:
-            ``{transition id: (Action class, checked params)}`` for bound transitions.
-
-        Raises:
-            NetFormatError: naming the file (``path``) and transition, for an unknown
-                action or guard or a bad parameter.
-        """
-        bound: dict[str, tuple[type[Action], dict[str, Any]]] = {}
-        for transition in net.transitions.values():
-            try:
-                if transition.guard is not None:
-                    self.guard(transition.guard)
-                if transition.action is None:
-                    continue
-                cls = self.resolve(transition.action)
-                bound[transition.id] = (cls, cls.check_params(transition.params, transition.id))
-            except UnknownActionError as exc:
-                raise NetFormatError(str(exc), path=path, element=transition.id) from None
-            except NetFormatError as exc:
-                raise NetFormatError(exc.message, path=path, element=transition.id) from None
-        return bound
+        return bind(net, self, path=path)
 
 
 default_registry = Registry()
@@ -199,3 +198,47 @@ def _register_core(registry: Registry) -> None:
 
 
 _register_core(default_registry)
+
+
+def action(name: str, params: dict[str, Param] | None = None, *, needs_world: bool = False,
+           replace: bool = False, registry: Registry | None = None) -> Callable:
+    """Decorator registering an action under ``name`` (in the run registry by default).
+
+    It takes a function ``f(ctx)`` (done at once, its return value the result), a
+    generator function (``yield`` waits one world step, ``yield seconds`` waits that
+    much simulated time, ``return value`` finishes), or an :class:`Action` subclass
+    (which declares its own ``params``). Raise
+    :class:`~petriflow.runtime.action.ActionFailure` to fail.
+
+    Args:
+        name: the name nets use (``action: name``).
+        params: the declared parameters of a function (``{name: Param}``).
+        needs_world: poll a generator at every world step (it moves something).
+        replace: replace an action already registered under ``name``.
+        registry: the registry (default: the one ``petriflow run`` uses).
+
+    Examples:
+        >>> from petriflow import Param, action
+        >>> @action("demo.charge", params={"minutes": Param(float, 5.0)}, registry=Registry(False))
+        ... def charge(ctx):
+        ...     yield ctx.params["minutes"] * 60
+        ...     return {"battery": 1.0}
+    """
+    target_registry = registry or default_registry
+
+    def decorate(target: Any) -> Any:
+        if isinstance(target, type) and issubclass(target, Action):
+            if params is not None:
+                raise PetriflowError(f"action {name!r}: an Action class declares its own params")
+            target_registry.register(name, target, replace=replace)
+        else:
+            target_registry.action(name, params, needs_world=needs_world, replace=replace)(target)
+        return target
+
+    return decorate
+
+
+def guard(name: str, *, replace: bool = False, registry: Registry | None = None) -> Callable:
+    """Decorator registering a guard ``f(tokens, params) -> bool`` under ``name``
+    (in the run registry by default); see :meth:`Registry.predicate`."""
+    return (registry or default_registry).predicate(name, replace=replace)

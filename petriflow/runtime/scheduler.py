@@ -1,22 +1,33 @@
-"""The discrete-event scheduler: the net decides when agents act.
+"""The scheduler: the net decides when agents act.
 
-One loop, readable in a sitting (after SimPy):
+A run is a sequence of *instants*, each at a tick of the :class:`~.kernel.Kernel`'s
+clock. At an instant, in this order:
 
-1. **Fire** every transition that can fire at the current instant, one at a time:
-   among the enabled ones (enough tokens, guard true, agent alive, its action not
-   already running) the highest ``priority`` wins, ties are broken by the run's
-   seeded random generator. Firing consumes the input tokens, applies the
-   cancellation region, and starts the bound action.
-2. **Advance** simulated time by one tick (the world's ``dt``) when an action that
-   needs the world is running, or jump straight to the next wake-up, delivery or
-   fault otherwise; the world is stepped to the new time either way.
-3. **Poll** running actions; an action that ends produces the output tokens of its
-   outcome (``ok``, ``failed``, ``timeout``, ``cancelled``). Tokens put into a channel
-   place go through the channel's model and appear on delivery, or never.
+1. **Advance**: the world steps up to the instant's tick (a run with no world jumps).
+2. **Poll**: the running actions due now are polled, in firing order: those that asked
+   for this time (``wake_at``), those that step with the world (``needs_world``),
+   those cleaning up after a cancellation, and those whose transition's ``timeout``
+   ran out (:meth:`Action.cancel` instead of :meth:`Action.poll`). An action that ends
+   produces the output tokens of its outcome (``ok``, ``failed``, ``timeout``,
+   ``cancelled``) by the net's outcome arcs.
+3. **Apply**: events from outside the firings apply in the order they were scheduled:
+   messages delivered into channel places (:class:`~.channels.Channels`), faults
+   (:class:`~.faults.Faults`).
+4. **Fire**: every transition that can fire now fires, one at a time: among the
+   enabled ones (enough tokens, guard true, agent alive, its action not already
+   running) the highest ``priority`` wins, ties are broken by one draw of the run's
+   seeded generator. Firing consumes the input tokens, applies the cancellation
+   region, and starts the bound action (which may end in the same instant).
 
-Time is an integer count of ticks, so the same net, world, configuration and seed give
-the same events bit for bit. Each transition runs one action at a time (a robot walks
-one walk at a time): a transition whose action is running is not enabled.
+Enabling and firing follow :mod:`petriflow.engine`'s rule (the compiled net's
+``consume`` at the start of a firing, ``produce`` at its end). The enabled set is
+kept up to date incrementally: only the transitions that read a place whose tokens
+changed, or whose own state changed, are checked again. So the work per firing, per
+poll and per message does not grow with the number of agents.
+
+Time is an integer count of ticks, so the same net, world, configuration and seed
+give the same events bit for bit. Each transition runs one action at a time (a robot
+walks one walk at a time): a transition whose action is running is not enabled.
 
 Examples:
     >>> from petriflow.io.yaml import loads_net
@@ -28,28 +39,35 @@ Examples:
     >>> run = Scheduler(net, seed=1)
     >>> result = run.run()
     >>> result.reason, result.time, result.marking
-    ('dead', 2.0, Marking({'o': 1}))
+    (<StopReason.DEAD: 'dead'>, 2.0, Marking({'o': 1}))
+    >>> run = Scheduler(net, seed=1)
+    >>> run.peek(), run.step(), run.peek(), run.running()
+    (0.0, None, 2.0, ['rest'])
 """
 
 from __future__ import annotations
 
-import math
 import random
 import time as wallclock
-from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 from petriflow.net import Net
-from petriflow.runtime.action import Action, ActionContext, ActionFailed, Outcome, Status
-from petriflow.runtime.channels import ChannelModel, IdealChannel, Message
-from petriflow.runtime.config import Fault, RunConfig
-from petriflow.runtime.registry import Registry, default_registry
-from petriflow.runtime.trace import Event, summarize
+from petriflow.outcome import Outcome, StopReason
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, Status
+from petriflow.runtime.binding import Binding, bind
+from petriflow.runtime.channels import Channels
+from petriflow.runtime.config import RunConfig
+from petriflow.runtime.faults import Faults
+from petriflow.runtime.kernel import POLL, Deadline, Kernel, Scheduled
+from petriflow.runtime.registry import Registry
+from petriflow.runtime.tokens import Agenda, TokenStore
+from petriflow.runtime.trace import Event, EventKind, summarize
 
-__all__ = ["Scheduler", "RunResult", "ZenoError"]
+__all__ = ["Scheduler", "RunResult", "ZenoError", "EmptySchedule", "MAX_FIRINGS_PER_INSTANT"]
 
 #: Firings allowed at one instant before the run is declared Zeno (an endless
 #: cascade of instant transitions).
@@ -57,9 +75,24 @@ MAX_FIRINGS_PER_INSTANT = 100_000
 
 EventHandler = Callable[[Event], None]
 
+_RUN, _START, _END, _CANCEL, _CUSTOM, _STOP = (EventKind.RUN.value, EventKind.START.value, EventKind.END.value,
+                                               EventKind.CANCEL.value, EventKind.CUSTOM.value, EventKind.STOP.value)
+
 
 class ZenoError(PetriflowError):
     """Instant transitions keep firing without simulated time passing."""
+
+
+class EmptySchedule(PetriflowError):
+    """:meth:`Scheduler.step` was asked for an instant but nothing more can happen."""
+
+
+class _Unrouted(Exception):
+    """A failure with no ``failed`` arcs: the run stops (internal)."""
+
+    def __init__(self, failure: ActionFailure) -> None:
+        super().__init__(str(failure))
+        self.failure = failure
 
 
 @dataclass
@@ -67,19 +100,20 @@ class RunResult:
     """How a run ended.
 
     Attributes:
-        reason: ``"final"`` (the net's final marking was reached), ``"dead"`` (no
-            transition can fire and nothing is running or pending, without reaching
-            a declared final marking), ``"until"`` (the
-            time limit), ``"firings"`` (the firing limit), or ``"failed"`` (an action
-            failed with no failure route; see ``error``).
+        reason: why it ended (:class:`~petriflow.outcome.StopReason`): ``final`` (the
+            net's final marking was reached with nothing running or pending),
+            ``dead`` (nothing can fire, run or arrive any more), ``until`` (the time
+            limit), ``firings`` (the firing limit), ``failed`` (an action failed with
+            no failure route; see ``error``) or ``fired`` (:meth:`Scheduler.fire_one`).
         time: simulated seconds at the end.
         firings: transitions fired.
         marking: token counts at the end.
         events: number of events recorded.
         error: the unrouted failure, if any.
+        tokens: ``{place: [data, ...]}`` at the end.
     """
 
-    reason: str
+    reason: StopReason
     time: float
     firings: int
     marking: Marking
@@ -88,28 +122,68 @@ class RunResult:
     tokens: dict[str, list[Any]] = field(default_factory=dict)
 
 
-@dataclass
-class _Running:
-    firing: int
-    transition: str
-    action: Action
-    ctx: ActionContext
-    deadline: float | None
-    cancelling: str | None = None  # outcome being cancelled towards (timeout/cancelled)
+class _Firing(Scheduled):
+    """The running firing of one transition (a transition runs one at a time, so one
+    record per transition serves all its firings); scheduled on the kernel, it is its
+    own wake-up (the poll it asked for last)."""
+
+    __slots__ = ("run", "number", "index", "action", "ctx", "deadline", "cancelling", "wake", "polled",
+                 "running")
+    phase = POLL
+
+    def __init__(self, run: "Scheduler", index: int, action: Action) -> None:
+        self.run = run
+        self.index = index
+        self.action = action
+        self.number = 0
+        self.ctx: ActionContext | None = None
+        self.deadline: float | None = None
+        self.cancelling: Outcome | None = None
+        self.wake = -1
+        self.polled = -1
+        self.running = False
+
+    def start(self, number: int, ctx: ActionContext, deadline: float | None) -> None:
+        """Begin firing ``number`` (the transition's previous firing has ended)."""
+        self.number = number
+        self.ctx = ctx
+        self.deadline = deadline
+        self.cancelling = None
+        self.wake = -1
+        self.polled = -1
+        self.running = True
+
+    def live(self, tick: int) -> bool:
+        return self.running and self.wake == tick
+
+    def apply(self, tick: int) -> None:
+        if self.polled != self.run.kernel.tick:  # once per tick, whichever entry comes first
+            self.run._poll(self)
+
+
+def _reason(exc: BaseException, hook: str | None = None) -> str:
+    text = str(exc) or type(exc).__name__
+    text = text if isinstance(exc, PetriflowError) else f"{type(exc).__name__}: {text}"
+    return f"{hook}() failed: {text}" if hook else text
 
 
 class Scheduler:
     """Runs a net's transitions as agent actions over an optional world.
 
     Args:
-        net: the net to run (loaded and bound: unknown actions fail here).
+        net: the net to run.
         world: a :class:`petriflow.world.World` or any object with ``dt``,
-            ``step()`` and optionally ``position(agent)``; ``None`` for a world-less run.
+            ``step()`` and optionally ``distance(a, b)``; ``None`` for a world-less run.
         config: faults, channel models, limits (:class:`RunConfig`).
         seed: seed of conflict resolution, action randomness and channel losses
             (overrides ``config.seed`` when given).
-        registry: where action and guard names are looked up.
+        registry: where action and guard names are looked up (when no ``binding``).
         path: the net's file, named in errors.
+        binding: the net already bound (:func:`~petriflow.runtime.binding.bind`).
+
+    Raises:
+        NetFormatError: an action, parameter, port or guard does not bind; a fault or
+            channel of the configuration names nothing in the net.
     """
 
     def __init__(
@@ -121,381 +195,345 @@ class Scheduler:
         seed: int | None = None,
         registry: Registry | None = None,
         path: str | None = None,
+        binding: Binding | None = None,
     ) -> None:
         self.net = net
         self.world = world
         self.config = config or RunConfig()
         self.seed = self.config.seed if seed is None else seed
-        self.registry = registry or default_registry
-        self.bound = self.registry.bind(net, path)
+        self.binding = binding if binding is not None else bind(net, registry, path=path)
+        self.registry = self.binding.registry
         self.config.check(net)
-        self.dt = float(getattr(world, "dt", None) or self.config.dt)
-        self._tick = 0
+        self.kernel = Kernel(float(getattr(world, "dt", None) or self.config.dt))
+        compiled = self.compiled = CompiledNet(net)
+        self.tokens = TokenStore(compiled, net.initial_marking, net.final_marking)
+        ids = self._ids = list(net.transitions)
+        self._position = {t: i for i, t in enumerate(ids)}
+        agent_of_subnet = {s.id: s.agent or s.id for s in net.subnets.values()}
+        transitions = list(net.transitions.values())
+        self._agent = [agent_of_subnet[t.subnet] if t.subnet else None for t in transitions]
+        self._of_agent: dict[str, list[int]] = {}
+        for t, agent in enumerate(self._agent):
+            if agent is not None:
+                self._of_agent.setdefault(agent, []).append(t)
+        self._row = [compiled.transition_index[t] for t in ids]
+        self._route = [{o: compiled.row(t, o) for o in Outcome} for t in ids]
+        consumers: list[list[int]] = [[] for _ in compiled.places]
+        for t, row in enumerate(self._row):
+            for p, _ in compiled.pre[row]:
+                consumers[p].append(t)
+        self._consumers = [tuple(c) for c in consumers]
+        self._channel = [net.places[p].channel is not None for p in compiled.places]
+        self._cancels = [tuple(self._position[n] for n in t.cancels if n in self._position) for t in transitions]
+        self._timeout = [t.timeout for t in transitions]
+        bound = [self.binding.transitions[t] for t in ids]
+        self._guard = [b.guard for b in bound]
+        self._params = [b.params for b in bound]
+        self._action_class = [b.action for b in bound]
+        self._actions: list[Action | None] = [None] * len(ids)
+        self._slot: list[_Firing | None] = [None] * len(ids)
+        self._setup_error: list[str | None] = [None] * len(ids)
+        self.agenda = Agenda([t.priority for t in transitions])
+        self._dirty: set[int] = set(range(len(ids)))
+        self._running: dict[int, _Firing] = {}
         self._handlers: list[EventHandler] = []
         self._seq = 0
-        self._firings = 0
+        self.firings = 0
+        self._fired_now = 0
         self._rng = random.Random(f"{self.seed}:conflicts")
-        self._channel_rng = random.Random(f"{self.seed}:channels")
-        self.tokens: dict[str, deque] = {p: deque() for p in net.places}
-        for place, count in net.initial_marking.items():
-            self.tokens[place].extend([None] * count)
-        self._agent_of = {
-            t.id: (net.subnets[t.subnet].agent or t.subnet) if t.subnet else None
-            for t in net.transitions.values()
-        }
-        self._place_agent = {
-            p.id: (net.subnets[p.subnet].agent or p.subnet) if p.subnet else None
-            for p in net.places.values()
-        }
-        self._consumers: dict[str, list[str]] = {p: [] for p in net.places}
-        for t in net.transitions:
-            for p in net.preset(t):
-                self._consumers[p].append(t)
-        self._preset = {t: net.preset(t) for t in net.transitions}
-        self._guarded = [t.id for t in net.transitions.values() if t.guard is not None]
-        # per transition: {route: [(place, weight, is channel)]}, route "ok" or an outcome
-        self._outputs = {
-            t: {route: [(p, w, net.places[p].channel is not None)
-                        for p, w in net.postset(t, None if route == "ok" else route).items()]
-                for route in ("ok", *net.outcomes(t))}
-            for t in net.transitions
-        }
-        # per transition: besides consumers of touched places, what to re-check after
-        # it fires: itself (its action may be running now) and the actions it cancels
-        self._recheck = {
-            t: {t, *(n for n in net.transitions[t].cancels if n in net.transitions)}
-            for t in net.transitions
-        }
-        self._order = {t: i for i, t in enumerate(net.transitions)}
-        self._actions: dict[str, Action] = {}
-        self._running: dict[str, _Running] = {}
-        self._pending: list[tuple[int, int, str, Any]] = []  # (tick, order, kind, payload)
-        self._pending_order = 0
-        self.alive: dict[str, bool] = {a: True for a in self.agents()}
-        self._down_links: set[frozenset[str]] = set()
-        self._channels: dict[str, ChannelModel] = dict(self.config.channel_models())
-        self.blackboard: dict[str, Any] = {}
+        self._seed_prefix = f"{self.seed}:"
         self._started = False
+        self._opened = False  # whether the instant at tick 0 was processed
         self._max_firings: int | None = None
-        self._finished: RunResult | None = None
         self._wall_start = 0.0
-        for fault in self.config.faults:
-            self._schedule(self._ticks_at(fault.at), "fault", fault)
-            if fault.kind == "join":
-                self.alive[fault.agent] = False
+        self._finished: RunResult | None = None
+        self.faults = Faults(self, self.config.faults, self.agents())
+        self._alive = self.faults.running
+        self.channels = Channels(self, self.config.channel_models(), self.seed)
 
     # Observers ----------------------------------------------------------------------
     def on_event(self, handler: EventHandler) -> None:
         """Call ``handler(event)`` for every event, in order."""
         self._handlers.append(handler)
 
-    def _emit(self, kind: str, transition: str | None = None, agent: str | None = None,
-              **data: Any) -> Event:
-        event = Event(self._seq, round(self.now, 9), kind, transition, agent, data)
-        self._seq += 1
-        for handler in self._handlers:
-            handler(event)
-        return event
+    def emit(self, kind: str, transition: str | None = None, agent: str | None = None, **data: Any) -> None:
+        """Record an event (for components; observers receive it)."""
+        seq = self._seq
+        self._seq = seq + 1
+        if self._handlers:
+            event = Event(seq, round(self.kernel.tick * self.kernel.dt, 9), kind, transition, agent, data)
+            for handler in self._handlers:
+                handler(event)
 
-    # Clock --------------------------------------------------------------------------
+    # Queries ------------------------------------------------------------------------
     @property
     def now(self) -> float:
         """Current simulated time in seconds."""
-        return self._tick * self.dt
+        return self.kernel.now
 
-    def _ticks_at(self, seconds: float) -> int:
-        return max(0, math.ceil(seconds / self.dt - 1e-9))
+    @property
+    def alive(self) -> dict[str, bool]:
+        """``{agent: running}`` for every agent."""
+        return self.faults.running
 
-    def _schedule(self, tick: int, kind: str, payload: Any) -> None:
-        self._pending.append((tick, self._pending_order, kind, payload))
-        self._pending_order += 1
-        self._pending.sort(key=lambda item: (item[0], item[1]))
-
-    # Queries ------------------------------------------------------------------------
     def agents(self) -> list[str]:
         """Agent names of the net's subnets, in declaration order."""
-        seen: list[str] = []
+        seen: dict[str, None] = {}
         for subnet in self.net.subnets.values():
-            agent = subnet.agent or subnet.id
-            if agent not in seen:
-                seen.append(agent)
-        return seen
+            seen.setdefault(subnet.agent or subnet.id)
+        return list(seen)
 
     def marking(self) -> Marking:
         """Token counts now."""
-        return Marking({p: len(q) for p, q in self.tokens.items() if q})
+        return self.tokens.marking()
 
     def running(self) -> list[str]:
         """Transitions whose actions are running, in firing order."""
-        return [r.transition for r in sorted(self._running.values(), key=lambda r: r.firing)]
+        return [self._ids[f.index] for f in sorted(self._running.values(), key=lambda f: f.number)]
 
-    def _can_fire(self, t: str) -> bool:
-        if t in self._running:
-            return False
-        agent = self._agent_of[t]
-        if agent is not None and not self.alive.get(agent, True):
-            return False
-        tokens = self.tokens
-        for place, weight in self._preset[t].items():
-            if len(tokens[place]) < weight:
-                return False
-        guard = self.net.transitions[t].guard
-        if guard is not None:
-            offered = {p: list(tokens[p])[:w] for p, w in self._preset[t].items()}
-            if not self.registry.guard(guard)(offered, self.net.transitions[t].params, self.blackboard):
-                return False
-        return True
+    def running_actions(self) -> dict[str, Action]:
+        """``{transition: action}`` of the firings running now, in firing order (the
+        action instances, for tests and inspection)."""
+        firings = sorted(self._running.values(), key=lambda f: f.number)
+        return {self._ids[f.index]: f.action for f in firings}
 
     def enabled(self) -> list[str]:
         """Transitions that may fire now, in the net's order."""
-        return [t for t in self.net.transitions if self._can_fire(t)]
+        self._refresh()
+        return [self._ids[t] for t in self.agenda.members()]
 
-    # Firing ------------------------------------------------------------------------
-    def _choose(self, candidates: list[str]) -> str:
-        best = max(self.net.transitions[t].priority for t in candidates)
-        top = [t for t in candidates if self.net.transitions[t].priority == best]
-        if len(top) == 1:
-            return top[0]
-        return top[int(self._rng.random() * len(top))]
+    def peek(self) -> float | None:
+        """Simulated time of the next instant at which something happens, or ``None``."""
+        if not self._opened:
+            return self.kernel.now
+        tick = self.kernel.peek()
+        return None if tick is None else tick * self.kernel.dt
 
+    # Enabling -----------------------------------------------------------------------
+    def _can_fire(self, t: int) -> bool:
+        if t in self._running:
+            return False
+        agent = self._agent[t]
+        if agent is not None and not self._alive.get(agent, True):
+            return False
+        row = self._row[t]
+        if not self.compiled.is_enabled(self.tokens.counts, row):
+            return False
+        guard = self._guard[t]
+        if guard is None:
+            return True
+        try:
+            return bool(guard(self.tokens.offered(row), self._params[t]))
+        except Exception as exc:
+            name = self.net.transitions[self._ids[t]].guard
+            raise PetriflowError(f"transition {self._ids[t]!r}: guard {name!r} raised {_reason(exc)}") from exc
+
+    def _refresh(self) -> None:
+        dirty = self._dirty
+        if dirty:
+            agenda, can_fire = self.agenda, self._can_fire
+            for t in dirty:
+                if can_fire(t):
+                    agenda.add(t)
+                else:
+                    agenda.discard(t)
+            dirty.clear()
+
+    # Firing -------------------------------------------------------------------------
     def _fire_instant(self) -> None:
-        """Fire until nothing more can fire at this instant.
-
-        The enabled set is kept up to date incrementally: after a firing only the
-        consumers of the places it touched, the transition itself, its cancellation
-        region and guarded transitions (whose guards may read any data) are re-checked.
-        """
-        fired_here = 0
-        enabled = {t for t in self.net.transitions if self._can_fire(t)}
-        while enabled and (self._max_firings is None or self._firings < self._max_firings):
-            t = self._choose(sorted(enabled, key=self._order.__getitem__))
-            touched = self._fire(t)
-            fired_here += 1
-            if fired_here > MAX_FIRINGS_PER_INSTANT:
+        """Fire until nothing more can fire at this instant (or the firing limit)."""
+        limit = self._max_firings
+        agenda, draw = self.agenda, self._rng.random
+        while True:
+            self._refresh()
+            if not agenda or (limit is not None and self.firings >= limit):
+                return
+            self._fire(agenda.pick(draw))
+            self._fired_now += 1
+            if self._fired_now > MAX_FIRINGS_PER_INSTANT:
                 raise ZenoError(
                     f"more than {MAX_FIRINGS_PER_INSTANT} firings at t={self.now:g}s without time"
                     " passing (a cycle of instant transitions?)"
                 )
-            dirty = {u for p in touched for u in self._consumers[p]}
-            dirty |= self._recheck[t]
-            for u in (*dirty, *self._guarded):
-                if self._can_fire(u):
-                    enabled.add(u)
-                else:
-                    enabled.discard(u)
 
-    def _fire(self, t: str) -> set[str]:
-        """Fire ``t`` now: consume, cancel its region, start its action. Returns the
-        places whose tokens changed."""
-        transition = self.net.transitions[t]
-        self._firings += 1
-        firing = self._firings
-        inputs: dict[str, list[Any]] = {}
-        for place, weight in self._preset[t].items():
-            queue = self.tokens[place]
-            inputs[place] = [queue.popleft() for _ in range(weight)]
-        touched = set(inputs)
-        agent = self._agent_of[t]
-        details: dict[str, Any] = {"firing": firing, "consumed": {p: len(v) for p, v in inputs.items()}}
-        carried = {p: [summarize(d) for d in v] for p, v in inputs.items() if any(d is not None for d in v)}
-        if carried:
-            details["inputs"] = carried
-        self._emit("start", t, agent, **details)
-        if transition.cancels:
-            touched |= self._cancel_region(transition, firing)
-        bound = self.bound.get(t)
-        now = self.now
-        ctx = ActionContext(
-            transition=t, agent=agent, params=bound[1] if bound else dict(transition.params),
-            inputs=inputs, world=self.world, seed=f"{self.seed}:{firing}",
-            started=now, now=now, blackboard=self.blackboard,
-        )
-        if bound is None:
+    def _fire(self, t: int) -> None:
+        """Fire transition index ``t`` now: consume, cancel its region, start its action."""
+        tid = self._ids[t]
+        self.firings += 1
+        number = self.firings
+        row = self._row[t]
+        compiled = self.compiled
+        inputs, withdrawn = self.tokens.consume(row)
+        consumers, dirty = self._consumers, self._dirty
+        for p, _ in compiled.pre[row]:
+            dirty.update(consumers[p])
+        for p in compiled.reset[row]:
+            dirty.update(consumers[p])
+        dirty.add(t)
+        agent = self._agent[t]
+        if self._handlers:
+            details: dict[str, Any] = {"firing": number, "consumed": {p: len(v) for p, v in inputs.items()}}
+            carried = {p: [summarize(d) for d in v] for p, v in inputs.items() if any(d is not None for d in v)}
+            if carried:
+                details["inputs"] = carried
+            self.emit(_START, tid, agent, **details)
+        else:
+            self._seq += 1
+        if self._cancels[t] or withdrawn:
+            self._cancel_region(t, number, withdrawn)
+        now = self.kernel.now
+        ctx = ActionContext(tid, agent, self._params[t], inputs, self.world, self._seed_prefix + str(number),
+                            now, now, _reader=self.tokens.read)
+        action = self._actions[t]
+        if action is None:
             ctx.result = ctx.token()
-            touched |= self._finish(firing, t, ctx, Outcome.OK)
-            return touched
-        action = self._action(t)
-        deadline = None if transition.timeout is None else self.now + transition.timeout
-        running = _Running(firing, t, action, ctx, deadline)
-        self._running[t] = running
+            self._finish(number, t, ctx, Outcome.OK)
+            return
+        if self._setup_error[t] is not None:
+            ctx.reason = self._setup_error[t]
+            self._finish(number, t, ctx, Outcome.FAILED)
+            return
+        timeout = self._timeout[t]
+        firing = self._slot[t]  # a transition runs one firing at a time: its record is reused
+        firing.start(number, ctx, None if timeout is None else now + timeout)
+        self._running[t] = firing
         try:
             action.start(ctx)
         except Exception as exc:  # an action's error is a failed outcome, never lost
             ctx.reason = _reason(exc)
-            del self._running[t]
-            touched |= self._finish(firing, t, ctx, Outcome.FAILED)
-            return touched
-        touched |= self._poll(running)
-        return touched
+            self._stop(firing)
+            self._finish(number, t, ctx, Outcome.FAILED)
+            return
+        kernel = self.kernel
+        if timeout is not None:
+            tick = max(kernel.tick + 1, kernel.ticks_at(firing.deadline))
+            kernel.schedule(tick, Deadline(firing, number), key=number)
+        wake = action.wake_at
+        if wake is not None and not action.needs_world and wake > now + 1e-12:
+            self._wake(firing, max(kernel.tick + 1, kernel.ticks_at(wake)))  # first poll when it asked
+        else:
+            self._poll(firing)
 
-    def _action(self, t: str) -> Action:
-        if t not in self._actions:
-            cls, params = self.bound[t]
-            action = cls(params)
-            action.setup(self.world)
-            self._actions[t] = action
-        return self._actions[t]
+    def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:
+        cancelled = [self._running[u] for u in self._cancels[t] if u in self._running]
+        for firing in cancelled:
+            firing.cancelling = Outcome.CANCELLED
+        if withdrawn or cancelled:
+            self.emit(_CANCEL, self._ids[t], self._agent[t], firing=number, withdrawn=withdrawn,
+                      actions=[self._ids[f.index] for f in cancelled])
+        for firing in cancelled:
+            if firing.running:
+                self._poll(firing)
 
-    def _cancel_region(self, transition, firing: int) -> set[str]:
-        touched: set[str] = set()
-        withdrawn: dict[str, int] = {}
-        for node in transition.cancels:
-            if node in self.tokens and self.tokens[node]:
-                withdrawn[node] = len(self.tokens[node])
-                self.tokens[node].clear()
-                touched.add(node)
-            elif node in self._running:
-                self._running[node].cancelling = Outcome.CANCELLED.value
-        if withdrawn or any(n in self._running for n in transition.cancels):
-            self._emit("cancel", transition.id, self._agent_of[transition.id], firing=firing,
-                       withdrawn=withdrawn,
-                       actions=[n for n in transition.cancels if n in self._running])
-        for node in transition.cancels:
-            if node in self._running:
-                touched |= self._poll(self._running[node])
-        return touched
+    def _stop(self, firing: _Firing) -> None:
+        firing.running = False
+        del self._running[firing.index]
+        self._dirty.add(firing.index)
 
-    def _poll(self, running: _Running) -> set[str]:
+    def _poll(self, firing: _Firing) -> None:
         """Poll one running action (or drive its cancellation); finish it if it ended."""
-        ctx, action = running.ctx, running.action
-        ctx.now = self.now
-        if running.cancelling is None and running.deadline is not None and self.now >= running.deadline - 1e-9:
-            running.cancelling = Outcome.TIMEOUT.value
-        if running.cancelling is not None:
+        kernel = self.kernel
+        firing.polled = tick = kernel.tick
+        ctx, action = firing.ctx, firing.action
+        ctx.now = now = kernel.now
+        if firing.cancelling is None and firing.deadline is not None and now >= firing.deadline - 1e-9:
+            firing.cancelling = Outcome.TIMEOUT
+        if firing.cancelling is not None:
+            outcome = firing.cancelling
             try:
                 done = action.cancel(ctx)
             except Exception as exc:
-                ctx.reason = _reason(exc)
-                done = True
+                ctx.reason = _reason(exc, "cancel")
+                done, outcome = True, Outcome.FAILED
             if not done:
-                return set()
-            del self._running[running.transition]
-            return self._finish(running.firing, running.transition, ctx, Outcome(running.cancelling))
+                self._wake(firing, tick + 1)
+                return
+            self._stop(firing)
+            self._finish(firing.number, firing.index, ctx, outcome)
+            return
         try:
             status = action.poll(ctx)
         except Exception as exc:
             ctx.reason = _reason(exc)
             status = Status.FAILED
         if status is Status.RUNNING:
-            return set()
+            if action.needs_world:
+                self._wake(firing, tick + 1)
+            else:
+                wake = action.wake_at
+                self._wake(firing, tick + 1 if wake is None else max(tick + 1, kernel.ticks_at(wake)))
+            return
         if not isinstance(status, Status):
             ctx.reason = f"poll() returned {status!r}, not a Status"
             status = Status.FAILED
-        del self._running[running.transition]
-        outcome = Outcome.OK if status is Status.OK else Outcome.FAILED
-        return self._finish(running.firing, running.transition, ctx, outcome)
+        self._stop(firing)
+        self._finish(firing.number, firing.index, ctx, Outcome.OK if status is Status.OK else Outcome.FAILED)
 
-    def _finish(self, firing: int, t: str, ctx: ActionContext, outcome: Outcome) -> set[str]:
+    def _wake(self, firing: _Firing, tick: int) -> None:
+        firing.wake = tick
+        self.kernel.schedule(tick, firing, key=firing.number)
+
+    def _finish(self, number: int, t: int, ctx: ActionContext, outcome: Outcome) -> None:
         """Produce the outputs of ``outcome`` and record the end of the firing."""
-        net = self.net
-        route = outcome.value
-        routes = self._outputs[t]
-        if outcome is Outcome.TIMEOUT and "timeout" not in routes and "failed" in routes:
-            route = "failed"  # a timeout is a failure when the net routes only failures
-        if outcome in (Outcome.FAILED, Outcome.TIMEOUT) and route not in routes:
+        tid = self._ids[t]
+        row = self._route[t][outcome]
+        if row is None and outcome is not Outcome.CANCELLED and outcome is not Outcome.OK:
             reason = ctx.reason or outcome.value
-            self._emit("end", t, self._agent_of[t], firing=firing, outcome=outcome.value,
-                       produced={}, reason=reason)
-            raise ActionFailed(net.id, t, net.transitions[t].action or "-", reason)
+            self.emit(_END, tid, ctx.agent, firing=number, outcome=outcome.value, produced={}, reason=reason)
+            raise _Unrouted(ActionFailure(reason, net=self.net.id, transition=tid,
+                                          action=self.net.transitions[tid].action))
+        if ctx.emitted:
+            for kind, data in ctx.emitted:
+                self.emit(_CUSTOM, tid, ctx.agent, firing=number, name=kind, data=summarize(data))
+            ctx.emitted.clear()
         produced: dict[str, int] = {}
         sent: list[tuple[str, Any]] = []
-        per_place = ctx.per_place and isinstance(ctx.result, dict)
-        for place, weight, channel in routes.get(route, ()):
-            data = ctx.result.get(place) if per_place else ctx.result
-            if channel:
-                sent.extend([(place, data)] * weight)
-            else:
-                self.tokens[place].extend([data] * weight)
-                produced[place] = weight
-        for kind, data in ctx.emitted:
-            self._emit("custom", t, ctx.agent, firing=firing, name=kind, data=summarize(data))
-        ctx.emitted.clear()
-        details: dict[str, Any] = {"firing": firing, "outcome": outcome.value, "produced": produced}
-        if ctx.result is not None:
-            details["result"] = summarize(ctx.result)
-        if ctx.reason:
-            details["reason"] = ctx.reason
-        self._emit("end", t, ctx.agent, **details)
-        for place, data in sent:
-            self._send(place, data, ctx.agent)
-        return set(produced)
-
-    # Channels -----------------------------------------------------------------------
-    def _receiver(self, place: str) -> str | None:
-        if self._place_agent[place] is not None:
-            return self._place_agent[place]
-        for t in self._consumers[place]:
-            if self._agent_of[t] is not None:
-                return self._agent_of[t]
-        return None
-
-    def _send(self, place: str, data: Any, sender: str | None) -> None:
-        channel = self.net.places[place].channel
-        receiver = self._receiver(place)
-        model = self._channels.setdefault(channel, IdealChannel())
-        distance = None
-        if sender and receiver and hasattr(self.world, "distance"):
-            distance = self.world.distance(sender, receiver)
-        size = int(getattr(data, "size", 0) or 0) if not isinstance(data, (dict, list)) else 0
-        if isinstance(data, dict) and isinstance(data.get("size"), int):
-            size = data["size"]
-        message = Message(place, sender, receiver, data, self.now, size or 16, distance)
-        link = frozenset(a for a in (sender, receiver) if a)
-        if link in self._down_links:
-            delay, why = None, "link down"
-        elif receiver is not None and not self.alive.get(receiver, True):
-            delay, why = None, "receiver not running"
+        if row is not None:
+            result, outputs = ctx.result, ctx.outputs
+            if ctx.per_place and isinstance(result, dict):
+                result, outputs = None, result
+            channel = self._channel
+            produced = self.tokens.produce(row, result, outputs, channel)
+            places = self.compiled.places
+            consumers, dirty = self._consumers, self._dirty
+            for p, w in self.compiled.post[row]:
+                if channel[p]:
+                    sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
+                else:
+                    dirty.update(consumers[p])
+        if self._handlers:
+            details: dict[str, Any] = {"firing": number, "outcome": outcome.value, "produced": produced}
+            if ctx.result is not None:
+                details["result"] = summarize(ctx.result)
+            if ctx.reason:
+                details["reason"] = ctx.reason
+            self.emit(_END, tid, ctx.agent, **details)
         else:
-            delay, why = model.deliver(message, self._channel_rng), "channel model"
-        info: dict[str, Any] = {"place": place, "channel": channel, "receiver": receiver,
-                                "size": message.size}
-        if distance is not None:
-            info["distance"] = round(distance, 6)
-        if delay is None:
-            self._emit("message", None, sender, fate="lost", why=why, **info)
-            return
-        arrival = self._ticks_at(self.now + delay)
-        self._emit("message", None, sender, fate="sent", arrival=round(arrival * self.dt, 9), **info)
-        self._schedule(arrival, "deliver", (place, data, sender))
+            self._seq += 1
+        for place, data in sent:
+            self.channels.send(place, data, ctx.agent)
 
-    # Faults --------------------------------------------------------------------------
-    def _apply(self, kind: str, payload: Any) -> set[str]:
-        if kind == "deliver":
-            place, data, sender = payload
-            self.tokens[place].append(data)
-            self._emit("message", None, sender, fate="delivered", place=place,
-                       channel=self.net.places[place].channel)
-            return {place}
-        fault: Fault = payload
-        touched: set[str] = set()
-        if fault.kind == "kill":
-            self.alive[fault.agent] = False
-            self._emit("fault", None, fault.agent, fault="kill")
-            for running in sorted(self._running.values(), key=lambda r: r.firing):
-                if self._agent_of[running.transition] == fault.agent:
-                    running.cancelling = Outcome.CANCELLED.value
-                    touched |= self._poll(running)
-        elif fault.kind == "join":
-            self.alive[fault.agent] = True
-            self._emit("fault", None, fault.agent, fault="join")
-        elif fault.kind == "drop_link":
-            self._down_links.add(frozenset(fault.link))
-            self._emit("fault", None, None, fault="drop_link", link=list(fault.link))
-            if fault.until is not None:
-                self._schedule(self._ticks_at(fault.until), "restore", fault)
-        return touched
+    # Components call these ------------------------------------------------------------
+    def deliver(self, place: str, data: Any) -> None:
+        """A token arrives in ``place`` from outside a firing (a channel's delivery)."""
+        index = self.tokens.index[place]
+        self.tokens.add(index, data)
+        self._dirty.update(self._consumers[index])
 
-    def _restore(self, fault: Fault) -> None:
-        self._down_links.discard(frozenset(fault.link))
-        self._emit("fault", None, None, fault="restore_link", link=list(fault.link))
+    def agent_stopped(self, agent: str) -> None:
+        """``agent`` stopped (a fault): its running actions are cancelled, its
+        transitions no longer fire."""
+        transitions = self._of_agent.get(agent, ())
+        self._dirty.update(transitions)
+        firings = sorted((self._running[t] for t in transitions if t in self._running), key=lambda f: f.number)
+        for firing in firings:
+            firing.cancelling = Outcome.CANCELLED
+            if firing.running:
+                self._poll(firing)
 
-    def _apply_due(self) -> None:
-        while self._pending and self._pending[0][0] <= self._tick:
-            _, _, kind, payload = self._pending.pop(0)
-            if kind == "restore":
-                self._restore(payload)
-            else:
-                self._apply(kind, payload)
+    def agent_started(self, agent: str) -> None:
+        """``agent`` started (a late joiner): its transitions may fire."""
+        self._dirty.update(self._of_agent.get(agent, ()))
 
     def set_tokens(self, tokens: dict[str, list[Any]]) -> None:
         """Replace the tokens (with their data) before the run starts.
@@ -507,71 +545,72 @@ class Scheduler:
             raise PetriflowError("tokens can only be set before the run starts")
         for place in tokens:
             self.net.place(place)
-        for place in self.tokens:
-            self.tokens[place] = deque(tokens.get(place, []))
+        self.tokens.replace(tokens)
+        self._dirty.update(range(len(self._ids)))
 
-    def fire_one(self, transition: str, timeout: float = 60.0) -> RunResult:
-        """Fire ``transition`` now and run only its action until it ends.
-
-        No other transition fires; the world steps as the action needs. This is what
-        :func:`petriflow.testing.fire_one` uses to test one transition on its own.
-
-        Raises:
-            NotEnabledError: the transition cannot fire in the current marking.
-            ActionFailed: its action failed and the net has no failure route.
-        """
-        from petriflow.engine import fire as fire_counts
-
-        self.net.transition(transition)
-        self.start()
-        if not self._can_fire(transition):
-            fire_counts(self.net, self.marking(), transition)  # raises naming short places
-            raise PetriflowError(f"transition {transition!r} cannot fire now (guard false or agent down)")
-        self._fire(transition)
-        limit = self._ticks_at(self.now + timeout)
-        while transition in self._running:
-            target = self._next_tick()
-            if target is None or target > limit:
-                return self._end("until")
-            self._advance_to(target, False)
-            self._apply_due()
-            for running in sorted(self._running.values(), key=lambda r: r.firing):
-                if running.transition in self._running:
-                    self._poll(running)
-        return self._end("fired")
-
-    # Main loop ----------------------------------------------------------------------
+    # Running ------------------------------------------------------------------------
     def start(self) -> None:
-        """Record the run's start (called by :meth:`run` if needed)."""
+        """Record the run's start and set up every bound action (called by :meth:`run`
+        and :meth:`step` if needed)."""
         if self._started:
             return
         self._started = True
         self._wall_start = wallclock.perf_counter()
-        self._emit("run", None, None, net=self.net.id, seed=self.seed, dt=self.dt,
-                   marking=self.marking().to_dict(), agents=self.agents())
+        self.emit(_RUN, None, None, net=self.net.id, seed=self.seed, dt=self.kernel.dt,
+                  marking=self.marking().to_dict(), agents=self.agents())
+        for t, cls in enumerate(self._action_class):
+            if cls is None:
+                continue
+            action = self._actions[t] = cls(self._params[t])
+            self._slot[t] = _Firing(self, t, action)
+            try:
+                action.setup(self.world)
+            except Exception as exc:  # every firing of t then fails with this reason
+                self._setup_error[t] = _reason(exc, "setup")
 
-    def _next_tick(self) -> int | None:
-        """The tick at which something next needs attention, or ``None``."""
-        if any(r.action.needs_world or r.cancelling for r in self._running.values()):
-            return self._tick + 1
-        candidates = [self._pending[0][0]] if self._pending else []
-        for running in self._running.values():
-            wake = running.action.wake_at
-            candidates.append(self._tick + 1 if wake is None else max(self._tick + 1, self._ticks_at(wake)))
-            if running.deadline is not None:
-                candidates.append(max(self._tick + 1, self._ticks_at(running.deadline)))
-        return min(candidates) if candidates else None
-
-    def _advance_to(self, tick: int, realtime: bool) -> None:
-        world = self.world
-        while self._tick < tick:
+    def _advance(self, tick: int, realtime: bool) -> None:
+        kernel, world = self.kernel, self.world
+        if world is None and not realtime:
+            kernel.tick = max(kernel.tick, tick)
+        while kernel.tick < tick:
             if world is not None:
                 world.step()
-            self._tick += 1
+            kernel.tick += 1
             if realtime:
-                ahead = self.now - (wallclock.perf_counter() - self._wall_start)
+                ahead = kernel.now - (wallclock.perf_counter() - self._wall_start)
                 if ahead > 0:
                     wallclock.sleep(ahead)
+        self._fired_now = 0
+
+    def _instant(self, fire: bool = True) -> None:
+        """Process the current tick: due polls and events, then the firings."""
+        kernel = self.kernel
+        self._opened = True
+        while True:
+            for tick, event in kernel.pop_due():
+                event.apply(tick)
+            if fire:
+                self._fire_instant()
+            if kernel.peek() != kernel.tick:
+                return
+
+    def step(self, realtime: bool = False) -> None:
+        """Process the next instant (see the module): advance, poll, apply, fire.
+
+        Raises:
+            EmptySchedule: nothing more can happen.
+            ZenoError: instant transitions keep firing without time passing.
+        """
+        self.start()
+        if self._opened:
+            tick = self.kernel.peek()
+            if tick is None:
+                raise EmptySchedule(f"nothing more can happen at t={self.now:g}s")
+            self._advance(tick, realtime)
+        try:
+            self._instant()
+        except _Unrouted as exc:
+            raise exc.failure from None
 
     def run(self, until: float | None = None, *, max_firings: int | None = None,
             realtime: bool = False) -> RunResult:
@@ -582,54 +621,82 @@ class Scheduler:
             max_firings: stop after this many firings.
             realtime: pace simulated time to the wall clock.
 
-        Raises:
-            ActionFailed: an action failed and its transition has no failure route
-                (the failure is also recorded in the trace before this is raised).
+        Returns:
+            How the run ended; an action that failed with no failure route ends it
+            with reason ``failed`` (recorded in the trace first).
         """
         until = self.config.until if until is None else until
-        limit_tick = None if until is None else self._ticks_at(until)
+        kernel = self.kernel
+        limit = None if until is None else kernel.ticks_at(until)
         self._max_firings = max_firings
         self.start()
         try:
+            if not self._opened:
+                self._instant()
             while True:
-                self._apply_due()
-                self._fire_instant()
-                if max_firings is not None and self._firings >= max_firings:
-                    return self._end("firings")
-                if not self._running and not self.enabled() and self._at_final():
-                    return self._end("final")
-                target = self._next_tick()
-                if target is None:
-                    return self._end("dead")
-                if limit_tick is not None and target > limit_tick:
-                    self._advance_to(limit_tick, realtime)
-                    return self._end("until")
-                self._advance_to(target, realtime)
-                for running in sorted(self._running.values(), key=lambda r: r.firing):
-                    if running.transition in self._running:
-                        self._poll(running)
-        except ActionFailed as exc:
-            return self._end("failed", str(exc))
+                if max_firings is not None and self.firings >= max_firings:
+                    return self._end(StopReason.FIRINGS)
+                if not self._running and not kernel.pending and self.tokens.at_final:
+                    return self._end(StopReason.FINAL)
+                tick = kernel.peek()
+                if tick is None:
+                    return self._end(StopReason.DEAD)
+                if limit is not None and tick > limit:
+                    self._advance(limit, realtime)
+                    return self._end(StopReason.UNTIL)
+                self._advance(tick, realtime)
+                self._instant()
+        except _Unrouted as exc:
+            return self._end(StopReason.FAILED, str(exc.failure))
 
-    def _at_final(self) -> bool:
-        final = self.net.final_marking
-        return final is not None and self.marking() == final and not self._pending
+    def fire_one(self, transition: str, timeout: float = 60.0) -> RunResult:
+        """Fire ``transition`` now and run only its action until it ends.
 
-    def _end(self, reason: str, error: str | None = None) -> RunResult:
-        data: dict[str, Any] = {"reason": reason, "firings": self._firings,
+        No other transition fires; the world steps as the action needs. This is what
+        :func:`petriflow.testing.fire_one` uses to test one transition on its own.
+
+        Raises:
+            NotEnabledError: the transition cannot fire in the current marking.
+        """
+        from petriflow.engine import fire as fire_counts
+
+        self.net.transition(transition)
+        t = self._position[transition]
+        self.start()
+        self._opened = True
+        if not self._can_fire(t):
+            fire_counts(self.net, self.marking(), transition)  # raises naming short places
+            raise PetriflowError(f"transition {transition!r} cannot fire now (guard false or agent down)")
+        kernel = self.kernel
+        try:
+            self._fire(t)
+            limit = kernel.ticks_at(self.now + timeout)
+            while t in self._running:
+                tick = kernel.peek()
+                if tick is None or tick > limit:
+                    return self._end(StopReason.UNTIL)
+                self._advance(tick, False)
+                self._instant(fire=False)
+        except _Unrouted as exc:
+            return self._end(StopReason.FAILED, str(exc.failure))
+        return self._end(StopReason.FIRED)
+
+    def _end(self, reason: StopReason, error: str | None = None) -> RunResult:
+        problems = {}
+        for t, action in enumerate(self._actions):
+            if action is not None:
+                try:
+                    action.teardown()
+                except Exception as exc:
+                    problems[self._ids[t]] = _reason(exc, "teardown")
+        self._actions = [None] * len(self._ids)
+        data: dict[str, Any] = {"reason": reason.value, "firings": self.firings,
                                 "marking": self.marking().to_dict(), "running": self.running()}
         if error:
             data["error"] = error
-        self._emit("stop", None, None, **data)
-        for action in self._actions.values():
-            action.teardown()
-        self._actions.clear()
-        self._finished = RunResult(reason, round(self.now, 9), self._firings, self.marking(),
-                                   self._seq, error,
-                                   {p: list(q) for p, q in self.tokens.items() if q})
+        if problems:
+            data["teardown_errors"] = problems
+        self.emit(_STOP, None, None, **data)
+        self._finished = RunResult(reason, round(self.now, 9), self.firings, self.marking(), self._seq, error,
+                                   self.tokens.tokens())
         return self._finished
-
-
-def _reason(exc: BaseException) -> str:
-    text = str(exc) or type(exc).__name__
-    return text if isinstance(exc, PetriflowError) else f"{type(exc).__name__}: {text}"

@@ -1,20 +1,32 @@
-"""One run from files to files: load the net, world and configuration, run, record.
+"""One run from files to files: load, bind, run, record.
 
-:func:`run_files` is what ``petriflow run`` does; :func:`resume` is ``--resume``.
-Observers (trace file, journal, progress line) subscribe to the scheduler's events.
+:func:`prepare` is what every command that reads a net to run, check or show does:
+read the net file once, find its run configuration, import the configuration's
+action modules, and bind the net (:func:`~petriflow.runtime.binding.bind`), so a
+typo fails with ``file:line`` before anything is created on disk. :func:`run_files`
+is ``petriflow run``; :func:`resume` is ``--resume``; :func:`run` is the Python API.
+
+The run configuration is, first found: the one given (``--config``), the one the net
+names (``run:`` in YAML, ``<run>`` in PNML's petriflow data: a file beside the net or
+the configuration itself), ``run.yaml`` beside the net, or the defaults.
+
+Observers (trace file, XES log, journal, progress line) subscribe to the scheduler's
+events; none of them keeps events in memory, so a run's memory does not grow with its
+length unless ``keep_events`` asks for the event list.
 
 Examples:
     >>> import tempfile, pathlib
     >>> folder = pathlib.Path(tempfile.mkdtemp())
     >>> _ = (folder / "net.yaml").write_text('''
     ... petriflow: 1
+    ... run: {until: 10}
     ... places: [{id: i, tokens: 1}, o]
     ... transitions: [{id: rest, action: core.wait, params: {seconds: 1.5}, in: [i], out: [o]}]
     ... final: {o: 1}
     ... ''')
     >>> outcome = run_files(folder / "net.yaml", trace=folder / "run.jsonl")
     >>> outcome.result.reason, outcome.result.time
-    ('final', 1.5)
+    (<StopReason.FINAL: 'final'>, 1.5)
     >>> [e.kind for e in read_trace(folder / "run.jsonl")]
     ['run', 'start', 'end', 'stop']
 """
@@ -29,13 +41,14 @@ from typing import Any, TextIO
 
 from petriflow.errors import NetFormatError
 from petriflow.net import Net
+from petriflow.runtime.binding import Binding, bind
 from petriflow.runtime.config import RunConfig, load_config
 from petriflow.runtime.journal import Journal, JournalError
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.scheduler import RunResult, Scheduler
-from petriflow.runtime.trace import Event, TraceWriter, read_trace, write_xes
+from petriflow.runtime.trace import Event, TraceWriter, XesWriter, read_trace
 
-__all__ = ["run_files", "resume", "RunOutcome", "Progress", "read_trace"]
+__all__ = ["run", "run_files", "resume", "prepare", "Prepared", "RunOutcome", "Progress", "read_trace"]
 
 #: Events after which the journal commits: each firing's start and end.
 _COMMIT_KINDS = {"run", "start", "end", "stop"}
@@ -43,7 +56,15 @@ _COMMIT_KINDS = {"run", "start", "end", "stop"}
 
 @dataclass
 class RunOutcome:
-    """What a run produced."""
+    """What a run produced.
+
+    Attributes:
+        result: how it ended.
+        net: the net run.
+        events: every event, when the run was asked to keep them (else empty).
+        wall: wall-clock seconds the run took.
+        written: the files written.
+    """
 
     result: RunResult
     net: Net
@@ -55,6 +76,25 @@ class RunOutcome:
     def realtime_factor(self) -> float:
         """Simulated seconds per wall-clock second."""
         return self.result.time / self.wall if self.wall > 0 else float("inf")
+
+
+@dataclass
+class Prepared:
+    """A net read, its run configuration found, its actions bound: ready to run.
+
+    Attributes:
+        net: the net.
+        text: the net file's text (what a journal keeps).
+        config: the run configuration.
+        binding: the net bound to the registry.
+        world: the world file to use, if any.
+    """
+
+    net: Net
+    text: str
+    config: RunConfig
+    binding: Binding
+    world: Path | None
 
 
 class Progress:
@@ -83,7 +123,7 @@ class Progress:
         alive = sum(self.scheduler.alive.values())
         total = len(self.scheduler.alive)
         agents = f"  agents alive {alive}/{total}" if total else ""
-        self.stream.write(f"\r  t = {event.time:9.2f} s  firings {self.scheduler._firings:7d}{agents}   ")
+        self.stream.write(f"\r  t = {event.time:9.2f} s  firings {self.scheduler.firings:7d}{agents}   ")
         self.stream.flush()
         self.shown = True
 
@@ -100,14 +140,58 @@ def _read_text(path: Path) -> str:
         raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
 
 
-def _net_from_text(text: str, name: str, path: str) -> Net:
+def _net_from_text(text: str, path: str) -> Net:
     if text.lstrip().startswith("<"):
         from petriflow.io.pnml import loads_pnml
 
         return loads_pnml(text, path=path)
     from petriflow.io.yaml import loads_net
 
-    return loads_net(text, path=path, name=name)
+    return loads_net(text, path=path, name=Path(path).stem)
+
+
+def net_config(net: Net, path: Path) -> RunConfig | None:
+    """The run configuration ``net`` (read from ``path``) names, or ``None``."""
+    named = net.run
+    if named is None:
+        return None
+    if isinstance(named, str):
+        file = path.parent / named
+        if not file.is_file():
+            raise NetFormatError(f"run configuration {named!r} not found (looked for {file})", path=str(path),
+                                 line=net.lines.get("run"))
+        return load_config(file)
+    return RunConfig.from_dict(named, str(path), base=str(path.parent))
+
+
+def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = None,
+            world: str | Path | None = None, registry: Registry | None = None) -> Prepared:
+    """Read the net in ``net_path`` once, resolve its run configuration, import the
+    configuration's action modules and bind the net.
+
+    Raises:
+        NetFormatError: a file is missing or malformed, an action, parameter or guard
+            does not bind (``file:line``), a module of ``actions`` does not import.
+    """
+    net_path = Path(net_path)
+    if not net_path.is_file():
+        raise NetFormatError("no such file", path=str(net_path))
+    text = _read_text(net_path)
+    net = _net_from_text(text, str(net_path))
+    if isinstance(config, RunConfig):
+        run_config = config
+    elif config is not None:
+        run_config = load_config(config)
+    else:
+        run_config = net_config(net, net_path)
+        if run_config is None and (net_path.parent / "run.yaml").is_file():
+            run_config = load_config(net_path.parent / "run.yaml")
+        run_config = run_config or RunConfig()
+    run_config.import_actions()
+    binding = bind(net, registry, path=str(net_path))
+    run_config.check(net)
+    world_path = Path(world) if world is not None else (Path(run_config.world) if run_config.world else None)
+    return Prepared(net, text, run_config, binding, world_path)
 
 
 def _world_from(inputs: dict[str, Any], gui: bool):
@@ -117,101 +201,117 @@ def _world_from(inputs: dict[str, Any], gui: bool):
 
     from petriflow.world import World
 
-    data = yaml.safe_load(inputs["world_text"])
+    try:
+        data = yaml.safe_load(inputs["world_text"])
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise NetFormatError(f"malformed YAML: {getattr(exc, 'problem', exc)}", path=inputs["world_file"],
+                             line=mark.line + 1 if mark else None) from None
     return World(data, base=inputs["world_base"], gui=gui, path=inputs["world_file"])
 
 
-def _execute(inputs: dict[str, Any], *, journal: Journal | None, trace: Path | None, xes: Path | None,
-             realtime: bool, gui: bool, registry: Registry | None, progress: bool,
-             max_firings: int | None) -> RunOutcome:
-    net = _net_from_text(inputs["net_text"], Path(inputs["net_file"]).stem, inputs["net_file"])
-    config = RunConfig.from_dict(inputs["config"])
-    config.world = inputs.get("world_file")
-    world = _world_from(inputs, gui)
-    events: list[Event] = []
-    writer = None
-    display = None
-    try:
-        scheduler = Scheduler(net, world=world, config=config, seed=inputs["seed"], registry=registry,
-                              path=inputs["net_file"])
+def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: Path | None,
+             xes: Path | None, progress: bool, keep_events: bool) -> dict[str, Any]:
+    """Subscribe the requested observers; returns them by name."""
+    observers: dict[str, Any] = {}
+    if keep_events:
+        observers["events"] = events = []
         scheduler.on_event(events.append)
-        if journal is not None:
-            def journal_event(event: Event) -> None:
-                journal.record(event)
-                if event.kind in _COMMIT_KINDS:
-                    journal.commit()
+    if journal is not None:
+        def journal_event(event: Event) -> None:
+            journal.record(event)
+            if event.kind in _COMMIT_KINDS:
+                journal.commit()
 
-            scheduler.on_event(journal_event)
-        if trace is not None:
-            writer = TraceWriter(trace)
-            scheduler.on_event(writer)
-        if progress:
-            display = Progress(scheduler)
-            scheduler.on_event(display)
+        scheduler.on_event(journal_event)
+    if trace is not None:
+        observers["trace"] = TraceWriter(trace)
+        scheduler.on_event(observers["trace"])
+    if xes is not None:
+        labels = {t.id: t.label or t.id for t in net.transitions.values()}
+        silent = [t.id for t in net.transitions.values() if t.silent]
+        observers["xes"] = XesWriter(xes, case=net.id, labels=labels, silent=silent)
+        scheduler.on_event(observers["xes"])
+    if progress:
+        observers["progress"] = Progress(scheduler)
+        scheduler.on_event(observers["progress"])
+    return observers
+
+
+def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, Any], *,
+             journal: Journal | None, trace: Path | None, xes: Path | None, realtime: bool, gui: bool,
+             progress: bool, max_firings: int | None, keep_events: bool = False) -> RunOutcome:
+    world = _world_from(inputs, gui)
+    observers: dict[str, Any] = {}
+    try:
+        scheduler = Scheduler(net, world=world, config=config, seed=inputs["seed"], binding=binding)
+        observers = _observe(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
+                             keep_events=keep_events)
         started = wallclock.perf_counter()
         result = scheduler.run(until=inputs["until"], max_firings=max_firings, realtime=realtime)
         wall = wallclock.perf_counter() - started
     except BaseException:
-        if writer is not None:
-            writer.close(keep=False)
+        for name in ("trace", "xes"):
+            if name in observers:
+                observers[name].close(keep=False)
         raise
     finally:
-        if display is not None:
-            display.close()
+        if "progress" in observers:
+            observers["progress"].close()
         if world is not None:
             world.close()
-    outcome = RunOutcome(result, net, events, wall)
-    if writer is not None:
-        writer.close()
+    outcome = RunOutcome(result, net, observers.get("events", []), wall)
+    if "trace" in observers:
+        observers["trace"].close()
         outcome.written.append(str(trace))
+    if "xes" in observers:
+        observers["xes"].close()
+        outcome.written.append(str(xes))
     if journal is not None:
         journal.finish()
         outcome.written.append(str(journal.path))
-    if xes is not None:
-        labels = {t.id: t.label or t.id for t in net.transitions.values()}
-        silent = [t.id for t in net.transitions.values() if t.silent]
-        write_xes(events, xes, case=net.id, labels=labels, silent=silent)
-        outcome.written.append(str(xes))
     return outcome
+
+
+def _inputs(prepared: Prepared, net_path: Path, seed: int | None, until: float | None) -> dict[str, Any]:
+    config = prepared.config
+    world = prepared.world
+    return {
+        "net_file": str(net_path),
+        "net_text": prepared.text,
+        "config": {k: v for k, v in config.to_dict().items() if k != "world"},
+        "seed": config.seed if seed is None else seed,
+        "until": config.until if until is None else until,
+        "world_file": None if world is None else str(world),
+        "world_base": None if world is None else str(world.resolve().parent),
+        "world_text": None if world is None else _read_text(world),
+    }
 
 
 def run_files(net_path: str | Path, *, world: str | Path | None = None, config: str | Path | None = None,
               seed: int | None = None, until: float | None = None, trace: str | Path | None = None,
               xes: str | Path | None = None, db: str | Path | None = None, realtime: bool = False,
               gui: bool = False, registry: Registry | None = None, progress: bool = False,
-              max_firings: int | None = None) -> RunOutcome:
-    """Run the net in ``net_path``.
+              max_firings: int | None = None, keep_events: bool = False) -> RunOutcome:
+    """Run the net in ``net_path`` (what ``petriflow run`` does).
 
-    The run configuration is ``config``, or ``run.yaml`` beside the net when that
-    exists; ``world``, ``seed`` and ``until`` override what the configuration says.
+    The run configuration is ``config``, else the one the net names, else
+    ``run.yaml`` beside the net; ``world``, ``seed`` and ``until`` override what the
+    configuration says.
 
     Raises:
         NetFormatError: a file is missing or malformed, an action is unknown...
         JournalError: ``db`` already exists.
     """
     net_path = Path(net_path)
-    net_text = _read_text(net_path)
-    if config is None and (net_path.parent / "run.yaml").is_file():
-        config = net_path.parent / "run.yaml"
-    run_config = load_config(config) if config is not None else RunConfig()
-    world_path = Path(world) if world is not None else (Path(run_config.world) if run_config.world else None)
-    inputs = {
-        "net_file": str(net_path),
-        "net_text": net_text,
-        "config": {k: v for k, v in run_config.to_dict().items() if k != "world"},
-        "seed": run_config.seed if seed is None else seed,
-        "until": run_config.until if until is None else until,
-        "world_file": None if world_path is None else str(world_path),
-        "world_base": None if world_path is None else str(world_path.parent),
-        "world_text": None if world_path is None else _read_text(world_path),
-    }
-    # fail on a bad net before creating any output file
-    _net_from_text(net_text, net_path.stem, str(net_path))
+    prepared = prepare(net_path, config=config, world=world, registry=registry)
+    inputs = _inputs(prepared, net_path, seed, until)
     journal = Journal(db, inputs) if db is not None else None
     try:
-        return _execute(inputs, journal=journal, trace=None if trace is None else Path(trace),
-                        xes=None if xes is None else Path(xes), realtime=realtime, gui=gui,
-                        registry=registry, progress=progress, max_firings=max_firings)
+        return _execute(prepared.net, prepared.binding, prepared.config, inputs, journal=journal,
+                        trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
+                        realtime=realtime, gui=gui, progress=progress, max_firings=max_firings,
+                        keep_events=keep_events)
     finally:
         if journal is not None:
             journal.close()
@@ -230,8 +330,88 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
     try:
         if journal.finished:
             raise JournalError(f"{db}: the run already finished ({journal.journaled} events)")
-        return _execute(journal.inputs, journal=journal, trace=None if trace is None else Path(trace),
-                        xes=None if xes is None else Path(xes), realtime=realtime, gui=gui,
-                        registry=registry, progress=progress, max_firings=None)
+        inputs = journal.inputs
+        net = _net_from_text(inputs["net_text"], inputs["net_file"])
+        config = RunConfig.from_dict(inputs["config"])
+        config.import_actions()
+        binding = bind(net, registry, path=inputs["net_file"])
+        return _execute(net, binding, config, inputs, journal=journal,
+                        trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
+                        realtime=realtime, gui=gui, progress=progress, max_firings=None)
     finally:
         journal.close()
+
+
+def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | str | Path | None = None,
+        seed: int | None = None, until: float | None = None, max_firings: int | None = None,
+        trace: str | Path | None = None, xes: str | Path | None = None, registry: Registry | None = None,
+        keep_events: bool = True) -> RunOutcome:
+    """Run a net from Python: a file (as ``petriflow run`` does) or a :class:`Net`.
+
+    Args:
+        net: a net file, or a net built or loaded in code.
+        world: a world file, a :class:`~petriflow.world.World` (or any object with
+            ``dt`` and ``step()``), or ``None``.
+        config: a :class:`RunConfig`, its mapping, or a file.
+        seed: the run seed (overrides the configuration's).
+        until: simulated-time limit in seconds (overrides the configuration's).
+        max_firings: stop after this many firings.
+        trace: write the events as JSON Lines to this file.
+        xes: write the firings as an XES log to this file.
+        registry: where actions are looked up (default: the run registry).
+        keep_events: keep every event in the outcome's ``events`` (memory grows with
+            the run; turn off for long runs).
+
+    Returns:
+        The :class:`RunOutcome`; ``outcome.result.reason`` says how the run ended.
+
+    Examples:
+        >>> from petriflow import Net, run
+        >>> net = Net("demo")
+        >>> _ = net.add_place("i", tokens=1); _ = net.add_place("o")
+        >>> _ = net.add_transition("rest", action="core.wait", params={"seconds": 3})
+        >>> _ = net.add_arc("i", "rest"); _ = net.add_arc("rest", "o")
+        >>> outcome = run(net)
+        >>> outcome.result.time, [e.kind for e in outcome.events]
+        (3.0, ['run', 'start', 'end', 'stop'])
+    """
+    if not isinstance(net, Net):
+        if isinstance(config, (RunConfig, dict)):
+            config = config if isinstance(config, RunConfig) else RunConfig.from_dict(config)
+        if world is not None and not isinstance(world, (str, Path)):
+            raise TypeError("with a net file, give the world as a file too")
+        return run_files(net, world=world, config=config, seed=seed, until=until, trace=trace, xes=xes,
+                         registry=registry, max_firings=max_firings, keep_events=keep_events)
+    if isinstance(config, dict):
+        config = RunConfig.from_dict(config)
+    elif isinstance(config, (str, Path)):
+        config = load_config(config)
+    config = config or RunConfig()
+    config.import_actions()
+    close = False
+    if isinstance(world, (str, Path)):
+        from petriflow.world import load_world
+
+        world, close = load_world(world), True
+    observers: dict[str, Any] = {}
+    try:
+        scheduler = Scheduler(net, world=world, config=config, seed=seed, registry=registry)
+        observers = _observe(scheduler, net, journal=None, trace=None if trace is None else Path(trace),
+                             xes=None if xes is None else Path(xes), progress=False, keep_events=keep_events)
+        started = wallclock.perf_counter()
+        result = scheduler.run(until=until, max_firings=max_firings)
+        wall = wallclock.perf_counter() - started
+    except BaseException:
+        for name in ("trace", "xes"):
+            if name in observers:
+                observers[name].close(keep=False)
+        raise
+    finally:
+        if close:
+            world.close()
+    outcome = RunOutcome(result, net, observers.get("events", []), wall)
+    for name, path in (("trace", trace), ("xes", xes)):
+        if name in observers:
+            observers[name].close()
+            outcome.written.append(str(path))
+    return outcome

@@ -2,8 +2,9 @@
 
 Every firing, action start and end, message, fault and cancellation of a run is an
 :class:`Event` stamped with simulated time and a sequence number. Observers (a trace
-file, the journal, a progress display) subscribe to the scheduler; none of them is
-imported by it.
+file, an XES log, the journal, a progress display) subscribe to the scheduler; none
+of them is imported by it, and none keeps the events in memory: a run of any length
+holds only what is still in flight (an XES log keeps the firings not yet ended).
 
 Token data can be large (camera frames) or not JSON at all; events carry
 :func:`summarize`\\ d data instead: plain JSON kept as it is, anything else replaced by
@@ -13,23 +14,53 @@ bit for bit between runs.
 
 from __future__ import annotations
 
+import enum
 import hashlib
 import json
 import math
+import os
+import tempfile
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 from xml.sax.saxutils import quoteattr
 
 from petriflow.errors import NetFormatError
+from petriflow.outcome import Outcome
 
-__all__ = ["Event", "summarize", "TraceWriter", "read_trace", "write_xes", "EVENT_KINDS"]
-
-#: The kinds of events a run records.
-EVENT_KINDS = ("run", "start", "end", "message", "fault", "cancel", "custom", "stop")
+__all__ = ["Event", "EventKind", "summarize", "TraceWriter", "XesWriter", "read_trace", "write_xes",
+           "EVENT_KINDS"]
 
 
-@dataclass(frozen=True)
+class EventKind(str, enum.Enum):
+    """What an :class:`Event` records."""
+
+    RUN = "run"
+    """The run starts: net, seed, ``dt``, initial marking, agents."""
+    START = "start"
+    """A transition fires: its input tokens are consumed and its action starts."""
+    END = "end"
+    """A firing's action ends with an outcome; its outputs are produced."""
+    MESSAGE = "message"
+    """A token put into a channel place is sent, delivered or lost."""
+    FAULT = "fault"
+    """An injected fault: an agent killed or joining, a link dropped or restored."""
+    CANCEL = "cancel"
+    """A cancellation region withdraws tokens and cancels running actions."""
+    CUSTOM = "custom"
+    """Something an action reported (``ctx.emit``)."""
+    STOP = "stop"
+    """The run ends: why, firings, marking, what was still running."""
+
+    def __str__(self) -> str:
+        return self.value
+
+
+#: The kinds of events a run records, as written in traces.
+EVENT_KINDS = tuple(k.value for k in EventKind)
+
+
+@dataclass(frozen=True, slots=True)
 class Event:
     """One thing that happened in a run.
 
@@ -102,28 +133,30 @@ def _digest(value: Any) -> str:
 
 
 class TraceWriter:
-    """Writes events to a JSON Lines file as they happen (flushing each line).
+    """Writes events to a JSON Lines file as they happen (an observer).
 
-    The file is first written as ``NAME.partial`` and renamed when the run closes, so
-    an existing trace of the same name is never half-overwritten by a failed run.
+    The file is written under a unique temporary name in the target folder and
+    renamed when the run closes, so an existing trace of the same name is never
+    half-overwritten by a failed run, and two runs never share a temporary file.
     """
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
-        self._partial = self.path.with_name(self.path.name + ".partial")
-        self._file = self._partial.open("w", encoding="utf-8")
+        fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial",
+                                             dir=self.path.parent if str(self.path.parent) else ".")
+        self._file = os.fdopen(fd, "w", encoding="utf-8")
 
     def __call__(self, event: Event) -> None:
         self._file.write(event.to_json() + "\n")
-        self._file.flush()
 
     def close(self, keep: bool = True) -> None:
         """Finish the file (rename into place), or drop it when ``keep`` is false."""
         self._file.close()
         if keep:
-            self._partial.replace(self.path)
+            os.chmod(self._partial, 0o666 & ~_umask())
+            os.replace(self._partial, self.path)
         else:
-            self._partial.unlink(missing_ok=True)
+            os.unlink(self._partial)
 
 
 def read_trace(path: str | Path) -> list[Event]:
@@ -148,69 +181,113 @@ def read_trace(path: str | Path) -> list[Event]:
     return events
 
 
-def _completed(events: Iterable[Event]) -> Iterator[tuple[Event, Event]]:
-    """Pairs (start, end) of firings that completed, in start order."""
-    starts: dict[int, Event] = {}
-    pairs = []
-    for event in events:
-        if event.kind == "start":
-            starts[event.data["firing"]] = event
-        elif event.kind == "end" and event.data.get("outcome") != "cancelled":
-            start = starts.get(event.data["firing"])
-            if start is not None:
-                pairs.append((start, event))
-    pairs.sort(key=lambda pair: pair[0].seq)
-    return iter(pairs)
+_XES_HEAD = [
+    '<?xml version="1.0" encoding="UTF-8"?>',
+    '<log xes.version="1.0" xes.features="nested-attributes" xmlns="http://www.xes-standard.org/">',
+    '  <extension name="Concept" prefix="concept" uri="http://www.xes-standard.org/concept.xesext"/>',
+    '  <extension name="Time" prefix="time" uri="http://www.xes-standard.org/time.xesext"/>',
+    '  <extension name="Lifecycle" prefix="lifecycle" uri="http://www.xes-standard.org/lifecycle.xesext"/>',
+    '  <extension name="Organizational" prefix="org" uri="http://www.xes-standard.org/org.xesext"/>',
+]
+
+
+class XesWriter:
+    """Writes the completed firings of a run as an XES event log with one trace, as
+    the run goes (an observer: ``scheduler.on_event(writer)``).
+
+    One XES event per firing that ended (``lifecycle:transition`` ``complete``), in
+    the order the firings ended, stamped with the time they ended (the time they
+    started is ``petriflow:start``). Ordered by completion, the log is a firing
+    sequence of the net with atomic transitions: a firing's inputs were produced by
+    firings that ended before it started. Its ``concept:name`` is the transition's
+    label (or, for a non-ok outcome, the label of its outcome variant
+    ``label@outcome``); silent transitions and cancelled firings are left out, as
+    process mining expects. Only the firings still running are held in memory; the
+    file is written under a temporary name and renamed by :meth:`close`.
+
+    Args:
+        path: the ``.xes`` file.
+        case: the trace's ``concept:name``.
+        labels: ``{transition: label}`` (default: the id).
+        silent: transitions to leave out.
+    """
+
+    def __init__(self, path: str | Path, *, case: str = "run", labels: dict[str, str] | None = None,
+                 silent: Iterable[str] = ()) -> None:
+        self.path = Path(path)
+        self.labels = labels or {}
+        self.silent = set(silent)
+        self.count = 0
+        fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial",
+                                             dir=self.path.parent if str(self.path.parent) else ".")
+        self._file = os.fdopen(fd, "w", encoding="utf-8")
+        self._file.write("\n".join(_XES_HEAD) + "\n")
+        self._file.write(f'  <trace>\n    <string key="concept:name" value={quoteattr(case)}/>\n')
+        self._open: dict[int, Event] = {}  # firing -> its start event, while it runs
+
+    def __call__(self, event: Event) -> None:
+        kind = event.kind
+        if kind == "start":
+            self._open[event.data["firing"]] = event
+        elif kind == "end":
+            start = self._open.pop(event.data["firing"], None)
+            if start is not None and event.data.get("outcome") != Outcome.CANCELLED:
+                self._write(start, event)
+
+    def _write(self, start: Event, end: Event) -> None:
+        transition = start.transition or ""
+        if transition in self.silent:
+            return
+        name = self.labels.get(transition, transition)
+        outcome = end.data.get("outcome", Outcome.OK.value)
+        if outcome != Outcome.OK:
+            name = f"{name}@{outcome}"
+        lines = ["    <event>",
+                 f'      <string key="concept:name" value={quoteattr(name)}/>',
+                 '      <string key="lifecycle:transition" value="complete"/>',
+                 f'      <date key="time:timestamp" value="{_timestamp(end.time)}"/>',
+                 f'      <float key="petriflow:start" value="{start.time!r}"/>']
+        if start.agent:
+            lines.append(f'      <string key="org:resource" value={quoteattr(start.agent)}/>')
+        lines.append("    </event>\n")
+        self._file.write("\n".join(lines))
+        self.count += 1
+
+    def close(self, keep: bool = True) -> int:
+        """Finish the log (firings still running are left out) and rename it into place,
+        or drop it when ``keep`` is false. Returns the number of events written."""
+        self._open.clear()
+        self._file.write("  </trace>\n</log>\n")
+        self._file.close()
+        if keep:
+            os.chmod(self._partial, 0o666 & ~_umask())
+            os.replace(self._partial, self.path)
+        else:
+            os.unlink(self._partial)
+        return self.count
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def write_xes(events: Iterable[Event], path: str | Path, *, case: str = "run",
               labels: dict[str, str] | None = None, silent: Iterable[str] = ()) -> int:
-    """Write the completed firings of a run as an XES event log with one trace.
-
-    Events are ordered by the time their transition fired (started), which is a
-    firing sequence of the net with atomic transitions. Each event's ``concept:name``
-    is the transition's label (or, for a non-ok outcome, the label of its outcome
-    variant ``label@outcome``); silent transitions are left out, as process mining
-    expects.
+    """Write the completed firings of recorded ``events`` as an XES log (see :class:`XesWriter`).
 
     Returns:
         The number of events written.
     """
-    from petriflow.io.files import write_atomic
-
-    labels = labels or {}
-    silent = set(silent)
-    lines = [
-        '<?xml version="1.0" encoding="UTF-8"?>',
-        '<log xes.version="1.0" xes.features="nested-attributes" xmlns="http://www.xes-standard.org/">',
-        '  <extension name="Concept" prefix="concept" uri="http://www.xes-standard.org/concept.xesext"/>',
-        '  <extension name="Time" prefix="time" uri="http://www.xes-standard.org/time.xesext"/>',
-        '  <extension name="Lifecycle" prefix="lifecycle" uri="http://www.xes-standard.org/lifecycle.xesext"/>',
-        '  <extension name="Organizational" prefix="org" uri="http://www.xes-standard.org/org.xesext"/>',
-        f'  <trace>\n    <string key="concept:name" value={quoteattr(case)}/>',
-    ]
-    count = 0
-    for start, end in _completed(events):
-        transition = start.transition or ""
-        if transition in silent:
-            continue
-        name = labels.get(transition, transition)
-        outcome = end.data.get("outcome", "ok")
-        if outcome != "ok":
-            name = f"{name}@{outcome}"
-        stamp = _timestamp(start.time)
-        lines.append("    <event>")
-        lines.append(f'      <string key="concept:name" value={quoteattr(name)}/>')
-        lines.append('      <string key="lifecycle:transition" value="complete"/>')
-        lines.append(f'      <date key="time:timestamp" value="{stamp}"/>')
-        lines.append(f'      <float key="petriflow:end" value="{end.time!r}"/>')
-        if start.agent:
-            lines.append(f'      <string key="org:resource" value={quoteattr(start.agent)}/>')
-        lines.append("    </event>")
-        count += 1
-    lines.append("  </trace>\n</log>\n")
-    write_atomic(path, "\n".join(lines))
-    return count
+    writer = XesWriter(path, case=case, labels=labels, silent=silent)
+    try:
+        for event in events:
+            writer(event)
+    except BaseException:
+        writer.close(keep=False)
+        raise
+    return writer.close()
 
 
 def _timestamp(seconds: float) -> str:

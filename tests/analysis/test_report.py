@@ -1,8 +1,7 @@
-"""``check_net``, its text report, exit codes and ``cmd_check``."""
+"""``check_net``, its text report, exit codes, and ``petriflow check`` printing them."""
 
 from __future__ import annotations
 
-import argparse
 import json
 
 import pytest
@@ -12,11 +11,11 @@ from petriflow.analysis.report import (
     EXIT_PROBLEM,
     EXIT_UNDECIDED,
     check_net,
-    cmd_check,
     exit_code,
     format_report,
 )
 from petriflow.classic import dining_philosophers, producer_consumer
+from petriflow.cli import main
 from petriflow.io.yaml import loads_net
 
 KEYS = {"places", "transitions", "workflow_net", "sound", "bounded", "safe", "deadlock_free",
@@ -122,11 +121,11 @@ def test_format_report_of_an_unbounded_net():
 
 
 @pytest.mark.parametrize("as_json", [False, True])
-def test_cmd_check_prints_and_returns_the_exit_code(tmp_path, capsys, as_json):
-    """cmd_check loads the file, prints the report (or JSON) and returns the exit code."""
+def test_check_command_prints_and_returns_the_exit_code(tmp_path, capsys, as_json):
+    """petriflow check loads the file, prints the report (or JSON) and returns the exit code."""
     path = tmp_path / "order.yaml"
     path.write_text(WORKFLOW)
-    code = cmd_check(argparse.Namespace(net=str(path), json=as_json, max_states=None))
+    code = main(["check", str(path)] + (["--json"] if as_json else []))
     out = capsys.readouterr().out
     assert code == EXIT_PROBLEM
     if as_json:
@@ -135,13 +134,13 @@ def test_cmd_check_prints_and_returns_the_exit_code(tmp_path, capsys, as_json):
         assert out.startswith("order:")
 
 
-def test_cmd_check_state_limit_message(tmp_path, capsys):
+def test_check_command_state_limit_message(tmp_path, capsys):
     """With --max-states too small: one line on stderr, exit 2, JSON with complete false."""
     path = tmp_path / "big.yaml"
     from petriflow.io.yaml import dumps_net
 
     path.write_text(dumps_net(dining_philosophers(10)))
-    code = cmd_check(argparse.Namespace(net=str(path), json=True, max_states=20))
+    code = main(["check", str(path), "--json", "--max-states", "20"])
     captured = capsys.readouterr()
     assert code == EXIT_UNDECIDED
     assert json.loads(captured.out)["complete"] is False
@@ -149,25 +148,18 @@ def test_cmd_check_state_limit_message(tmp_path, capsys):
     assert len(error_lines) == 1 and "max_states=20" in error_lines[0]
 
 
-def test_cmd_check_rejects_a_bad_limit(tmp_path):
-    """--max-states 0 is bad input (a PetriflowError, exit 2 in the CLI)."""
-    from petriflow.errors import PetriflowError
-
+def test_check_command_rejects_a_bad_limit(tmp_path, capsys):
+    """--max-states 0 is bad input: one line, exit 2."""
     path = tmp_path / "order.yaml"
     path.write_text(WORKFLOW)
-    with pytest.raises(PetriflowError, match="max-states"):
-        cmd_check(argparse.Namespace(net=str(path), json=False, max_states=0))
+    assert main(["check", str(path), "--max-states", "0"]) == 2
+    assert "max-states" in capsys.readouterr().err
 
 
-def test_cli_wiring_sketch(tmp_path, capsys):
-    """The way cli.py is meant to call it: a subcommand whose handler is cmd_check."""
-    parser = argparse.ArgumentParser()
-    parser.add_argument("net")
-    parser.add_argument("--json", action="store_true")
-    parser.add_argument("--max-states", type=int, default=None)
+def test_check_command_json_counts_states(tmp_path, capsys):
     path = tmp_path / "philosophers.yaml"
     from petriflow.io.yaml import dumps_net
 
     path.write_text(dumps_net(dining_philosophers(4)))
-    assert cmd_check(parser.parse_args([str(path), "--json", "--max-states", "1000"])) == EXIT_OK
+    assert main(["check", str(path), "--json", "--max-states", "1000"]) == EXIT_OK
     assert json.loads(capsys.readouterr().out)["states"] == 7

@@ -172,7 +172,7 @@ transitions:
 def test_guard_reads_token_data_through_a_registered_predicate():
     """A guard is a registered predicate over the tokens a firing would take."""
     registry = Registry(load_plugins=False)
-    registry.predicate("test.positive")(lambda tokens, params, board: tokens["n"][0] > 0)
+    registry.predicate("test.positive")(lambda tokens, params: tokens["n"][0] > 0)
     registry.register("core.noop", default_registry.resolve("core.noop"))
     net = net_of("""
 places: [n, out]

@@ -46,7 +46,7 @@ def test_world_run_is_deterministic(tmp_path):
 
 def test_passage_robots_move_through_the_passage_by_physics(tmp_path):
     """Both robots end on the other side of the wall, taking turns in the passage."""
-    outcome = run_files(PASSAGE, trace=tmp_path / "t.jsonl")
+    outcome = run_files(PASSAGE, trace=tmp_path / "t.jsonl", keep_events=True)
     assert outcome.result.reason == "final"
     ends = {e.transition: e for e in outcome.events if e.kind == "end"}
     assert ends["red_leave"].data["result"]["x"] > 1.0

@@ -72,7 +72,7 @@ def test_capture_renders_only_when_fired(marker_scene, renders):
     fired = fire_one(net, "capture", world=marker_scene.world)
     assert renders == [("top", 320, 240)]
     assert fired.outcome == "ok"
-    assert scheduler.blackboard == {}
+    assert scheduler.running() == []
 
 
 def test_fire_capture_gives_a_frame_token(marker_scene):
@@ -117,18 +117,19 @@ def test_capture_with_an_unknown_camera_fails(marker_scene):
     assert fired.outcome == "failed" and "side" in fired.reason
 
 
-def test_whole_net_passes_frame_and_camera_through_the_blackboard(marker_scene, renders):
-    """capture then locate in one run: one render; locate reads the blackboard's camera."""
-    net = loads_net(NET.replace("params: {camera: top}", "params: {camera: top, width: 640, height: 480}"))
+def test_whole_net_passes_the_camera_with_the_frame_token(marker_scene, renders):
+    """capture then locate in one run: one render; the frame token knows its camera,
+    so locate measures in metres with nothing shared beside the net."""
+    net = loads_net(NET.replace("params: {camera: top}", "params: {camera: top, width: 640, height: 480}")
+                    .replace("params: {require", "params: {camera: null, require"))
     scheduler = Scheduler(net, world=marker_scene.world, seed=1)
     events = []
     scheduler.on_event(events.append)
     result = scheduler.run()
     assert result.reason == "final"
     assert len(renders) == 1
-    scene = scheduler.blackboard["scene"]
-    assert scene.size == (640, 480)
-    assert scheduler.blackboard["frame"].shape == (480, 640, 3)
+    scene = result.tokens["identified"][0]
+    assert scene.size == (640, 480) and scene.camera is not None and scene.camera.width == 640
     for colour, (x, y, _) in marker_scene.truth.items():
         px, py = scene.robots[colour].position
         assert math.hypot(px - x, py - y) < 0.01

@@ -8,7 +8,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from petriflow.agents.smart.actions import ORDERS_KEY, Avoid, Follow, Send, frame_record, simplify
+from petriflow.agents.smart.actions import Avoid, Follow, Send, frame_record, simplify
 from petriflow.agents.smart.guards import help_needed
 from petriflow.agents.smart.messages import ActionId, Command
 
@@ -79,41 +79,56 @@ def test_help_needed_wants_the_helper_up_and_the_other_robot_down():
     labels[10:20, 10:40] = 2                                        # red, seen without its discs
     down = SimpleNamespace(robots={"yellow": pose(0, 0)}, segmented=labels, metres_per_pixel=0.01,
                            origin=(0, 0))
-    assert help_needed({"P6": [down]}, {"helper": "yellow", "fallen": "red"}, {})
+    assert help_needed({"P6": [down]}, {"helper": "yellow", "fallen": "red"})
     nobody = SimpleNamespace(robots={"yellow": pose(0, 0)}, segmented=np.zeros_like(labels),
                              metres_per_pixel=0.01, origin=(0, 0))
-    assert not help_needed({"P6": [nobody]}, {"helper": "yellow", "fallen": "red"}, {})
+    assert not help_needed({"P6": [nobody]}, {"helper": "yellow", "fallen": "red"})
+
+
+AVOID = """
+petriflow: 1
+places: [a, b, orders]
+transitions: [{id: t, action: smart.avoid, params: {priorities: {yellow: 2, blue: 1}, step: 0.08, radius: 0.13,
+               orders: orders}, in: [a, orders], out: [b, orders]}]
+"""
+
+
+def avoid_orders(*scenes):
+    """Fire smart.avoid once per scene (one run: the avoidance keeps its state); the
+    standing orders token at the end, and the custom events."""
+    run = Scheduler(loads_net(AVOID), seed=1)
+    run.set_tokens({"a": list(scenes), "orders": [None]})
+    events = []
+    run.on_event(events.append)
+    result = run.run()
+    assert result.firings == len(scenes)
+    custom = [(e.data["name"], e.data["data"]) for e in events if e.kind == "custom"]
+    return result.tokens["orders"][0], custom
 
 
 def test_avoid_holds_the_lower_priority_robot_and_replans_the_other():
     """Closer than two steps: blue (priority 1) holds with a STOP frame, yellow (2)
-    re-plans; once yellow has passed, blue goes on."""
-    net = loads_net("""
-petriflow: 1
-places: [{id: a, tokens: 1}, b]
-transitions: [{id: t, action: smart.avoid, params: {priorities: {yellow: 2, blue: 1}, step: 0.08, radius: 0.13},
-               in: [a], out: [b]}]
-""")
-    run = Scheduler(net, seed=1)
-    run.set_tokens({"a": [scene(yellow=(0.0, 0.0), blue=(1.0, 0.0))]})
-    run.fire_one("t")
-    assert run.blackboard[ORDERS_KEY] == {"blue": {"order": "go", "others": [], "t": 0.0},
-                                          "yellow": {"order": "go", "others": [], "t": 0.0}}
-    events = []
-    run.on_event(events.append)
-    for place_, where in (("b", (0.40, 0.0)), ("b", (0.40, 0.0))):
-        run.tokens["a"].append(scene(yellow=(0.0, 0.0), blue=where))
-        run._started = True
-        run.fire_one("t")
-    orders = run.blackboard[ORDERS_KEY]
+    re-plans; the orders are the token of the orders place, given back updated."""
+    orders, custom = avoid_orders(scene(yellow=(0.0, 0.0), blue=(1.0, 0.0)))
+    assert orders == {"blue": {"order": "go", "others": [], "t": 0.0},
+                      "yellow": {"order": "go", "others": [], "t": 0.0}}
+    orders, custom = avoid_orders(scene(yellow=(0.0, 0.0), blue=(1.0, 0.0)),
+                                  scene(yellow=(0.0, 0.0), blue=(0.40, 0.0)),
+                                  scene(yellow=(0.0, 0.0), blue=(0.40, 0.0)))
     assert orders["blue"]["order"] == "hold" and orders["blue"]["others"] == ["yellow"]
-    assert orders["yellow"]["order"] == "replan"
-    stops = [e.data["data"] for e in events if e.kind == "custom" and e.data["name"] == "smart.frame"]
-    assert [(s["action"], s["robot"]) for s in stops] == [("STOP", 3)]
-    orders["yellow"]["order"] = "replanning"                      # taken by yellow's walk
-    run.tokens["a"].append(scene(yellow=(-0.5, 0.3), blue=(0.40, 0.0)))
-    run.fire_one("t")
-    assert orders["blue"]["order"] == "go" and orders["yellow"]["order"] == "go"
+    assert orders["yellow"]["order"] == "replan" and orders["yellow"]["id"] == 1
+    assert [(d["action"], d["robot"]) for name, d in custom if name == "smart.frame"] == [("STOP", 3)]
+
+
+def test_avoid_releases_the_held_robot_once_the_other_has_passed():
+    """Once yellow has passed, blue is told to go; yellow's re-plan order stands (its
+    walk obeys an order id once)."""
+    orders, custom = avoid_orders(scene(yellow=(0.0, 0.0), blue=(0.40, 0.0)),
+                                  scene(yellow=(-0.5, 0.3), blue=(0.40, 0.0)))
+    assert orders["blue"]["order"] == "go"
+    assert orders["yellow"]["order"] == "replan" and orders["yellow"]["id"] == 1
+    assert [(d["robot"], d["order"]) for name, d in custom if name == "smart.order"] == [
+        ("blue", "hold"), ("yellow", "replan"), ("blue", "go")]
 
 
 def test_push_moves_a_body(arena):
@@ -158,17 +173,30 @@ def test_follow_fails_for_a_replan_when_far_from_its_path(arena):
 
 
 def test_follow_holds_while_told_to(arena):
-    """A hold order (smart.avoid) keeps the robot standing once its legs are in their
-    posture (the first second); it does not walk."""
+    """A hold order (smart.avoid's, in the place its orders port names) keeps the robot
+    standing once its legs are in their posture (the first second); it does not walk."""
     world = arena(settle=0.2)
-    net = loads_net(FOLLOW.replace("PATH", "[[-0.8, -0.55], [-0.5, -0.2]]"))
+    net = loads_net("""
+petriflow: 1
+places: [{id: a, tokens: 1}, b, orders]
+transitions:
+  - {id: t, action: smart.follow, in: [a], out: [b],
+     params: {robot: robot3l, colour: yellow, path: [[-0.8, -0.55], [-0.5, -0.2]], localise: world,
+              orders: orders}}
+""")
     run = Scheduler(net, world=world, seed=1)
-    run.blackboard[ORDERS_KEY] = {"yellow": {"order": "hold", "others": ["blue"]}}
+    run.set_tokens({"a": [None], "orders": [{"yellow": {"order": "hold", "others": ["blue"]}}]})
     before = world.pose("robot3l")
     result = run.fire_one("t", timeout=4.0)
     assert result.reason == "until" and run.running() == ["t"]
-    assert run._running["t"].action.held_for > 2.5
+    assert run.running_actions()["t"].held_for > 2.5
     assert math.dist(world.pose("robot3l")[:2], before[:2]) < 0.03
+
+
+def test_follow_port_must_name_a_place_of_the_net():
+    """The orders and scene ports are checked when the net is bound."""
+    with pytest.raises(NetFormatError, match="port 'orders' names unknown place 'order'"):
+        default_registry.bind(loads_net(one("smart.follow", "{orders: order}")))
 
 
 def test_follow_checks_its_parameters():

@@ -59,7 +59,7 @@ def test_net_loads_and_binds_to_registered_actions(name):
     """Every transition's action and guard resolve and its parameters check."""
     net = load_net(SMART / name)
     bound = default_registry.bind(net, name)
-    assert set(bound) == {t for t, tr in net.transitions.items() if tr.action}
+    assert set(bound.actions()) == {t for t, tr in net.transitions.items() if tr.action}
 
 
 def test_smart_net_keeps_the_papers_places_and_transitions(net):
@@ -87,8 +87,9 @@ def test_smart_net_is_a_wf_net_with_source_i_and_sink_o(net):
 
 
 def test_t0_puts_the_papers_initial_marking(net):
-    """T0 puts M0 = (P1, P5) of the paper (plus the task token P13)."""
-    assert fire(net, net.initial_marking, "T0") == {"P1": 1, "P5": 1, "P13": 1}
+    """T0 puts M0 = (P1, P5) of the paper (plus the task token P13 and the latest-scene
+    place S)."""
+    assert fire(net, net.initial_marking, "T0") == {"P1": 1, "P5": 1, "P13": 1, "S": 1}
 
 
 @pytest.mark.parametrize("name", ["smart.yaml", "reinsertion.yaml", "crossing.yaml"])

@@ -28,11 +28,12 @@ def frames_of(fired):
 
 
 def test_t0_dresses_the_arena_and_takes_the_first_image(net, arena):
-    """T0 (smart.capture): white floor, hats on, one 320 x 240 frame in P1; marks M0."""
+    """T0 (smart.capture): white floor, hats on, one 320 x 240 frame in P1; marks M0
+    (and the latest-scene place S)."""
     world = arena(settle=0.0)
     fired = fire_one(net, "T0", world=world)
     assert fired.outcome == "ok"
-    assert fired.marking == {"P1": 1, "P5": 1, "P13": 1}
+    assert fired.marking == {"P1": 1, "P5": 1, "P13": 1, "S": 1}
     frame = fired.tokens["P1"][0]
     assert frame.shape == (240, 320, 3) and frame.dtype == np.uint8
     assert (frame[5, 5] == 255).all()                      # the floor is white
@@ -58,12 +59,14 @@ def test_t2_captures_a_new_image_when_the_decision_maker_asks(net, arena):
 
 def test_t3_locates_the_helper_and_not_the_fallen_robot(net, arena):
     """T3 (vision.locate): the standing Robot3L is found where it is; the fallen Robot4L
-    shows no discs, so it is not among the located robots."""
+    shows no discs, so it is not among the located robots. The scene also replaces the
+    latest scene in S."""
     world = arena()
     frame = world.camera("top").capture()
-    fired = fire_one(net, "T3", tokens={"P3": [frame], "P5": [None]}, world=world)
-    assert fired.outcome == "ok" and fired.marking == {"P4": 1}
+    fired = fire_one(net, "T3", tokens={"P3": [frame], "P5": [None], "S": [None]}, world=world)
+    assert fired.outcome == "ok" and fired.marking == {"P4": 1, "S": 1}
     scene = fired.tokens["P4"][0]
+    assert fired.tokens["S"] == [scene]
     x, y, _ = world.pose("robot3l")
     seen = scene.robots["yellow"].position
     assert math.dist(seen, (x, y)) < 0.03
@@ -168,6 +171,6 @@ def test_t6_the_fallen_robot_stands_up_leaning_on_the_helper(net, arena):
 def test_t9_the_helper_holds_and_the_net_ends(net):
     """T9 (smart.send HOLD to Robot3L) collects the helper's, the fallen robot's and the
     camera loop's tokens into o."""
-    fired = fire_one(net, "T9", marking={"P11": 1, "P12": 1, "P2": 1, "P5": 1, "P6": 1})
+    fired = fire_one(net, "T9", marking={"P11": 1, "P12": 1, "P2": 1, "P5": 1, "P6": 1, "S": 1})
     assert fired.outcome == "ok" and fired.marking == {"o": 1}
     assert [(c.action, c.robot) for c in frames_of(fired)] == [(ActionId.HOLD, 4)]

@@ -1,0 +1,157 @@
+"""Binding a net to code: every action, parameter, port and guard resolved at load time.
+
+A net names actions and guards; it never names code. :func:`bind` resolves each bound
+transition against a :class:`~petriflow.runtime.registry.Registry` once, before a
+run, a check or an ``info`` shows it, so a typo fails before a robot moves (as
+BehaviorTree.CPP checks a tree's ports against its node manifest when it loads):
+
+* the action name must be registered (close matches are suggested);
+* its parameters are checked against the action's declared :class:`Param`\\ s
+  (unknown, missing, ill-typed: close matches again);
+* its :class:`Port`\\ s must name places of the net;
+* the guard name must be registered.
+
+Errors name the file and the line the loader recorded (``net.lines``), location first.
+
+Examples:
+    >>> from petriflow.io.yaml import loads_net
+    >>> net = loads_net('''
+    ... petriflow: 1
+    ... places: [{id: a, tokens: 1}, b]
+    ... transitions:
+    ...   - {id: rest, action: core.wait, params: {seconds: 2}, in: [a], out: [b]}
+    ... ''', path="demo.yaml")
+    >>> bind(net).transitions["rest"].params
+    {'seconds': 2.0}
+    >>> net = loads_net('''
+    ... petriflow: 1
+    ... places: [{id: a, tokens: 1}, b]
+    ... transitions:
+    ...   - id: rest
+    ...     action: core.wait
+    ...     params: {secnds: 2}
+    ...     in: [a]
+    ...     out: [b]
+    ... ''', path="demo.yaml")
+    >>> bind(net)
+    Traceback (most recent call last):
+    ...
+    petriflow.errors.NetFormatError: demo.yaml:7: 'rest': action has no parameter 'secnds' (did you mean 'seconds'?) (it takes: seconds)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from petriflow.errors import NetFormatError, did_you_mean
+from petriflow.net import Net
+from petriflow.runtime.action import Action, Port
+from petriflow.runtime.registry import Predicate, Registry, UnknownActionError, default_registry
+
+__all__ = ["Binding", "BoundTransition", "bind"]
+
+
+@dataclass(frozen=True)
+class BoundTransition:
+    """One transition resolved to code.
+
+    Attributes:
+        id: the transition.
+        action: the :class:`Action` class, or ``None`` for a transition with no action
+            (it fires and ends in the same instant, passing its input data on).
+        params: the checked parameters (defaults filled in).
+        guard: the guard predicate, or ``None``.
+        ports: ``{port: place}`` of the action's ports that name a place.
+    """
+
+    id: str
+    action: type[Action] | None
+    params: dict[str, Any]
+    guard: Predicate | None = None
+    ports: dict[str, str] | None = None
+
+
+@dataclass(frozen=True)
+class Binding:
+    """A net whose transitions are all resolved: what a run needs before it starts.
+
+    Attributes:
+        net: the net.
+        registry: where the names were resolved.
+        transitions: ``{transition id: BoundTransition}`` for every transition.
+    """
+
+    net: Net
+    registry: Registry
+    transitions: dict[str, BoundTransition]
+
+    def actions(self) -> dict[str, type[Action]]:
+        """``{transition id: Action class}`` of the bound transitions."""
+        return {t: b.action for t, b in self.transitions.items() if b.action is not None}
+
+
+def _line(net: Net, *keys: str) -> int | None:
+    for key in keys:
+        line = net.lines.get(key)
+        if line is not None:
+            return line
+    return None
+
+
+def bind(net: Net, registry: Registry | None = None, *, path: str | None = None) -> Binding:
+    """Resolve every transition of ``net`` against ``registry`` (default: the run registry).
+
+    Args:
+        net: the net, as loaded (its ``lines`` give error lines).
+        registry: where action and guard names are looked up.
+        path: the file named in errors (default: the file the net was read from).
+
+    Raises:
+        NetFormatError: ``file:line: 'transition': ...`` for an unknown action or guard,
+            a bad parameter, or a port that names no place (with close matches).
+    """
+    registry = registry or default_registry
+    path = path or net.path
+    bound: dict[str, BoundTransition] = {}
+    resolved: dict[str, type[Action]] = {}
+    guards: dict[str, Predicate] = {}
+    for transition in net.transitions.values():
+        tid = transition.id
+
+        def fail(message: str, *keys: str) -> NetFormatError:
+            return NetFormatError(message, path=path, line=_line(net, *keys, tid), element=tid)
+
+        guard = None
+        if transition.guard is not None:
+            guard = guards.get(transition.guard)
+            if guard is None:
+                try:
+                    guard = guards[transition.guard] = registry.guard(transition.guard)
+                except UnknownActionError as exc:
+                    raise fail(str(exc), f"{tid}/guard") from None
+        if transition.action is None:
+            bound[tid] = BoundTransition(tid, None, dict(transition.params), guard)
+            continue
+        cls = resolved.get(transition.action)
+        if cls is None:
+            try:
+                cls = resolved[transition.action] = registry.resolve(transition.action)
+            except UnknownActionError as exc:
+                raise fail(str(exc), f"{tid}/action") from None
+        try:
+            params = cls.check_params(transition.params, tid)
+        except NetFormatError as exc:
+            param = getattr(exc, "param", None)
+            raise fail(exc.message, f"{tid}/params/{param}", f"{tid}/params") from None
+        ports = {}
+        for name, declared in cls.params.items():
+            if not isinstance(declared, Port) or params.get(name) is None:
+                continue
+            place = params[name]
+            if place not in net.places:
+                raise fail(f"port {name!r} names unknown place {place!r}{did_you_mean(place, net.places)}",
+                           f"{tid}/params/{name}", f"{tid}/params")
+            ports[name] = place
+        bound[tid] = BoundTransition(tid, cls, params, guard, ports)
+    return Binding(net, registry, bound)

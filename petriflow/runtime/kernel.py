@@ -1,0 +1,187 @@
+"""The event core: a tick clock and a heap of typed events, in SimPy's mould.
+
+Simulated time is an integer count of ticks of ``dt`` seconds, so equal inputs give
+equal runs bit for bit. Everything that will happen later is a :class:`Scheduled`
+event, ordered by ``(tick, phase, key)``:
+
+* phase :data:`POLL`: a running firing asks to be polled (the firing itself is the
+  event): at the time it asked for, at its transition's timeout (:class:`Deadline`),
+  or at the next tick while it steps with the world or cleans up after a
+  cancellation. Polls of one tick run in firing order (``key`` is the firing number).
+* phase :data:`APPLY`: something from outside the net's firings: a message delivered
+  by a channel, a fault, a link restored. They apply in the order they were
+  scheduled.
+
+Components (channels, faults, the scheduler's firings) schedule events; an event
+knows what to do when its time comes (:meth:`Scheduled.apply`); the kernel only
+orders them. Nothing here is per agent or per transition: scheduling an event is an
+append, and a tick costs one heap operation however many events share it.
+
+Examples:
+    >>> clock = Kernel(dt=0.5)
+    >>> clock.ticks_at(1.2), clock.now
+    (3, 0.0)
+    >>> class Note(Scheduled):
+    ...     phase = APPLY
+    ...     def __init__(self, text): self.text = text
+    ...     def apply(self, tick): print(self.text, clock.now)
+    >>> clock.schedule(2, Note("second")); clock.schedule(1, Note("first"))
+    >>> clock.peek()
+    1
+    >>> clock.tick = 1; [event.apply(tick) for tick, event in clock.pop_due()]
+    first 0.5
+    [None]
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from typing import Any, Iterator
+
+__all__ = ["Kernel", "Scheduled", "Deadline", "POLL", "APPLY"]
+
+#: Phase of events that poll running firings (first at a tick, in firing order).
+POLL = 0
+#: Phase of events that change the marking or the agents from outside (after the polls).
+APPLY = 1
+
+
+class Scheduled:
+    """Something that happens at a tick. Subclasses set :attr:`phase` and implement
+    :meth:`apply`; :meth:`live` lets an event that no longer matters be skipped."""
+
+    __slots__ = ()
+    phase: int = APPLY
+
+    def live(self, tick: int) -> bool:
+        """Whether the event, scheduled at ``tick``, still matters (default: always)."""
+        return True
+
+    def apply(self, tick: int) -> None:
+        """Do what the event stands for, at its ``tick``."""
+        raise NotImplementedError
+
+
+class Deadline(Scheduled):
+    """A running firing's timeout: it is polled at that tick, whatever else it asked for.
+
+    Attributes:
+        firing: the firing's record (a :class:`Scheduled` with ``running``, ``number``
+            and ``apply``).
+        number: the firing's number (a record serves one firing after another).
+    """
+
+    __slots__ = ("firing", "number")
+    phase = POLL
+
+    def __init__(self, firing: Scheduled, number: int) -> None:
+        self.firing = firing
+        self.number = number
+
+    def live(self, tick: int) -> bool:
+        return self.firing.running and self.firing.number == self.number
+
+    def apply(self, tick: int) -> None:
+        self.firing.apply(tick)
+
+
+class Kernel:
+    """A tick clock and the :class:`Scheduled` events ahead, in buckets by tick.
+
+    Ticks are integers, so the events of one tick share a bucket (a list of polls and
+    a list of applies) and only the distinct ticks are kept in a heap: scheduling is
+    an append (plus a heap push for a tick not yet seen), and a thousand agents
+    waking at the same tick cost one heap entry. The polls of a tick are sorted by
+    their key (the firing number) when the tick comes.
+
+    Args:
+        dt: seconds per tick.
+
+    Attributes:
+        tick: the current tick (the scheduler advances it).
+        pending: the :data:`APPLY` events not yet applied (deliveries, faults): a run
+            is not over while one is.
+    """
+
+    def __init__(self, dt: float) -> None:
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be a finite number of seconds > 0, got {dt!r}")
+        self.dt = float(dt)
+        self.tick = 0
+        self.pending = 0
+        self._ticks: list[int] = []
+        self._buckets: dict[int, tuple[list[tuple[int, int, Scheduled]], list[Scheduled]]] = {}
+        self._order = 0
+
+    @property
+    def now(self) -> float:
+        """Current simulated time in seconds."""
+        return self.tick * self.dt
+
+    def ticks_at(self, seconds: float) -> int:
+        """The first tick at or after ``seconds`` (never before tick 0)."""
+        return max(0, math.ceil(seconds / self.dt - 1e-9))
+
+    def schedule(self, tick: int, event: Scheduled, key: int | None = None) -> None:
+        """Schedule ``event`` at ``tick`` (not before the current tick).
+
+        ``key`` orders the polls of one tick (default: scheduling order); applies keep
+        the order they were scheduled in.
+        """
+        if tick < self.tick:
+            tick = self.tick
+        bucket = self._buckets.get(tick)
+        if bucket is None:
+            bucket = self._buckets[tick] = ([], [])
+            heapq.heappush(self._ticks, tick)
+        self._order += 1
+        if event.phase == POLL:
+            bucket[0].append((self._order if key is None else key, self._order, event))
+        else:
+            self.pending += 1
+            bucket[1].append(event)
+
+    def peek(self) -> int | None:
+        """The tick of the next live event, or ``None`` when nothing is scheduled."""
+        ticks, buckets = self._ticks, self._buckets
+        while ticks:
+            tick = ticks[0]
+            polls, applies = buckets[tick]
+            if applies:
+                return tick
+            while polls and not polls[-1][2].live(tick):
+                polls.pop()
+            if polls:
+                return tick
+            del buckets[tick]
+            heapq.heappop(ticks)
+        return None
+
+    def pop_due(self) -> Iterator[tuple[int, Scheduled]]:
+        """Take the live events due at the current tick, in order (polls by key, then
+        applies), as ``(tick, event)``. Applies scheduled for the current tick while
+        iterating are taken too."""
+        tick = self.tick
+        bucket = self._buckets.get(tick)
+        if bucket is None:
+            return
+        polls, applies = bucket
+        if polls:
+            polls.sort()
+            for _, _, event in polls:
+                if event.live(tick):
+                    yield tick, event
+            polls.clear()
+        index = 0
+        while index < len(applies):
+            event = applies[index]
+            index += 1
+            self.pending -= 1
+            if event.live(tick):
+                yield tick, event
+        applies.clear()
+
+    def __len__(self) -> int:
+        """Events scheduled (live or not)."""
+        return sum(len(polls) + len(applies) for polls, applies in self._buckets.values())

@@ -1,0 +1,241 @@
+"""Tokens with data, and the set of transitions that may fire, kept up to date.
+
+:class:`TokenStore` is a run's marking: per place, the data of its tokens in arrival
+order, beside the count vector that :class:`~petriflow.engine.CompiledNet`'s firing
+rule reads. Starting a firing and ending it go through the compiled net's
+:meth:`~petriflow.engine.CompiledNet.consume` and
+:meth:`~petriflow.engine.CompiledNet.produce`: the runtime and the token game share
+one firing rule.
+
+:class:`Agenda` holds the transitions enabled right now, by priority, in net order,
+and picks one: the highest priority wins and a tie is broken by one draw of the run's
+generator. Adding, removing and picking cost a binary search over the enabled
+transitions, so a firing's cost does not grow with the size of the net.
+
+Examples:
+    >>> agenda = Agenda([0, 0, 1, 0])
+    >>> for t in (0, 1, 3): agenda.add(t)
+    >>> agenda.pick(lambda: 0.99), len(agenda)
+    (3, 3)
+    >>> agenda.add(2); agenda.pick(lambda: 0.0)
+    2
+"""
+
+from __future__ import annotations
+
+from bisect import bisect_left, insort
+from collections import deque
+from typing import Any, Callable, Iterable, Mapping, Sequence
+
+from petriflow.engine import CompiledNet
+from petriflow.marking import Marking
+
+__all__ = ["TokenStore", "Agenda"]
+
+
+class Agenda:
+    """The enabled transitions (by their index in the net's order), grouped by priority.
+
+    Each priority level keeps its enabled transitions in a sorted array: adding and
+    removing one is a binary search plus a block move inside the array (a C
+    ``memmove`` of a few bytes per enabled transition: nothing next to a firing's
+    other work, even with thousands enabled at once), picking is an index.
+
+    Args:
+        priorities: per transition index, its priority.
+    """
+
+    def __init__(self, priorities: Sequence[int]) -> None:
+        levels = sorted(set(priorities), reverse=True)
+        self._levels: list[list[int]] = [[] for _ in levels]
+        level_of = {p: i for i, p in enumerate(levels)}
+        self._level = [self._levels[level_of[p]] for p in priorities]
+        self._on = [False] * len(priorities)
+        self._count = 0
+
+    def __len__(self) -> int:
+        return self._count
+
+    def __contains__(self, t: int) -> bool:
+        return self._on[t]
+
+    def add(self, t: int) -> None:
+        """Mark transition ``t`` enabled (no-op if it is)."""
+        if not self._on[t]:
+            self._on[t] = True
+            self._count += 1
+            level = self._level[t]
+            if not level or level[-1] < t:
+                level.append(t)
+            else:
+                insort(level, t)
+
+    def discard(self, t: int) -> None:
+        """Mark transition ``t`` not enabled (no-op if it is not)."""
+        if self._on[t]:
+            self._on[t] = False
+            self._count -= 1
+            level = self._level[t]
+            if level[-1] == t:
+                level.pop()
+            else:
+                del level[bisect_left(level, t)]
+
+    def pick(self, draw: Callable[[], float]) -> int:
+        """The transition to fire: of the highest priority enabled, the only one, or
+        the ``int(draw() * n)``-th of the ``n`` in net order (one draw, only on a tie)."""
+        for level in self._levels:
+            if level:
+                if len(level) == 1:
+                    return level[0]
+                return level[int(draw() * len(level))]
+        raise LookupError("no transition is enabled")
+
+    def members(self) -> list[int]:
+        """The enabled transitions, in net order."""
+        return [t for t, on in enumerate(self._on) if on]
+
+
+class TokenStore:
+    """A run's marking: per place, the data of its tokens (oldest first).
+
+    Args:
+        compiled: the net's compiled firing rule.
+        initial: token counts to start with (tokens without data).
+        final: the final marking, if the net has one (tracked in ``O(1)`` per change).
+
+    Attributes:
+        counts: per place index, the token count (what the firing rule reads).
+        data: per place index, a deque of the tokens' data.
+    """
+
+    def __init__(self, compiled: CompiledNet, initial: Mapping[str, int],
+                 final: Mapping[str, int] | None = None) -> None:
+        self.compiled = compiled
+        self.places = compiled.places
+        self.index = compiled.place_index
+        self.counts = [0] * len(self.places)
+        self.data: list[deque] = [deque() for _ in self.places]
+        self._final = None if final is None else compiled.vector(final)
+        self.mismatch = 0
+        self.replace({p: [None] * n for p, n in initial.items()})
+
+    def replace(self, tokens: Mapping[str, Iterable[Any]]) -> None:
+        """Set every place's tokens (places not named hold none)."""
+        for i in range(len(self.places)):
+            self.data[i] = deque()
+            self.counts[i] = 0
+        for place, items in tokens.items():
+            i = self.index[place]
+            self.data[i] = deque(items)
+            self.counts[i] = len(self.data[i])
+        final = self._final
+        self.mismatch = 0 if final is None else sum(c != f for c, f in zip(self.counts, final))
+
+    @property
+    def at_final(self) -> bool:
+        """Whether the token counts equal the final marking (``False`` without one)."""
+        return self._final is not None and self.mismatch == 0
+
+    def _track(self, i: int, before: int) -> None:
+        final = self._final
+        if final is not None:
+            self.mismatch += (self.counts[i] != final[i]) - (before != final[i])
+
+    def consume(self, row: int) -> tuple[dict[str, list[Any]], dict[str, int]]:
+        """Start firing ``row`` (its preset enabled): take its input tokens and empty its
+        cancellation region's places, by the compiled firing rule.
+
+        Returns:
+            ``({place: [data, ...]} taken, {place: count} withdrawn by the region)``.
+        """
+        compiled, counts, data, places, final = self.compiled, self.counts, self.data, self.places, self._final
+        reset = compiled.reset[row]
+        if reset:
+            return self._consume_with_reset(row)
+        taken = {}
+        for p, w in compiled.pre[row]:
+            queue = data[p]
+            taken[places[p]] = [queue.popleft()] if w == 1 else [queue.popleft() for _ in range(w)]
+            if final is not None:
+                count, wanted = counts[p], final[p]
+                self.mismatch += (count - w != wanted) - (count != wanted)
+        compiled.consume(counts, row)
+        return taken, {}
+
+    def _consume_with_reset(self, row: int) -> tuple[dict[str, list[Any]], dict[str, int]]:
+        compiled, counts, data, places = self.compiled, self.counts, self.data, self.places
+        touched = {p for p, _ in compiled.pre[row]} | set(compiled.reset[row])
+        before = {p: counts[p] for p in touched}
+        taken = {}
+        for p, w in compiled.pre[row]:
+            queue = data[p]
+            taken[places[p]] = [queue.popleft() for _ in range(w)]
+        withdrawn = {}
+        for p in compiled.reset[row]:
+            if data[p]:
+                withdrawn[places[p]] = len(data[p])
+                data[p].clear()
+        compiled.consume(counts, row)
+        for p, count in before.items():
+            self._track(p, count)
+        return taken, withdrawn
+
+    def produce(self, row: int, result: Any, outputs: Mapping[str, Any] | None,
+                skip: Sequence[bool]) -> dict[str, int]:
+        """End firing ``row``: add its output tokens by the compiled firing rule, with
+        ``result`` as their data (``outputs[place]`` for the places it names), except
+        in the places where ``skip[index]`` holds (channel places: their tokens arrive
+        later, through :meth:`add`).
+
+        Returns:
+            ``{place: count}`` produced here.
+        """
+        produced = {}
+        counts, data, places, final = self.counts, self.data, self.places, self._final
+        post = self.compiled.post[row]
+        skipped = False
+        for p, w in post:
+            if skip[p]:
+                skipped = True
+                continue
+            item = outputs.get(places[p], result) if outputs else result
+            if w == 1:
+                data[p].append(item)
+            else:
+                data[p].extend([item] * w)
+            produced[places[p]] = w
+            if final is not None:
+                count, wanted = counts[p], final[p]
+                self.mismatch += (count + w != wanted) - (count != wanted)
+        if skipped:  # the rule's counts, less what travels through channels
+            for p, w in post:
+                if not skip[p]:
+                    counts[p] += w
+        else:
+            self.compiled.produce(counts, row)
+        return produced
+
+    def add(self, i: int, item: Any) -> None:
+        """One token with data ``item`` arrives in place index ``i`` (a delivery)."""
+        before = self.counts[i]
+        self.counts[i] += 1
+        self.data[i].append(item)
+        self._track(i, before)
+
+    def offered(self, row: int) -> dict[str, list[Any]]:
+        """``{place: [data, ...]}`` of the tokens firing ``row`` would take now."""
+        data, places = self.data, self.places
+        return {places[p]: [data[p][k] for k in range(w)] for p, w in self.compiled.pre[row]}
+
+    def read(self, place: str) -> list[Any]:
+        """The data of the tokens in ``place`` (oldest first), not taken."""
+        return list(self.data[self.index[place]])
+
+    def marking(self) -> Marking:
+        """Token counts now."""
+        return Marking({self.places[i]: c for i, c in enumerate(self.counts) if c})
+
+    def tokens(self) -> dict[str, list[Any]]:
+        """``{place: [data, ...]}`` of the marked places."""
+        return {self.places[i]: list(q) for i, q in enumerate(self.data) if q}
