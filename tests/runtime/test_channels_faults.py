@@ -118,3 +118,44 @@ def test_range_model_rssi_falls_with_distance():
     """RSSI follows the log-distance law: -20 dB per decade at exponent 2."""
     radio = RangeChannel(tx_power_dbm=-40.0, exponent=2.0)
     assert radio.rssi(1.0) - radio.rssi(10.0) == pytest.approx(20.0)
+
+
+def test_the_receiver_is_the_agent_that_takes_from_the_channel_place():
+    """A channel place declared in the sender's subnet is still received by the agent
+    whose transitions consume from it: killing that agent loses the message."""
+    net = loads_net("""
+petriflow: 1
+subnets:
+  - id: a
+    places: [{id: a_ready, tokens: 1}, {id: outbox, channel: radio}]
+    transitions: [{id: send, action: core.wait, params: {seconds: 2}, in: [a_ready], out: [outbox]}]
+  - id: b
+    places: [b_done]
+    transitions: [{id: receive, in: [outbox], out: [b_done]}]
+""")
+    config = RunConfig.from_dict({"faults": [{"kill": "b", "at": 1}]})
+    scheduler = Scheduler(net, config=config)
+    events = []
+    scheduler.on_event(events.append)
+    scheduler.run()
+    message = [e.data for e in events if e.kind == "message"][0]
+    assert (message["receiver"], message["fate"], message["why"]) == ("b", "lost", "receiver not running")
+
+
+def test_messages_between_many_agents_are_delivered_in_order():
+    """Pairs of agents exchanging through an ideal channel with latency: every message
+    arrives after the latency, in the order sent."""
+    lines = ["petriflow: 1", "subnets:"]
+    for k in range(20):
+        lines.append(f"  - {{id: s{k}, places: [{{id: s{k}r, tokens: 1}}], transitions: ["
+                     f"{{id: s{k}send, action: core.wait, params: {{seconds: 0.{k + 1:02d}}}, in: [s{k}r], out: [m{k}]}}]}}")
+        lines.append(f"  - {{id: d{k}, places: [{{id: m{k}, channel: radio}}, d{k}got], transitions: ["
+                     f"{{id: d{k}take, in: [m{k}], out: [d{k}got]}}]}}")
+    config = RunConfig.from_dict({"channels": {"radio": {"model": "ideal", "latency": 0.5}}})
+    scheduler = Scheduler(loads_net("\n".join(lines) + "\n"), config=config)
+    events = []
+    scheduler.on_event(events.append)
+    result = scheduler.run()
+    delivered = [(e.data["place"], e.time) for e in events if e.kind == "message" and e.data["fate"] == "delivered"]
+    assert delivered == [(f"m{k}", round(0.01 * (k + 1) + 0.5, 9)) for k in range(20)]
+    assert result.marking == {f"d{k}got": 1 for k in range(20)}

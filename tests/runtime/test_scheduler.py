@@ -269,3 +269,89 @@ transitions:
     assert end.data["outcome"] == "cancelled"
     assert end.time == pytest.approx(1.02)  # abort at 1.0 s, then two more ticks of clean-up
     assert result.marking == {"stopped": 1}
+
+
+def test_step_and_peek_walk_the_run_one_instant_at_a_time():
+    """peek() says when the next instant is; step() processes it; EmptySchedule at the end."""
+    from petriflow.runtime.scheduler import EmptySchedule
+
+    net = net_of("""
+places: [{id: a, tokens: 1}, b, c]
+transitions:
+  - {id: first, action: core.wait, params: {seconds: 1.5}, in: [a], out: [b]}
+  - {id: second, action: core.wait, params: {seconds: 2}, in: [b], out: [c]}
+""")
+    run = Scheduler(net)
+    seen = []
+    while run.peek() is not None:
+        seen.append(run.peek())
+        run.step()
+        seen.append(run.running())
+    assert seen == [0.0, ["first"], 1.5, ["second"], 3.5, []]
+    assert run.marking() == {"c": 1}
+    with pytest.raises(EmptySchedule):
+        run.step()
+
+
+def test_an_action_waking_later_is_first_polled_when_it_asked():
+    """needs_world False and wake_at set in start(): no poll before that time."""
+    from petriflow.runtime.action import Action
+
+    polls = []
+
+    class Later(Action):
+        needs_world = False
+
+        def start(self, ctx):
+            self.wake_at = ctx.now + 2.0
+
+        def poll(self, ctx):
+            polls.append(ctx.now)
+            return Status.OK
+
+    registry = Registry(load_plugins=False)
+    registry.register("test.later", Later)
+    net = net_of("places: [{id: a, tokens: 1}, b]\ntransitions: [{id: t, action: test.later, in: [a], out: [b]}]\n")
+    assert Scheduler(net, registry=registry).run().time == 2.0
+    assert polls == [2.0]
+
+
+def test_staggered_and_lockstep_agents_fire_the_same_firings():
+    """Independent agents: whether their waits line up or not, each fires its cycle."""
+    lines = ["subnets:"]
+    for k, seconds in enumerate((1.0, 1.0, 1.37, 1.91)):
+        lines.append(f"  - {{id: r{k}, places: [{{id: r{k}a, tokens: 1}}, r{k}b], transitions: ["
+                     f"{{id: r{k}go, action: core.wait, params: {{seconds: {seconds}}}, in: [r{k}a], out: [r{k}b]}},"
+                     f"{{id: r{k}back, action: core.wait, params: {{seconds: {seconds}}}, in: [r{k}b], out: [r{k}a]}}]}}")
+    run = Scheduler(net_of("\n".join(lines) + "\n"))
+    events = events_of(run)
+    run.run(until=10)
+    starts = [e.transition for e in events if e.kind == "start"]
+    assert [starts.count(f"r{k}go") for k in range(4)] == [6, 6, 4, 3]   # at 0, 2, ... 10 s; 0, 2.74...; 0, 3.82...
+
+
+def test_a_long_run_keeps_no_state_per_firing():
+    """Without observers nothing per firing is kept: memory after 20,000 firings is
+    what it was after 2,000 (within a small margin for Python's allocator)."""
+    import gc
+    import tracemalloc
+
+    net = net_of("""
+subnets:
+  - {id: r, places: [{id: a, tokens: 1}, b], transitions: [
+      {id: go, action: core.wait, params: {seconds: 0.5}, in: [a], out: [b]},
+      {id: back, action: core.fail, params: {seconds: 0.5, probability: 0.3}, in: [b], out: [a], outcomes: {failed: [a]}}]}
+""")
+    run = Scheduler(net, seed=2)
+    tracemalloc.start()
+    try:
+        run.run(max_firings=2_000)
+        gc.collect()
+        early = tracemalloc.get_traced_memory()[0]
+        run.run(max_firings=20_000)
+        gc.collect()
+        late = tracemalloc.get_traced_memory()[0]
+    finally:
+        tracemalloc.stop()
+    assert run.firings == 20_000
+    assert late - early < 64_000   # the old kernel kept ~1.2 kB per firing: 21 MB here
