@@ -86,7 +86,8 @@ def fire_one(
         scheduler.set_tokens({p: [None] * n for p, n in marking.items()})
     events: list[Event] = []
     scheduler.on_event(events.append)
-    run = scheduler.fire_one(transition, timeout=timeout)
+    with scheduler:
+        run = scheduler.fire_one(transition, timeout=timeout)
     ends = [e for e in events if e.kind == "end" and e.transition == transition]
     outcome = ends[-1].data["outcome"] if ends else None
     result = ends[-1].data.get("result") if ends else None

@@ -7,11 +7,13 @@ scheduler without a world.
 
 from __future__ import annotations
 
-from typing import Any
+import math
+from typing import Any, ClassVar
 
-from petriflow.runtime.action import ActionFailure, Param
+from petriflow.errors import NetFormatError
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
 
-__all__ = ["register"]
+__all__ = ["register", "Wait"]
 
 
 def noop(ctx) -> Any:
@@ -19,10 +21,35 @@ def noop(ctx) -> Any:
     return ctx.token()
 
 
-def wait(ctx):
-    """Wait a fixed simulated time, then pass the input token's data on."""
-    yield ctx.params["seconds"]
-    return ctx.token()
+class Wait(Action):
+    """Wait a fixed simulated time, then pass the input token's data on.
+
+    The commonest action of all (every timed step of a net that has no robot), so it
+    is a class rather than a generator: no generator per firing, one poll when the
+    time comes.
+    """
+
+    params: ClassVar[dict[str, Param]] = {"seconds": Param(float, 1.0, "simulated seconds to wait")}
+    needs_world = False
+
+    @classmethod
+    def check_params(cls, given: dict[str, Any], where: str) -> dict[str, Any]:
+        checked = super().check_params(given, where)
+        if not (math.isfinite(checked["seconds"]) and checked["seconds"] >= 0):
+            error = NetFormatError(f"parameter 'seconds' must be a finite number >= 0, got {checked['seconds']!r}",
+                                   element=where)
+            error.param = "seconds"
+            raise error
+        return checked
+
+    def start(self, ctx: ActionContext) -> None:
+        self.wake_at = ctx.now + self.params["seconds"]
+
+    def poll(self, ctx: ActionContext) -> Status:
+        if ctx.now < self.wake_at - 1e-12:
+            return Status.RUNNING
+        ctx.result = ctx.token()
+        return Status.OK
 
 
 def fail(ctx):
@@ -46,7 +73,7 @@ def has_data(tokens, params) -> bool:
 def register(registry) -> None:
     """Register the ``core.*`` actions and guards in ``registry``."""
     registry.action("core.noop")(noop)
-    registry.action("core.wait", {"seconds": Param(float, 1.0, "simulated seconds to wait")})(wait)
+    registry.register("core.wait", Wait)
     registry.action(
         "core.fail",
         {

@@ -158,6 +158,11 @@ class Kernel:
             heapq.heappop(ticks)
         return None
 
+    def due(self) -> bool:
+        """Whether events are scheduled at the current tick (and not yet taken)."""
+        bucket = self._buckets.get(self.tick)
+        return bucket is not None and bool(bucket[0] or bucket[1])
+
     def pop_due(self) -> Iterator[tuple[int, Scheduled]]:
         """Take the live events due at the current tick, in order (polls by key, then
         applies), as ``(tick, event)``. Applies scheduled for the current tick while

@@ -243,6 +243,7 @@ class Scheduler:
         self._rng = random.Random(f"{self.seed}:conflicts")
         self._seed_prefix = f"{self.seed}:"
         self._started = False
+        self._closed = False
         self._opened = False  # whether the instant at tick 0 was processed
         self._max_firings: int | None = None
         self._wall_start = 0.0
@@ -343,9 +344,10 @@ class Scheduler:
     def _fire_instant(self) -> None:
         """Fire until nothing more can fire at this instant (or the firing limit)."""
         limit = self._max_firings
-        agenda, draw = self.agenda, self._rng.random
+        agenda, draw, dirty = self.agenda, self._rng.random, self._dirty
         while True:
-            self._refresh()
+            if dirty:
+                self._refresh()
             if not agenda or (limit is not None and self.firings >= limit):
                 return
             self._fire(agenda.pick(draw))
@@ -591,7 +593,7 @@ class Scheduler:
                 event.apply(tick)
             if fire:
                 self._fire_instant()
-            if kernel.peek() != kernel.tick:
+            if not kernel.due():
                 return
 
     def step(self, realtime: bool = False) -> None:
@@ -630,9 +632,10 @@ class Scheduler:
         limit = None if until is None else kernel.ticks_at(until)
         self._max_firings = max_firings
         self.start()
+        if self._closed:
+            raise PetriflowError("this run has ended; make a new Scheduler to run again")
         try:
-            if not self._opened:
-                self._instant()
+            self._instant()  # the first instant, or the rest of the one a limit stopped in
             while True:
                 if max_firings is not None and self.firings >= max_firings:
                     return self._end(StopReason.FIRINGS)
@@ -681,15 +684,37 @@ class Scheduler:
             return self._end(StopReason.FAILED, str(exc.failure))
         return self._end(StopReason.FIRED)
 
-    def _end(self, reason: StopReason, error: str | None = None) -> RunResult:
-        problems = {}
+    def close(self) -> dict[str, str]:
+        """End the run for good: tear every action down (once). :meth:`run` does it when
+        the run is over (final, dead, failed); after a time or firing limit the run
+        may go on with another :meth:`run`, so call this (or use the scheduler as a
+        context manager) when done.
+
+        Returns:
+            ``{transition: reason}`` of the actions whose ``teardown()`` raised.
+        """
+        problems: dict[str, str] = {}
+        if self._closed:
+            return problems
+        self._closed = True
         for t, action in enumerate(self._actions):
             if action is not None:
                 try:
                     action.teardown()
                 except Exception as exc:
                     problems[self._ids[t]] = _reason(exc, "teardown")
-        self._actions = [None] * len(self._ids)
+        return problems
+
+    def __enter__(self) -> "Scheduler":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def _end(self, reason: StopReason, error: str | None = None) -> RunResult:
+        problems = {}
+        if reason not in (StopReason.UNTIL, StopReason.FIRINGS):
+            problems = self.close()
         data: dict[str, Any] = {"reason": reason.value, "firings": self.firings,
                                 "marking": self.marking().to_dict(), "running": self.running()}
         if error:

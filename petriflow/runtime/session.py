@@ -233,8 +233,10 @@ def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: 
         observers["xes"] = XesWriter(xes, case=net.id, labels=labels, silent=silent)
         scheduler.on_event(observers["xes"])
     if progress:
-        observers["progress"] = Progress(scheduler)
-        scheduler.on_event(observers["progress"])
+        display = Progress(scheduler)
+        if display.active:  # an observer makes every event be built: only on a terminal
+            observers["progress"] = display
+            scheduler.on_event(display)
     return observers
 
 
@@ -248,7 +250,8 @@ def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, An
         observers = _observe(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
                              keep_events=keep_events)
         started = wallclock.perf_counter()
-        result = scheduler.run(until=inputs["until"], max_firings=max_firings, realtime=realtime)
+        with scheduler:
+            result = scheduler.run(until=inputs["until"], max_firings=max_firings, realtime=realtime)
         wall = wallclock.perf_counter() - started
     except BaseException:
         for name in ("trace", "xes"):
@@ -399,7 +402,8 @@ def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | 
         observers = _observe(scheduler, net, journal=None, trace=None if trace is None else Path(trace),
                              xes=None if xes is None else Path(xes), progress=False, keep_events=keep_events)
         started = wallclock.perf_counter()
-        result = scheduler.run(until=until, max_firings=max_firings)
+        with scheduler:
+            result = scheduler.run(until=until, max_firings=max_firings)
         wall = wallclock.perf_counter() - started
     except BaseException:
         for name in ("trace", "xes"):

@@ -20,7 +20,7 @@ import json
 import math
 import os
 import tempfile
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Iterator
 from xml.sax.saxutils import quoteattr
@@ -59,6 +59,8 @@ class EventKind(str, enum.Enum):
 #: The kinds of events a run records, as written in traces.
 EVENT_KINDS = tuple(k.value for k in EventKind)
 
+_ENCODER = json.JSONEncoder(sort_keys=True, separators=(",", ":"), allow_nan=False)
+
 
 @dataclass(frozen=True, slots=True)
 class Event:
@@ -82,7 +84,8 @@ class Event:
 
     def to_json(self) -> str:
         """One line of JSON, keys in a fixed order (so equal events give equal lines)."""
-        return json.dumps(asdict(self), sort_keys=True, separators=(",", ":"), allow_nan=False)
+        return _ENCODER.encode({"agent": self.agent, "data": self.data, "kind": self.kind, "seq": self.seq,
+                                "time": self.time, "transition": self.transition})
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> "Event":

@@ -355,3 +355,30 @@ subnets:
         tracemalloc.stop()
     assert run.firings == 20_000
     assert late - early < 64_000   # the old kernel kept ~1.2 kB per firing: 21 MB here
+
+
+def test_a_run_stopped_by_a_limit_goes_on_with_the_same_events():
+    """run(until=...) then run() again: the same events as one run, and the actions are
+    torn down only once the run is over."""
+    Walk = ScriptedAction.script([Status.RUNNING] * 30 + [Status.OK])
+    registry = Registry(load_plugins=False)
+    registry.register("test.walk", Walk)
+    registry.register("core.wait", default_registry.resolve("core.wait"))
+    text = """
+places: [{id: a, tokens: 3}, b, c]
+transitions:
+  - {id: walk, action: test.walk, in: [a], out: [b]}
+  - {id: rest, action: core.wait, params: {seconds: 0.25}, in: [b], out: [c]}
+"""
+    whole = Scheduler(net_of(text), registry=registry, seed=2)
+    expected = events_of(whole)
+    whole.run()
+    parts = Scheduler(net_of(text), registry=registry, seed=2)
+    got = events_of(parts)
+    assert parts.run(until=0.4).reason == "until" and Walk.calls["teardown"] == 1
+    assert parts.run(max_firings=4).reason == "firings"
+    assert parts.run().reason == "dead" and Walk.calls["teardown"] == 2
+    def story(events):  # the stops of the partial runs take sequence numbers of their own
+        return [(e.kind, e.transition, e.time, e.data) for e in events if e.kind != "stop"]
+
+    assert story(got) == story(expected)
