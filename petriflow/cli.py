@@ -248,15 +248,20 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_actions(args: argparse.Namespace) -> int:
-    from petriflow.runtime.action import REQUIRED
+    from petriflow.runtime.action import REQUIRED, Port
     from petriflow.runtime.registry import default_registry
+
+    def type_name(param) -> str:
+        if isinstance(param, Port):
+            return "port (a place it reads)"
+        types = param.type if isinstance(param.type, tuple) else (param.type,)
+        return " or ".join("none" if t is type(None) else t.__name__ for t in types)
 
     listing = []
     for spec in default_registry.specs():
         cls = spec.load()
         params = {
-            name: {"type": " or ".join(t.__name__ for t in (p.type if isinstance(p.type, tuple) else (p.type,))),
-                   "default": None if p.default is REQUIRED else p.default,
+            name: {"type": type_name(p), "default": None if p.default is REQUIRED else p.default,
                    "required": p.default is REQUIRED, "doc": p.doc}
             for name, p in cls.params.items()
         }

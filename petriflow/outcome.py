@@ -16,11 +16,12 @@ from __future__ import annotations
 
 import enum
 
-__all__ = ["Outcome", "ROUTED_OUTCOMES", "StopReason"]
+__all__ = ["Name", "Outcome", "ROUTED_OUTCOMES", "StopReason"]
 
 
-class _Name(str, enum.Enum):
-    """A ``str`` enum whose members print and format as their value."""
+class Name(str, enum.Enum):
+    """Base of petriflow's closed sets of names: a ``str`` enum whose members equal,
+    print and format as their value (what files hold)."""
 
     def __str__(self) -> str:
         return self.value
@@ -29,7 +30,7 @@ class _Name(str, enum.Enum):
         return format(self.value, spec)
 
 
-class Outcome(_Name):
+class Outcome(Name):
     """How a started action ended; selects the output arcs that produce tokens."""
 
     OK = "ok"
@@ -46,7 +47,7 @@ class Outcome(_Name):
 ROUTED_OUTCOMES = (Outcome.FAILED, Outcome.TIMEOUT, Outcome.CANCELLED)
 
 
-class StopReason(_Name):
+class StopReason(Name):
     """Why a run ended."""
 
     FINAL = "final"

@@ -122,23 +122,19 @@ def bind(net: Net, registry: Registry | None = None, *, path: str | None = None)
         def fail(message: str, *keys: str) -> NetFormatError:
             return NetFormatError(message, path=path, line=_line(net, *keys, tid), element=tid)
 
-        guard = None
-        if transition.guard is not None:
-            guard = guards.get(transition.guard)
-            if guard is None:
+        def lookup(cache: dict, name: str, find, key: str):
+            if name not in cache:
                 try:
-                    guard = guards[transition.guard] = registry.guard(transition.guard)
+                    cache[name] = find(name)
                 except UnknownActionError as exc:
-                    raise fail(str(exc), f"{tid}/guard") from None
+                    raise fail(str(exc), f"{tid}/{key}") from None
+            return cache[name]
+
+        guard = None if transition.guard is None else lookup(guards, transition.guard, registry.guard, "guard")
         if transition.action is None:
             bound[tid] = BoundTransition(tid, None, dict(transition.params), guard)
             continue
-        cls = resolved.get(transition.action)
-        if cls is None:
-            try:
-                cls = resolved[transition.action] = registry.resolve(transition.action)
-            except UnknownActionError as exc:
-                raise fail(str(exc), f"{tid}/action") from None
+        cls = lookup(resolved, transition.action, registry.resolve, "action")
         try:
             params = cls.check_params(transition.params, tid)
         except NetFormatError as exc:

@@ -29,7 +29,6 @@ Examples:
 
 from __future__ import annotations
 
-import enum
 import math
 import random
 from dataclasses import dataclass
@@ -37,6 +36,7 @@ from typing import Any, Callable
 
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
+from petriflow.outcome import Name
 from petriflow.runtime.kernel import APPLY, Scheduled
 
 __all__ = [
@@ -54,15 +54,12 @@ __all__ = [
 ]
 
 
-class Fate(str, enum.Enum):
+class Fate(Name):
     """What became of a message (the ``fate`` of a ``message`` event)."""
 
     SENT = "sent"
     DELIVERED = "delivered"
     LOST = "lost"
-
-    def __str__(self) -> str:
-        return self.value
 
 
 @dataclass

@@ -23,7 +23,6 @@ Examples:
 
 from __future__ import annotations
 
-import enum
 import importlib
 import sys
 from dataclasses import dataclass, field
@@ -32,6 +31,7 @@ from typing import Any
 
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
+from petriflow.outcome import Name
 from petriflow.runtime.channels import ChannelModel, build_channel
 
 __all__ = ["RunConfig", "Fault", "FaultKind", "load_config"]
@@ -39,7 +39,7 @@ __all__ = ["RunConfig", "Fault", "FaultKind", "load_config"]
 _KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions"}
 
 
-class FaultKind(str, enum.Enum):
+class FaultKind(Name):
     """The faults a run configuration can inject."""
 
     KILL = "kill"
@@ -50,9 +50,6 @@ class FaultKind(str, enum.Enum):
     """Messages between the two agents are lost from ``at`` until ``until``."""
     RESTORE_LINK = "restore_link"
     """In traces only: a dropped link works again (at its ``until``)."""
-
-    def __str__(self) -> str:
-        return self.value
 
 
 _FAULT_KINDS = (FaultKind.KILL.value, FaultKind.JOIN.value, FaultKind.DROP_LINK.value)

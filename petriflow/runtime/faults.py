@@ -9,40 +9,27 @@ started), so the scheduler never branches on fault kinds.
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 from petriflow.runtime.config import Fault, FaultKind
 from petriflow.runtime.kernel import APPLY, Scheduled
 
-__all__ = ["Faults", "FaultEvent", "LinkRestored"]
+__all__ = ["Faults", "FaultEvent"]
 
 
 class FaultEvent(Scheduled):
-    """A fault's time has come."""
+    """A fault's time has come (``handler`` is :meth:`Faults.apply`), or a dropped
+    link's ``until`` (:meth:`Faults.restore`)."""
 
-    __slots__ = ("faults", "fault")
+    __slots__ = ("handler", "fault")
     phase = APPLY
 
-    def __init__(self, faults: "Faults", fault: Fault) -> None:
-        self.faults = faults
+    def __init__(self, handler: Callable[[Fault], None], fault: Fault) -> None:
+        self.handler = handler
         self.fault = fault
 
     def apply(self, tick: int) -> None:
-        self.faults.apply(self.fault)
-
-
-class LinkRestored(Scheduled):
-    """A dropped link works again (the ``until`` of a ``drop_link``)."""
-
-    __slots__ = ("faults", "fault")
-    phase = APPLY
-
-    def __init__(self, faults: "Faults", fault: Fault) -> None:
-        self.faults = faults
-        self.fault = fault
-
-    def apply(self, tick: int) -> None:
-        self.faults.restore(self.fault)
+        self.handler(self.fault)
 
 
 class Faults:
@@ -61,7 +48,7 @@ class Faults:
         self.down: set[frozenset[str]] = set()
         kernel = run.kernel
         for fault in faults:
-            kernel.schedule(kernel.ticks_at(fault.at), FaultEvent(self, fault))
+            kernel.schedule(kernel.ticks_at(fault.at), FaultEvent(self.apply, fault))
             if fault.kind == FaultKind.JOIN:
                 self.running[fault.agent] = False
 
@@ -88,7 +75,7 @@ class Faults:
             self.down.add(frozenset(fault.link))
             run.emit("fault", None, None, fault=FaultKind.DROP_LINK.value, link=list(fault.link))
             if fault.until is not None:
-                run.kernel.schedule(run.kernel.ticks_at(fault.until), LinkRestored(self, fault))
+                run.kernel.schedule(run.kernel.ticks_at(fault.until), FaultEvent(self.restore, fault))
 
     def restore(self, fault: Fault) -> None:
         """The link ``fault`` dropped works again."""

@@ -240,18 +240,17 @@ def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: 
     return observers
 
 
-def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, Any], *,
-             journal: Journal | None, trace: Path | None, xes: Path | None, realtime: bool, gui: bool,
-             progress: bool, max_firings: int | None, keep_events: bool = False) -> RunOutcome:
-    world = _world_from(inputs, gui)
+def _observed_run(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: Path | None,
+                  xes: Path | None, progress: bool, keep_events: bool, **limits: Any) -> RunOutcome:
+    """Run ``scheduler`` with the requested observers; the trace and XES files are
+    renamed into place if the run ends, dropped if it raises."""
     observers: dict[str, Any] = {}
     try:
-        scheduler = Scheduler(net, world=world, config=config, seed=inputs["seed"], binding=binding)
         observers = _observe(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
                              keep_events=keep_events)
         started = wallclock.perf_counter()
         with scheduler:
-            result = scheduler.run(until=inputs["until"], max_firings=max_firings, realtime=realtime)
+            result = scheduler.run(**limits)
         wall = wallclock.perf_counter() - started
     except BaseException:
         for name in ("trace", "xes"):
@@ -261,15 +260,26 @@ def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, An
     finally:
         if "progress" in observers:
             observers["progress"].close()
+    outcome = RunOutcome(result, net, observers.get("events", []), wall)
+    for name, path in (("trace", trace), ("xes", xes)):
+        if name in observers:
+            observers[name].close()
+            outcome.written.append(str(path))
+    return outcome
+
+
+def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, Any], *,
+             journal: Journal | None, trace: Path | None, xes: Path | None, realtime: bool, gui: bool,
+             progress: bool, max_firings: int | None, keep_events: bool = False) -> RunOutcome:
+    world = _world_from(inputs, gui)
+    try:
+        scheduler = Scheduler(net, world=world, config=config, seed=inputs["seed"], binding=binding)
+        outcome = _observed_run(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
+                                keep_events=keep_events, until=inputs["until"], max_firings=max_firings,
+                                realtime=realtime)
+    finally:
         if world is not None:
             world.close()
-    outcome = RunOutcome(result, net, observers.get("events", []), wall)
-    if "trace" in observers:
-        observers["trace"].close()
-        outcome.written.append(str(trace))
-    if "xes" in observers:
-        observers["xes"].close()
-        outcome.written.append(str(xes))
     if journal is not None:
         journal.finish()
         outcome.written.append(str(journal.path))
@@ -396,26 +406,11 @@ def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | 
         from petriflow.world import load_world
 
         world, close = load_world(world), True
-    observers: dict[str, Any] = {}
     try:
         scheduler = Scheduler(net, world=world, config=config, seed=seed, registry=registry)
-        observers = _observe(scheduler, net, journal=None, trace=None if trace is None else Path(trace),
-                             xes=None if xes is None else Path(xes), progress=False, keep_events=keep_events)
-        started = wallclock.perf_counter()
-        with scheduler:
-            result = scheduler.run(until=until, max_firings=max_firings)
-        wall = wallclock.perf_counter() - started
-    except BaseException:
-        for name in ("trace", "xes"):
-            if name in observers:
-                observers[name].close(keep=False)
-        raise
+        return _observed_run(scheduler, net, journal=None, trace=None if trace is None else Path(trace),
+                             xes=None if xes is None else Path(xes), progress=False, keep_events=keep_events,
+                             until=until, max_firings=max_firings)
     finally:
         if close:
             world.close()
-    outcome = RunOutcome(result, net, observers.get("events", []), wall)
-    for name, path in (("trace", trace), ("xes", xes)):
-        if name in observers:
-            observers[name].close()
-            outcome.written.append(str(path))
-    return outcome

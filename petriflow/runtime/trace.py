@@ -14,7 +14,6 @@ bit for bit between runs.
 
 from __future__ import annotations
 
-import enum
 import hashlib
 import json
 import math
@@ -26,13 +25,13 @@ from typing import Any, Iterable, Iterator
 from xml.sax.saxutils import quoteattr
 
 from petriflow.errors import NetFormatError
-from petriflow.outcome import Outcome
+from petriflow.outcome import Name, Outcome
 
 __all__ = ["Event", "EventKind", "summarize", "TraceWriter", "XesWriter", "read_trace", "write_xes",
            "EVENT_KINDS"]
 
 
-class EventKind(str, enum.Enum):
+class EventKind(Name):
     """What an :class:`Event` records."""
 
     RUN = "run"
@@ -51,9 +50,6 @@ class EventKind(str, enum.Enum):
     """Something an action reported (``ctx.emit``)."""
     STOP = "stop"
     """The run ends: why, firings, marking, what was still running."""
-
-    def __str__(self) -> str:
-        return self.value
 
 
 #: The kinds of events a run records, as written in traces.
@@ -135,6 +131,33 @@ def _digest(value: Any) -> str:
     return f"<{type(value).__name__} sha1={hashlib.sha1(text).hexdigest()[:12]}>"
 
 
+class _PartialFile:
+    """A text file written under a unique temporary name in its target folder and
+    renamed into place when finished: an existing file of that name is never
+    half-overwritten, and two writers never share a temporary file."""
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial",
+                                             dir=self.path.parent if str(self.path.parent) else ".")
+        self.file = os.fdopen(fd, "w", encoding="utf-8")
+
+    def finish(self, keep: bool = True) -> None:
+        """Close the file and rename it into place (ordinary file mode), or drop it."""
+        self.file.close()
+        if keep:
+            os.chmod(self._partial, 0o666 & ~_umask())
+            os.replace(self._partial, self.path)
+        else:
+            os.unlink(self._partial)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 class TraceWriter:
     """Writes events to a JSON Lines file as they happen (an observer).
 
@@ -145,21 +168,15 @@ class TraceWriter:
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
-        fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial",
-                                             dir=self.path.parent if str(self.path.parent) else ".")
-        self._file = os.fdopen(fd, "w", encoding="utf-8")
+        self._out = _PartialFile(path)
+        self._write = self._out.file.write
 
     def __call__(self, event: Event) -> None:
-        self._file.write(event.to_json() + "\n")
+        self._write(event.to_json() + "\n")
 
     def close(self, keep: bool = True) -> None:
         """Finish the file (rename into place), or drop it when ``keep`` is false."""
-        self._file.close()
-        if keep:
-            os.chmod(self._partial, 0o666 & ~_umask())
-            os.replace(self._partial, self.path)
-        else:
-            os.unlink(self._partial)
+        self._out.finish(keep)
 
 
 def read_trace(path: str | Path) -> list[Event]:
@@ -221,9 +238,8 @@ class XesWriter:
         self.labels = labels or {}
         self.silent = set(silent)
         self.count = 0
-        fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial",
-                                             dir=self.path.parent if str(self.path.parent) else ".")
-        self._file = os.fdopen(fd, "w", encoding="utf-8")
+        self._out = _PartialFile(path)
+        self._file = self._out.file
         self._file.write("\n".join(_XES_HEAD) + "\n")
         self._file.write(f'  <trace>\n    <string key="concept:name" value={quoteattr(case)}/>\n')
         self._open: dict[int, Event] = {}  # firing -> its start event, while it runs
@@ -261,19 +277,8 @@ class XesWriter:
         or drop it when ``keep`` is false. Returns the number of events written."""
         self._open.clear()
         self._file.write("  </trace>\n</log>\n")
-        self._file.close()
-        if keep:
-            os.chmod(self._partial, 0o666 & ~_umask())
-            os.replace(self._partial, self.path)
-        else:
-            os.unlink(self._partial)
+        self._out.finish(keep)
         return self.count
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def write_xes(events: Iterable[Event], path: str | Path, *, case: str = "run",
