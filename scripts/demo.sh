@@ -3,6 +3,7 @@
 # pybullet with trace, XES log and journal, and drawn; then the small passage example.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+export PATH="$PWD/.venv/bin:$PATH"   # the project's environment (scripts/setup.sh makes it)
 mkdir -p out
 rm -f out/smart.sqlite* out/passage.sqlite*
 
