@@ -10,7 +10,33 @@ from petriflow.io.yaml import loads_net
 
 REPO = Path(__file__).resolve().parents[1]
 NETS = REPO / "nets"
-ORACLE = REPO.parent / "shared" / "oracle"
+#: Real-world nets with known answers, copied into the tests (see its README for licences).
+ORACLE = Path(__file__).resolve().parent / "data" / "oracle"
+#: The fuller corpus beside the project, when there is one: it also holds nets whose
+#: licence does not allow copying them here.
+SHARED_ORACLE = REPO.parent / "shared" / "oracle"
+#: The folders of the shared corpus that are not copied here, by their path under it.
+NOT_COPIED = ("workflow/hagen-Beispiel-01", "workflow/hagen-Beispiel-Deadlock", "workflow/hagen-Beispiel-Fehler-01",
+              "workflow/hagen-Beispiel-Fehler-02", "workflow/hagen-Beispiel-Kontakt-01")
+
+
+def oracle_cases(legal_only: bool = False) -> list:
+    """Every oracle folder (with its ``answer.json``), as pytest params: the copied
+    corpus, then the shared one's extra folders, or for each of those a param that
+    skips saying why."""
+    cases = [pytest.param(p.parent, id=f"{p.parent.parent.name}/{p.parent.name}")
+             for p in sorted(ORACLE.glob("*/*/answer.json"))]
+    for name in NOT_COPIED:
+        folder = SHARED_ORACLE / name
+        if (folder / "answer.json").is_file():
+            cases.append(pytest.param(folder, id=name))
+        else:
+            cases.append(pytest.param(None, id=name, marks=pytest.mark.skip(
+                reason=f"{name} is not copied into tests/data (its repository states no licence);"
+                       " it runs when ../shared/oracle is beside the project")))
+    if legal_only:
+        cases = [c for c in cases if "illegal" not in c.id]
+    return cases
 
 def bench_module(name: str):
     """Import ``bench/NAME.py`` (bench/ is a folder of scripts, not a package)."""
@@ -59,7 +85,5 @@ def sequence_net():
 
 @pytest.fixture
 def oracle_dir() -> Path:
-    """The shared folder of nets written by other tools, skipping when it is absent."""
-    if not ORACLE.is_dir():
-        pytest.skip("shared oracle nets not available")
+    """The folder of nets written by other tools (copied into the tests)."""
     return ORACLE

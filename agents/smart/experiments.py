@@ -35,16 +35,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from petriflow import examples
+
 __all__ = ["NETS", "Run", "crossing", "helping", "main", "reinsertion", "run_net", "world_with_camera"]
 
 
-def _nets_folder() -> Path:
-    here = Path(__file__).resolve().parents[2] / "nets" / "smart"
-    return here if here.is_dir() else Path.cwd() / "nets" / "smart"
-
-
-#: Where the SMART nets and worlds are (the repository's ``nets/smart``).
-NETS = _nets_folder()
+#: Where the SMART nets and worlds are (``nets/smart``, installed with petriflow).
+NETS = examples.path("smart")
 #: The camera loop's transitions (left out of the firing sequences printed).
 LOOP = {"T1", "T2", "T3", "T4", "detect"}
 

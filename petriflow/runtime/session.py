@@ -301,6 +301,16 @@ def _inputs(prepared: Prepared, net_path: Path, seed: int | None, until: float |
     }
 
 
+def _make_folders(*outputs: str | Path | None) -> None:
+    """Create the folders the output files go into (before anything is written)."""
+    for output in outputs:
+        if output is not None:
+            try:
+                Path(output).parent.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise NetFormatError(f"cannot create its folder: {exc.strerror or exc}", path=str(output)) from None
+
+
 def run_files(net_path: str | Path, *, world: str | Path | None = None, config: str | Path | None = None,
               seed: int | None = None, until: float | None = None, trace: str | Path | None = None,
               xes: str | Path | None = None, db: str | Path | None = None, realtime: bool = False,
@@ -319,6 +329,10 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     net_path = Path(net_path)
     prepared = prepare(net_path, config=config, world=world, registry=registry)
     inputs = _inputs(prepared, net_path, seed, until)
+    inputs["max_firings"] = max_firings
+    inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())
+                         for name, path in (("trace", trace), ("xes", xes))}
+    _make_folders(trace, xes, db)
     journal = Journal(db, inputs) if db is not None else None
     try:
         return _execute(prepared.net, prepared.binding, prepared.config, inputs, journal=journal,
@@ -335,22 +349,28 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
            progress: bool = False) -> RunOutcome:
     """Continue the run journaled in ``db`` after a kill.
 
-    The run is re-executed from its journaled inputs; every event up to the journal's
-    end must come out identical (else :class:`~petriflow.runtime.journal.ResumeMismatch`),
-    and only later events are appended. The trace written is the whole run's.
+    The run is re-executed from its journaled inputs (the firing limit and the trace and
+    XES files it was started with included); every event up to the journal's end must
+    come out identical (else :class:`~petriflow.runtime.journal.ResumeMismatch`), and
+    only later events are appended. The trace written is the whole run's; ``trace``
+    and ``xes`` write it elsewhere.
     """
     journal = Journal(db)
     try:
         if journal.finished:
             raise JournalError(f"{db}: the run already finished ({journal.journaled} events)")
         inputs = journal.inputs
+        started_with = inputs.get("outputs") or {}
+        trace = trace if trace is not None else started_with.get("trace")
+        xes = xes if xes is not None else started_with.get("xes")
+        _make_folders(trace, xes)
         net = _net_from_text(inputs["net_text"], inputs["net_file"])
         config = RunConfig.from_dict(inputs["config"])
         config.import_actions()
         binding = bind(net, registry, path=inputs["net_file"])
         return _execute(net, binding, config, inputs, journal=journal,
                         trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
-                        realtime=realtime, gui=gui, progress=progress, max_firings=None)
+                        realtime=realtime, gui=gui, progress=progress, max_firings=inputs.get("max_firings"))
     finally:
         journal.close()
 

@@ -14,11 +14,13 @@ bit for bit between runs.
 
 from __future__ import annotations
 
+import glob
 import hashlib
 import json
 import math
 import os
 import tempfile
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Iterator
@@ -138,18 +140,29 @@ class _PartialFile:
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
+        self._started = time.time()
         fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial",
                                              dir=self.path.parent if str(self.path.parent) else ".")
         self.file = os.fdopen(fd, "w", encoding="utf-8")
 
     def finish(self, keep: bool = True) -> None:
-        """Close the file and rename it into place (ordinary file mode), or drop it."""
+        """Close the file and rename it into place (ordinary file mode), or drop it.
+
+        Temporary files of the same name left by killed writers (untouched since this
+        one began) are removed once the file is in place.
+        """
         self.file.close()
-        if keep:
-            os.chmod(self._partial, 0o666 & ~_umask())
-            os.replace(self._partial, self.path)
-        else:
+        if not keep:
             os.unlink(self._partial)
+            return
+        os.chmod(self._partial, 0o666 & ~_umask())
+        os.replace(self._partial, self.path)
+        for stale in self.path.parent.glob(f".{glob.escape(self.path.name)}.*.partial"):
+            try:
+                if stale.stat().st_mtime < self._started:
+                    stale.unlink()
+            except OSError:  # gone already, or not ours to remove
+                pass
 
 
 def _umask() -> int:

@@ -1,9 +1,9 @@
-"""The analyses on real-world PNML files with known answers (../shared/oracle).
+"""The analyses on real-world PNML files with known answers (tests/data/oracle).
 
-Each folder holds a net and an ``answer.json`` (see the oracle's INDEX.md): MCC models
-with the contest's published StateSpace answers, dialect samples, workflow nets with a
-soundness verdict, and an unbounded net. Skipped when the oracle folder or the PNML
-reader is absent.
+Each folder holds a net and an ``answer.json``: MCC models with the contest's published
+StateSpace answers, dialect samples, workflow nets with a soundness verdict, and an
+unbounded net. The few nets that may not be copied into the tests run when the shared
+corpus is beside the project, and skip saying so otherwise.
 """
 
 from __future__ import annotations
@@ -16,16 +16,9 @@ import pytest
 
 from petriflow.analysis.report import check_net
 
-ORACLE = Path(__file__).resolve().parents[2].parent / "shared" / "oracle"
+from tests.conftest import oracle_cases
 
-
-def oracle_cases() -> list[Path]:
-    if not ORACLE.is_dir():
-        return []
-    return sorted(p.parent for p in ORACLE.glob("*/*/answer.json"))
-
-
-CASES = [c for c in oracle_cases() if "illegal" not in c.name]
+CASES = oracle_cases(legal_only=True)
 
 
 def load(case: Path):
@@ -49,12 +42,7 @@ def published_state_space(case: Path) -> dict[str, int]:
     return values
 
 
-def ids(case: Path) -> str:
-    return f"{case.parent.name}/{case.name}"
-
-
-@pytest.mark.skipif(not CASES, reason="oracle folder ../shared/oracle not found")
-@pytest.mark.parametrize("case", CASES, ids=ids)
+@pytest.mark.parametrize("case", CASES)
 def test_answers_match(case):
     """states, edges, max tokens, safe, bounded, sound, WF-ness as in answer.json."""
     net, answer = load(case)
@@ -77,11 +65,10 @@ def test_answers_match(case):
     assert got == expected
 
 
-MCC = [c for c in CASES if c.parent.name == "mcc"]
+MCC = [c for c in CASES if c.id.startswith("mcc/")]
 
 
-@pytest.mark.skipif(not MCC, reason="no MCC models in the oracle folder")
-@pytest.mark.parametrize("case", MCC, ids=ids)
+@pytest.mark.parametrize("case", MCC)
 def test_mcc_published_state_space(case):
     """The Model Checking Contest's StateSpace answers, straight from oracle-StateSpace.out."""
     net, _ = load(case)
@@ -93,11 +80,10 @@ def test_mcc_published_state_space(case):
         published["MAX_TOKEN_PER_MARKING"])
 
 
-UNSOUND_WORKFLOWS = [c for c in CASES if c.parent.name == "workflow"]
+UNSOUND_WORKFLOWS = [c for c in CASES if c.id.startswith("workflow/")]
 
 
-@pytest.mark.skipif(not UNSOUND_WORKFLOWS, reason="no workflow nets in the oracle folder")
-@pytest.mark.parametrize("case", UNSOUND_WORKFLOWS, ids=ids)
+@pytest.mark.parametrize("case", UNSOUND_WORKFLOWS)
 def test_workflow_violations_have_replayable_witnesses(case):
     """Every violation witness of an oracle workflow net fires from [i] to its marking."""
     from petriflow.engine import fire_sequence

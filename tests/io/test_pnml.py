@@ -28,18 +28,11 @@ from petriflow.io.pnml import (
 from petriflow.io.yaml import dumps_net, load_yaml, loads_net
 from petriflow.net import Net, Operator
 
+from tests.conftest import ORACLE, oracle_cases
+
 REPO = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parent / "data"
-ORACLE = REPO / ".." / "shared" / "oracle"
 ISO = PNML_NAMESPACE
-
-
-def oracle_cases() -> list:
-    """Every oracle folder with its answer, or one case that skips when the folder is absent."""
-    if not ORACLE.is_dir():
-        return [pytest.param(None, id="no-oracle")]
-    return [pytest.param(folder, id=f"{folder.parent.name}/{folder.name}")
-            for folder in sorted(ORACLE.glob("*/*")) if (folder / "answer.json").is_file()]
 
 
 def tidy(text: str) -> str:
@@ -90,8 +83,6 @@ def arcs_of(net: Net) -> set[tuple[str, str, int]]:
 @pytest.mark.parametrize("folder", oracle_cases())
 def test_oracle_file_loads_with_the_expected_counts(folder):
     """Every file other tools wrote loads with the known counts, or is rejected if illegal."""
-    if folder is None:
-        pytest.skip("shared oracle nets not available")
     answer = json.loads((folder / "answer.json").read_text(encoding="utf-8"))
     path = folder / answer["file"]
     if folder.name.startswith("epnk-illegal"):
@@ -112,13 +103,9 @@ def test_oracle_file_loads_with_the_expected_counts(folder):
         assert net.initial_marking == expected["initial_marking"]
 
 
-@pytest.mark.parametrize("folder", oracle_cases())
+@pytest.mark.parametrize("folder", oracle_cases(legal_only=True))
 def test_oracle_file_survives_a_petriflow_round_trip(folder):
     """What petriflow read from a foreign file, it writes and reads back unchanged."""
-    if folder is None:
-        pytest.skip("shared oracle nets not available")
-    if folder.name.startswith("epnk-illegal"):
-        pytest.skip("rejected on purpose")
     answer = json.loads((folder / "answer.json").read_text(encoding="utf-8"))
     net, _ = load_warned(folder / answer["file"])
     back = read(dumps_pnml(net))
@@ -132,8 +119,6 @@ def test_oracle_file_survives_a_petriflow_round_trip(folder):
 def test_illegal_epnk_file_is_rejected_naming_a_net():
     """ePNK's CyclicReferences example (two nets, reference cycles) is refused."""
     path = ORACLE / "dialects" / "epnk-illegal-CyclicReferences" / "CyclicReferences.pnml"
-    if not path.is_file():
-        pytest.skip("shared oracle nets not available")
     with pytest.raises(NetFormatError) as info:
         load_pnml(path)
     assert info.value.line is not None and "4711" in str(info.value)
@@ -143,8 +128,6 @@ def test_cli_info_works_on_every_oracle_file(capsys):
     """``petriflow info`` answers 0 on every legal oracle file and 2 on the illegal one."""
     from petriflow.cli import main
 
-    if not ORACLE.is_dir():
-        pytest.skip("shared oracle nets not available")
     for answer_file in sorted(ORACLE.glob("*/*/answer.json")):
         net_file = answer_file.parent / json.loads(answer_file.read_text(encoding="utf-8"))["file"]
         with warnings.catch_warnings():

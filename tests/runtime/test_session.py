@@ -175,3 +175,53 @@ def test_replay_prints_the_token_game(tmp_path, ticker, capsys):
     assert main(["replay", str(tmp_path / "t.jsonl")]) == 0
     out = capsys.readouterr().out.splitlines()
     assert "fire   tick" in out[1] and out[-1].endswith("count=2")
+
+
+def test_output_folders_are_made(tmp_path, ticker):
+    """--trace/--xes/--db into folders that do not exist yet: the folders are made."""
+    out = tmp_path / "out" / "smart"
+    code = main(["run", str(ticker), "--until", "0.2", "--trace", str(out / "run.jsonl"),
+                 "--xes", str(out / "run.xes"), "--db", str(out / "run.sqlite")])
+    assert code == 0
+    assert sorted(p.name for p in out.iterdir()) == ["run.jsonl", "run.sqlite", "run.xes"]
+
+
+def test_resume_writes_the_outputs_the_run_was_started_with(tmp_path, ticker, monkeypatch):
+    """Killed mid-way, the run resumed with only --db rewrites its trace and XES, keeps its
+    firing limit, and leaves no temporary file behind."""
+    whole = tmp_path / "whole"
+    run_files(ticker, max_firings=12, trace=whole / "t.jsonl")
+
+    class Crash(Exception):
+        pass
+
+    original = session.Scheduler.on_event
+
+    def crash_after(self, handler):
+        original(self, handler)
+        if not getattr(self, "_crash_installed", False):
+            self._crash_installed = True
+            original(self, lambda event: (_ for _ in ()).throw(Crash()) if event.seq == 9 else None)
+
+    monkeypatch.setattr(session.Scheduler, "on_event", crash_after)
+    out = tmp_path / "out"
+    with pytest.raises(Crash):
+        run_files(ticker, max_firings=12, trace=out / "t.jsonl", xes=out / "t.xes", db=out / "t.sqlite")
+    monkeypatch.undo()
+    assert not (out / "t.jsonl").exists()
+    assert main(["run", "--resume", "--db", str(out / "t.sqlite")]) == 0
+    assert lines(out / "t.jsonl") == lines(whole / "t.jsonl")
+    assert read_trace(out / "t.jsonl")[-1].data["firings"] == 12
+    assert (out / "t.xes").exists()
+    assert sorted(p.name for p in out.iterdir()) == ["t.jsonl", "t.sqlite", "t.xes"]
+
+
+def test_a_killed_writers_temporary_file_is_cleaned_up(tmp_path, ticker):
+    """A trace's temporary file left by a killed run goes once a later run's trace is in place."""
+    import os
+
+    stale = tmp_path / ".t.jsonl.abc123.partial"
+    stale.write_text("half a trace")
+    os.utime(stale, (1, 1))
+    run_files(ticker, until=0.1, trace=tmp_path / "t.jsonl")
+    assert sorted(p.name for p in tmp_path.iterdir() if p.suffix != ".yaml") == ["t.jsonl"]
