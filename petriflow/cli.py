@@ -172,20 +172,35 @@ def cmd_fire(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _size(text: str | None) -> tuple[float, float] | None:
+    if text is None:
+        return None
+    try:
+        width, height = (float(v) for v in text.lower().replace("x", ",").split(","))
+    except ValueError:
+        raise PetriflowError(f"--size is WIDTH,HEIGHT in inches, e.g. 12,9; got {text!r}") from None
+    if not (0 < width < 1000 and 0 < height < 1000):
+        raise PetriflowError(f"--size must be between 0 and 1000 inches each way, got {text!r}")
+    return width, height
+
+
 def cmd_export(args: argparse.Namespace) -> int:
+    from petriflow.export import export_net, format_of
+
+    format = format_of(args.output, args.format)  # a bad format or ending fails before any work
+    size = _size(args.size)
     net = load_net(args.net)
     marking = _start_marking(net, args.marking)
-    from petriflow.export import export_net
-
     highlight = [h for h in (args.highlight or "").split(",") if h] or None
+    caption = None
     if args.violation:
         from petriflow.analysis.report import check_net
 
         violations = [v for v in check_net(net)["violations"] if v.get("transitions")]
         if not violations:
-            print(f"petriflow: {args.net}: the analysis found no violation with a witness to draw",
+            print(f"petriflow: {args.net}: the analysis found no violation with a witness; nothing drawn",
                   file=sys.stderr)
-            return EXIT_PROBLEM
+            return EXIT_OK
         witness = violations[0]
         # outcome variants (t@failed) are drawn on the transition they belong to
         from petriflow.engine import CompiledNet
@@ -195,8 +210,11 @@ def cmd_export(args: argparse.Namespace) -> int:
         highlight = list(dict.fromkeys(origin.get(t, t) for t in witness["transitions"]))
         highlight += [p for p in (witness.get("marking") or {}) if p in net.places]
         marking = net.check_marking(witness.get("marking") or {})
+        caption = (f"red: {witness['message']}, reached by firing {' '.join(witness['transitions'])};"
+                   " tokens: the marking it reaches")
         print(witness["message"])
-    export_net(net, args.output, args.format, marking=marking, highlight=highlight)
+    export_net(net, args.output, format, marking=marking, highlight=highlight, caption=caption,
+               rankdir=args.rankdir, size=size)
     return EXIT_OK
 
 
@@ -226,7 +244,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         "firings": result.firings,
         "events": result.events,
         "wall_seconds": round(outcome.wall, 3),
-        "realtime_factor": round(outcome.realtime_factor, 2) if outcome.wall > 0 else None,
+        "realtime_factor": round(outcome.realtime_factor, 2) if outcome.wall > 0 and result.time > 0 else None,
+        "seed": outcome.seed,
         "marking": result.marking.to_dict(),
         "error": result.error,
         "written": outcome.written,
@@ -234,9 +253,11 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.json:
         _print_json(summary)
     else:
-        print(f"{outcome.net.id}: {result.reason} at t = {result.time:g} s after {result.firings} firings"
-              f" ({outcome.wall:.2f} s wall, {outcome.realtime_factor:.1f}x real time)")
-        print(f"  final marking: {_format_marking(result.marking)}")
+        pace = (f"{outcome.realtime_factor:.1f}x real time" if result.time > 0
+                else "no simulated time passed")
+        print(f"{outcome.net.id}: {result.reason} at t = {result.time:g} s after {result.firings}"
+              f" firing{'' if result.firings == 1 else 's'} (seed {outcome.seed}; {outcome.wall:.2f} s wall, {pace})")
+        print(f"  marking at the end: {_format_marking(result.marking)}")
         if result.error:
             print(f"  error: {result.error}")
         for path in outcome.written:
@@ -333,9 +354,13 @@ def build_parser() -> argparse.ArgumentParser:
     fire_cmd.add_argument("--json", action="store_true", help="print JSON")
 
     export = net_command("export", "Convert a net or draw it.", cmd_export)
-    export.add_argument("--format", "-f", required=True,
-                        choices=["pnml", "yaml", "dot", "svg", "png"], help="output format")
+    export.add_argument("--format", "-f", choices=["pnml", "yaml", "dot", "svg", "png"],
+                        help="output format (default: from the output file's ending)")
     export.add_argument("--output", "-o", required=True, help="output file")
+    export.add_argument("--rankdir", choices=["LR", "TB", "auto"], default="auto",
+                        help="pictures: left to right, top to bottom, or auto (top to bottom when left to"
+                        " right would be too wide; the default)")
+    export.add_argument("--size", metavar="W,H", help="pictures: at most this size in inches (PNG at 150 dpi)")
     export.add_argument("--marking", help="marking to draw, as JSON (default: initial)")
     export.add_argument("--highlight", metavar="IDS", help="comma-separated node ids to highlight")
     export.add_argument("--violation", action="store_true",

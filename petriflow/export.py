@@ -2,9 +2,14 @@
 
 :func:`to_dot` turns a net (and a marking) into Graphviz DOT text: places are circles
 holding their tokens, transitions are boxes naming the action they run, agent subnets
-are labelled clusters, and the layout flows left to right. :func:`render` runs the
-``dot`` program to make SVG or PNG, and :func:`export_net` is what ``petriflow export``
-calls for any of ``pnml``, ``yaml``, ``dot``, ``svg`` and ``png``.
+are labelled clusters. Every node shows its id beside its label (``T5 · start
+cooperative task``), so the picture matches the ids that ``check``, ``replay`` and
+error messages name. WF operators carry WoPeD-style markers (the parts of an XOR side
+are grouped in a dashed frame); running transitions (``replay --draw``) are drawn in
+their own colour with the tokens they hold. :func:`render` runs the ``dot`` program to
+make SVG or PNG, and :func:`export_net` is what ``petriflow export`` calls for any of
+``pnml``, ``yaml``, ``dot``, ``svg`` and ``png``; it lays a picture out left to right,
+or top to bottom when that would be too wide to read (``rankdir="auto"``).
 
 Only ``dot`` itself is needed for pictures (no Python Graphviz binding); DOT text can
 be made without it.
@@ -18,6 +23,8 @@ Examples:
     >>> _ = net.add_arc("ready", "go"), net.add_arc("go", "done", weight=2)
     >>> source = to_dot(net)
     >>> source.startswith('digraph "demo" {'), "rankdir=LR" in source
+    (True, True)
+    >>> "<B>go</B>" in source, "ready" in source
     (True, True)
     >>> print(next(line.strip() for line in source.splitlines() if "->" in line))
     "ready" -> "go";
@@ -36,8 +43,8 @@ from petriflow.errors import DependencyNotInstalled, PetriflowError, UnknownElem
 from petriflow.net import Net
 
 __all__ = [
-    "to_dot", "render", "export_net", "EXPORT_FORMATS", "PICTURE_FORMATS", "DOT_EXECUTABLE",
-    "HIGHLIGHT_COLOUR",
+    "to_dot", "render", "export_net", "format_of", "EXPORT_FORMATS", "PICTURE_FORMATS", "DOT_EXECUTABLE",
+    "HIGHLIGHT_COLOUR", "RUNNING_COLOUR", "RANK_DIRECTIONS",
 ]
 
 #: Every format :func:`export_net` writes.
@@ -58,6 +65,14 @@ _FONT = "Helvetica"
 #: Colour of highlighted nodes and arcs (see :func:`to_dot`).
 HIGHLIGHT_COLOUR = "#d62728"
 _HIGHLIGHT_FILL = "#fde0dd"
+#: Colour of transitions whose actions are running (see :func:`to_dot`).
+RUNNING_COLOUR = "#1f6fb4"
+_RUNNING_FILL = "#d7e8f7"
+#: Layout directions: left to right, top to bottom, or chosen from the net's shape.
+RANK_DIRECTIONS = ("LR", "TB", "auto")
+#: With ``rankdir="auto"``, a left-to-right layout wider than this many times its
+#: height is drawn top to bottom instead.
+AUTO_RATIO = 2.2
 _TRANSITION_FILL = "#dfe6ee"
 _CLUSTER_COLOURS = (  # (fill, border) per subnet, in turn
     ("#eef5fc", "#6b9bc8"),
@@ -70,6 +85,7 @@ _CLUSTER_COLOURS = (  # (fill, border) per subnet, in turn
 _PLACE_SIZE = 0.42
 _NAME_ROW = 14  # points: height of the name under a place
 _DOT = "\u25cf"  # a black circle: one token
+_SEPARATOR = " \u00b7 "  # between a node's id and its label
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
 _BACKSLASHES_AT_RISK = re.compile(r'\\+(?=["\n]|\Z)')
@@ -131,7 +147,7 @@ def _place_lines(net: Net, place: str, count: int, highlighted: bool, indent: st
     spec = net.places[place]
     colour = HIGHLIGHT_COLOUR if highlighted else "black"
     side = round(_PLACE_SIZE * 72)
-    name = _html(spec.label or spec.id)
+    name = _html(_name(spec.id, spec.label))
     label = (
         '<<TABLE BORDER="0" CELLBORDER="0" CELLSPACING="0" CELLPADDING="0">'
         f'<TR><TD HEIGHT="{_NAME_ROW}"> </TD></TR>'
@@ -145,27 +161,73 @@ def _place_lines(net: Net, place: str, count: int, highlighted: bool, indent: st
     return f"{indent}{_quote(place)} {_attributes(attrs)};"
 
 
-def _transition_lines(net: Net, transition: str, highlighted: bool, indent: str) -> str:
+def _name(node_id: str, label: str | None) -> str:
+    """What a node is called in pictures: its id, and its label when it has another.
+
+    Examples:
+        >>> _name("T5", "start cooperative task"), _name("go", None), _name("go", "go")
+        ('T5 · start cooperative task', 'go', 'go')
+    """
+    return node_id if not label or label == node_id else f"{node_id}{_SEPARATOR}{label}"
+
+
+def _operator_marker(net: Net, transition: str) -> str | None:
+    """The WoPeD-style marker of a transition that is (part of) a WF operator.
+
+    Examples:
+        >>> from petriflow.workflow import add_operator
+        >>> net = Net()
+        >>> for p in ("a", "b", "c"): _ = net.add_place(p)
+        >>> add_operator(net, "pick", inputs={"a": 1}, outputs={"b": 1, "c": 1}, split="xor")
+        ['pick_op_1', 'pick_op_2']
+        >>> _operator_marker(net, "pick_op_2")
+        'XOR-split ▷ pick, branch 2 of 2'
+    """
+    operator = net.transitions[transition].operator
+    if operator is None:
+        return None
+    sides = []
+    if operator.join:
+        sides.append(f"\u25c1 {operator.join.upper()}-join")
+    if operator.split:
+        sides.append(f"{operator.split.upper()}-split \u25b7")
+    text = " \u00b7 ".join(sides) or "operator"
+    parts = [t.id for t in net.transitions.values() if t.operator is not None and t.operator.group == operator.group]
+    if len(parts) > 1:
+        return f"{text} {operator.group}, branch {parts.index(transition) + 1} of {len(parts)}"
+    return text if operator.group == transition else f"{text} {operator.group}"
+
+
+def _transition_lines(net: Net, transition: str, highlighted: bool, indent: str,
+                      holding: Mapping[str, int] | None = None) -> str:
     spec = net.transitions[transition]
-    colour = HIGHLIGHT_COLOUR if highlighted else "black"
+    colour = HIGHLIGHT_COLOUR if highlighted else (RUNNING_COLOUR if holding is not None else "black")
     if spec.silent:
         attrs = {
             "label": '""', "width": "0.1", "height": "0.45", "fixedsize": "true",
             "style": "filled", "fillcolor": f'"{colour}"', "color": f'"{colour}"',
+            "tooltip": _quote(_name(spec.id, spec.label)), "xlabel": _quote(spec.id),
         }
         return f"{indent}{_quote(transition)} {_attributes(attrs)};"
-    lines = [f"<B>{_html(spec.label or spec.id)}</B>"]
+    lines = [f"<B>{_html(_name(spec.id, spec.label))}</B>"]
+    marker = _operator_marker(net, transition)
+    if marker:
+        lines.append(f'<FONT POINT-SIZE="8" COLOR="#7a4f00">{_html(marker)}</FONT>')
     if spec.action:
         lines.append(f'<FONT POINT-SIZE="8" COLOR="#404040">{_html(spec.action)}</FONT>')
     if spec.guard:
         lines.append(f'<FONT POINT-SIZE="8" COLOR="#404040">[{_html(spec.guard)}]</FONT>')
+    if holding is not None:
+        held = ", ".join(p if n == 1 else f"{p}\u00d7{n}" for p, n in holding.items()) or "no token"
+        lines.append(f'<FONT POINT-SIZE="8" COLOR="{RUNNING_COLOUR}">running, holds {_html(held)}</FONT>')
+    fill = _HIGHLIGHT_FILL if highlighted else (_RUNNING_FILL if holding is not None else _TRANSITION_FILL)
     attrs = {
         "label": "<" + "<BR/>".join(lines) + ">",
-        "fillcolor": f'"{_HIGHLIGHT_FILL if highlighted else _TRANSITION_FILL}"',
+        "fillcolor": f'"{fill}"',
         "color": f'"{colour}"',
         "fontcolor": f'"{colour}"',
     }
-    if highlighted:
+    if highlighted or holding is not None:
         attrs["penwidth"] = "2.5"
     return f"{indent}{_quote(transition)} {_attributes(attrs)};"
 
@@ -201,6 +263,9 @@ def to_dot(
     *,
     highlight: Sequence[str] | None = None,
     title: str | None = None,
+    caption: str | None = None,
+    running: Mapping[str, Mapping[str, int]] | None = None,
+    rankdir: str = "LR",
 ) -> str:
     """Graphviz DOT source drawing ``net`` in ``marking``.
 
@@ -220,6 +285,11 @@ def to_dot(
             A single string is taken as one id.
         title: text above the picture; defaults to the net's label or id; ``""`` for
             none.
+        caption: a line under the title saying what the picture shows (e.g. what the
+            highlighted path is).
+        running: ``{transition: {place: tokens}}`` of the transitions whose actions
+            are running, with the tokens they took and hold: drawn in their own colour.
+        rankdir: ``"LR"`` (left to right) or ``"TB"`` (top to bottom).
 
     Returns:
         The DOT text (Graphviz reads it with ``dot -Tsvg`` and the like).
@@ -237,15 +307,23 @@ def to_dot(
     """
     marking = net.initial_marking if marking is None else net.check_marking(marking)
     chosen, bold_arcs = _highlight_sets(net, highlight)
+    running = dict(running or {})
+    for transition in running:
+        net.transition(transition)
+    if rankdir not in ("LR", "TB"):
+        raise PetriflowError(f"rankdir must be LR or TB, got {rankdir!r}")
     title = (net.label or net.id) if title is None else title
 
     out = [f"digraph {_quote(net.id)} {{"]
     graph = {
-        "rankdir": "LR", "nodesep": "0.3", "ranksep": "0.45", "newrank": "true",
+        "rankdir": rankdir, "nodesep": "0.3", "ranksep": "0.45", "newrank": "true",
         "fontname": f'"{_FONT}"', "fontsize": "12", "pad": "0.25", "outputorder": "edgesfirst",
     }
-    if title:
-        graph.update({"label": f"<<B>{_html(title)}</B>>", "labelloc": "t", "fontsize": "14"})
+    heading = [f"<B>{_html(title)}</B>"] if title else []
+    if caption:
+        heading.append(f'<FONT POINT-SIZE="11">{_html(caption)}</FONT>')
+    if heading:
+        graph.update({"label": "<" + "<BR/>".join(heading) + ">", "labelloc": "t", "fontsize": "14"})
     out.append(f"  graph {_attributes(graph)};")
     out.append(
         f'  node [fontname="{_FONT}", fontsize=10, shape=circle, fixedsize=shape,'
@@ -260,7 +338,23 @@ def to_dot(
                 f"{indent}node [shape=box, fixedsize=false, style=\"filled,rounded\","
                 f" width=0.3, height=0.35, margin=\"0.08,0.03\", penwidth=1.2];"
             )
-            lines += [_transition_lines(net, t, t in chosen, indent) for t in transitions]
+            groups: dict[str, list[str]] = {}
+            for t in transitions:
+                operator = net.transitions[t].operator
+                if operator is not None and (operator.split == "xor" or operator.join == "xor"):
+                    groups.setdefault(operator.group, []).append(t)
+            framed = {t for parts in groups.values() if len(parts) > 1 for t in parts}
+            lines += [_transition_lines(net, t, t in chosen, indent, running.get(t))
+                      for t in transitions if t not in framed]
+            for group, parts in groups.items():
+                if len(parts) < 2:
+                    continue
+                lines.append(f"{indent}subgraph {_quote('cluster_operator_' + group)} {{")
+                lines.append(f'{indent}  graph [label=<<FONT POINT-SIZE="9" COLOR="#7a4f00">operator {_html(group)}'
+                             f'</FONT>>, labeljust=l, style="dashed,rounded", color="#b07d1a", penwidth=1.0,'
+                             f" margin=6];")
+                lines += [_transition_lines(net, t, t in chosen, indent + "  ", running.get(t)) for t in parts]
+                lines.append(f"{indent}}}")
         return lines
 
     for number, subnet in enumerate(net.subnets.values()):
@@ -314,7 +408,24 @@ def _write(path: Path, data: bytes) -> None:
         raise PetriflowError(f"{path}: cannot write: {exc.strerror or exc}") from None
 
 
-def render(dot_source: str, path: str | Path, format: str) -> None:
+def _layout_size(dot_source: str) -> tuple[float, float] | None:
+    """Width and height (inches) of the layout ``dot`` makes of ``dot_source``, or
+    ``None`` when ``dot`` is missing or fails (the caller then keeps its choice)."""
+    executable = shutil.which(DOT_EXECUTABLE)
+    if executable is None:
+        return None
+    try:
+        done = subprocess.run([executable, "-Tplain"], input=dot_source.encode("utf-8"), capture_output=True,
+                              timeout=DOT_TIMEOUT_S)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    first = done.stdout.decode("utf-8", "replace").split("\n", 1)[0].split()
+    if done.returncode != 0 or len(first) < 4 or first[0] != "graph":
+        return None
+    return float(first[2]), float(first[3])
+
+
+def render(dot_source: str, path: str | Path, format: str, *, size: tuple[float, float] | None = None) -> None:
     """Lay out ``dot_source`` with Graphviz and write the picture to ``path``.
 
     The picture is written atomically: when ``dot`` is missing, fails or times out,
@@ -324,6 +435,8 @@ def render(dot_source: str, path: str | Path, format: str) -> None:
         dot_source: DOT text, e.g. from :func:`to_dot`.
         path: the file to write.
         format: ``"svg"`` or ``"png"``.
+        size: the largest the picture may be, ``(width, height)`` in inches (at 150
+            dots per inch for PNG): a larger layout is scaled down to fit.
 
     Raises:
         DependencyNotInstalled: the ``dot`` program is not installed.
@@ -340,6 +453,8 @@ def render(dot_source: str, path: str | Path, format: str) -> None:
     command = [executable, f"-T{format}"]
     if format == "png":
         command.append(f"-Gdpi={PNG_DPI}")
+    if size is not None:
+        command.append(f"-Gsize={size[0]:g},{size[1]:g}")
     try:
         done = subprocess.run(
             command, input=dot_source.encode("utf-8"), capture_output=True, timeout=DOT_TIMEOUT_S
@@ -357,12 +472,44 @@ def render(dot_source: str, path: str | Path, format: str) -> None:
     _write(path, done.stdout)
 
 
+def format_of(path: str | Path, format: str | None = None) -> str:
+    """The export format for ``path``: ``format`` if given (it must agree with the
+    file's ending when that names a format), else the one the ending names.
+
+    Examples:
+        >>> format_of("net.svg"), format_of("net.PNG"), format_of("net.txt", "dot")
+        ('svg', 'png', 'dot')
+        >>> format_of("net.svg", "png")
+        Traceback (most recent call last):
+        ...
+        petriflow.errors.PetriflowError: net.svg: the file ends in .svg but the format asked for is png; name it .png or drop -f
+    """
+    ending = Path(path).suffix.lower().lstrip(".")
+    ending = {"yml": "yaml", "gv": "dot", "xml": "pnml"}.get(ending, ending)
+    if format is None:
+        if ending not in EXPORT_FORMATS:
+            raise PetriflowError(f"{path}: cannot tell the format from the ending {Path(path).suffix or '(none)'!r};"
+                                 f" give -f {'|'.join(EXPORT_FORMATS)}")
+        return ending
+    if format not in EXPORT_FORMATS:
+        raise PetriflowError(f"unknown export format {format!r}; use one of {', '.join(EXPORT_FORMATS)}")
+    if ending in EXPORT_FORMATS and ending != format:
+        raise PetriflowError(f"{path}: the file ends in .{Path(path).suffix.lower().lstrip('.')} but the format"
+                             f" asked for is {format}; name it .{format} or drop -f")
+    return format
+
+
 def export_net(
     net: Net,
     path: str | Path,
-    format: str,
+    format: str | None = None,
     marking: Mapping[str, int] | None = None,
     highlight: Sequence[str] | None = None,
+    *,
+    caption: str | None = None,
+    running: Mapping[str, Mapping[str, int]] | None = None,
+    rankdir: str = "auto",
+    size: tuple[float, float] | None = None,
 ) -> None:
     """Write ``net`` to ``path`` as ``pnml``, ``yaml``, ``dot``, ``svg`` or ``png``.
 
@@ -371,20 +518,28 @@ def export_net(
     Args:
         net: the net.
         path: the output file; its directory must exist.
-        format: one of :data:`EXPORT_FORMATS`.
+        format: one of :data:`EXPORT_FORMATS`; default: from the file's ending (a
+            format that contradicts the ending is refused, see :func:`format_of`).
         marking: for pictures and DOT, the tokens to draw (default: the initial
             marking); for ``pnml``/``yaml``, the initial marking to write when it
             differs from the net's own.
         highlight: for pictures and DOT, node ids to highlight (see :func:`to_dot`);
             not used by ``pnml``/``yaml``.
+        caption: for pictures and DOT, a line under the title.
+        running: for pictures and DOT, running transitions and the tokens they hold.
+        rankdir: ``LR``, ``TB``, or ``auto``: left to right unless that layout would be
+            more than :data:`AUTO_RATIO` times wider than high, then top to bottom.
+        size: for pictures, the largest size ``(width, height)`` in inches.
 
     Raises:
-        PetriflowError: unknown format, missing output directory, unknown node in
-            ``marking``/``highlight``, or a failed write or layout.
+        PetriflowError: unknown format, a format the file's ending contradicts,
+            missing output directory, unknown node in ``marking``/``highlight``, or a
+            failed write or layout.
         DependencyNotInstalled: a picture was asked for and Graphviz is missing.
     """
-    if format not in EXPORT_FORMATS:
-        raise PetriflowError(f"unknown export format {format!r}; use one of {', '.join(EXPORT_FORMATS)}")
+    format = format_of(path, format)
+    if rankdir not in RANK_DIRECTIONS:
+        raise PetriflowError(f"rankdir must be one of {', '.join(RANK_DIRECTIONS)}, got {rankdir!r}")
     path = Path(path)
     _check_directory(path)
     if format in ("pnml", "yaml"):
@@ -400,8 +555,13 @@ def export_net(
         except OSError as exc:
             raise PetriflowError(f"{path}: cannot write: {exc.strerror or exc}") from None
         return
-    source = to_dot(net, marking, highlight=highlight)
+    options = {"highlight": highlight, "caption": caption, "running": running}
+    source = to_dot(net, marking, rankdir="LR" if rankdir == "auto" else rankdir, **options)
+    if rankdir == "auto":
+        extent = _layout_size(source)
+        if extent is not None and extent[0] > AUTO_RATIO * extent[1]:
+            source = to_dot(net, marking, rankdir="TB", **options)
     if format == "dot":
         _write(path, source.encode("utf-8"))
     else:
-        render(source, path, format)
+        render(source, path, format, size=size)

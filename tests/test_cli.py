@@ -57,7 +57,7 @@ def test_simulate_prints_fired_transitions_and_final_marking(capsys, sequence_fi
     code, out, _ = run(capsys, "simulate", sequence_file, "--steps", "5")
     assert code == 0
     assert out.splitlines()[:2] == ["     1  a", "     2  b"]
-    assert "final marking: o=2" in out
+    assert "marking at the end: o=2" in out
 
 
 def test_fire_prints_marking_after_each_transition(capsys, sequence_file):

@@ -96,7 +96,7 @@ def test_dot_has_one_labelled_cluster_per_subnet(inspection):
         assert f"agent: {subnet.agent or subnet.id}" in body
         places, transitions = inspection.nodes_of(subnet.id)
         assert set(node_statements(body)) == set(places) | set(transitions)
-    assert source.count("subgraph ") == len(inspection.subnets)
+    assert source.count('subgraph "cluster_') - source.count('subgraph "cluster_operator_') == len(inspection.subnets)
 
 
 def test_weights_above_one_are_edge_labels():
@@ -231,7 +231,7 @@ def test_png_is_a_png(tmp_path, inspection):
 
 def test_dot_format_writes_the_dot_source(tmp_path, inspection):
     out = tmp_path / "net.dot"
-    export_net(inspection, out, "dot", marking={"o": 5}, highlight=["o"])
+    export_net(inspection, out, "dot", marking={"o": 5}, highlight=["o"], rankdir="LR")
     assert out.read_text(encoding="utf-8") == to_dot(inspection, {"o": 5}, highlight=["o"])
 
 
@@ -322,3 +322,67 @@ def test_cli_exports_dot_without_graphviz(tmp_path, monkeypatch):
     out = tmp_path / "inspection.dot"
     assert main(["export", str(INSPECTION), "-f", "dot", "-o", str(out)]) == 0
     assert 'subgraph "cluster_camera"' in out.read_text(encoding="utf-8")
+
+
+def test_nodes_show_their_id_beside_their_label():
+    """What check, replay and errors name (ids) is in the picture next to the label."""
+    from petriflow.io import load_net
+    from tests.conftest import NETS
+
+    source = to_dot(load_net(NETS / "smart" / "smart.yaml"))
+    assert "<B>T5 \u00b7 start cooperative task</B>" in source
+    assert "P2 \u00b7 camera standby" in source
+
+
+def test_operators_carry_markers_and_xor_parts_are_framed_together(inspection):
+    """An AND side is marked in its box; the parts of an XOR side sit in one dashed frame."""
+    from petriflow.net import Net
+    from petriflow.workflow import add_operator
+
+    net = Net("ops")
+    for place in ("a", "b", "c", "d"):
+        net.add_place(place)
+    add_operator(net, "fork", inputs={"a": 1}, outputs={"b": 1, "c": 1}, split="and")
+    add_operator(net, "pick", inputs={"b": 1}, outputs={"c": 1, "d": 1}, split="xor")
+    source = to_dot(net)
+    assert "AND-split \u25b7" in node_statements(source)["fork"]
+    frame = source[source.index('subgraph "cluster_operator_pick"'):]
+    frame = frame[:frame.index("}")]
+    assert '"pick_op_1"' in frame and '"pick_op_2"' in frame and "branch 2 of 2" in source
+
+
+def test_running_transitions_are_drawn_with_the_tokens_they_hold(inspection):
+    source = to_dot(inspection, running={"capture": {"i": 1}})
+    from petriflow.export import RUNNING_COLOUR
+
+    assert RUNNING_COLOUR in node_statements(source)["capture"] and "running, holds i" in source
+
+
+def test_a_caption_says_what_the_picture_shows(inspection):
+    assert "the path to the deadlock" in to_dot(inspection, caption="red: the path to the deadlock")
+
+
+def test_the_format_comes_from_the_ending_and_a_contradiction_is_refused(tmp_path, inspection):
+    export_net(inspection, tmp_path / "net.dot")
+    assert (tmp_path / "net.dot").read_text().startswith("digraph")
+    with pytest.raises(PetriflowError, match="ends in .svg but the format asked for is png"):
+        export_net(inspection, tmp_path / "net.svg", "png")
+    assert not (tmp_path / "net.svg").exists()
+
+
+def test_a_wide_net_is_laid_out_top_to_bottom(tmp_path):
+    """rankdir auto: a long chain, too wide left to right, is drawn top to bottom."""
+    pytest.importorskip("shutil").which("dot") or pytest.skip("Graphviz 'dot' is not installed")
+    from petriflow.net import Net
+
+    chain = Net("chain")
+    chain.add_place("p0", tokens=1)
+    for k in range(12):
+        chain.add_place(f"p{k + 1}")
+        chain.add_transition(f"t{k}")
+        chain.add_arc(f"p{k}", f"t{k}")
+        chain.add_arc(f"t{k}", f"p{k + 1}")
+    export_net(chain, tmp_path / "chain.dot")
+    assert "rankdir=TB" in (tmp_path / "chain.dot").read_text()
+    export_net(chain, tmp_path / "lr.dot", rankdir="LR")
+    assert "rankdir=LR" in (tmp_path / "lr.dot").read_text()

@@ -254,9 +254,11 @@ def _bounded_result(result: dict[str, Any], space, violations: list[Violation],
     if deadlock_states.size and not workflow:
         state = int(deadlock_states[0])
         reached = space.marking(state)
+        count = int(deadlock_states.size)
         violations.append(Violation(
-            "deadlock", f"deadlock: {int(deadlock_states.size)} reachable markings enable no"
-            f" transition, e.g. {_format(reached)}", space.path(state), reached.to_dict()))
+            "deadlock", f"deadlock: {_count(count, 'reachable marking')} "
+            f"{'enables' if count == 1 else 'enable'} no transition, e.g. {_format(reached)}",
+            space.path(state), reached.to_dict()))
 
 
 def _reaches(space, final) -> bool:
@@ -342,8 +344,8 @@ def format_report(result: dict[str, Any]) -> str:
         lines.append(f"  state space: {result['error']}")
     elif result["bounded"]:
         safety = "safe" if result["safe"] else f"{result['max_tokens_place']}-bounded"
-        lines.append(f"  state space: {result['states']} states, {result['edges']} edges;"
-                     f" bounded ({safety}); at most {result['max_tokens_marking']} tokens in a marking")
+        lines.append(f"  state space: {_count(result['states'], 'state')}, {_count(result['edges'], 'edge')};"
+                     f" bounded ({safety}); at most {_count(result['max_tokens_marking'], 'token')} in a marking")
         ending = ""
         if not result["deadlock_free"] and result.get("stuck_markings") == 0:
             ending = " (the only dead marking is the declared final marking)"
@@ -367,6 +369,16 @@ def format_report(result: dict[str, Any]) -> str:
         if violation["transitions"]:
             lines.append(f"      witness: {' '.join(violation['transitions'])}")
     return "\n".join(lines)
+
+
+def _count(number: int, noun: str) -> str:
+    """``number`` and ``noun``, plural unless the number is one.
+
+    Examples:
+        >>> _count(1, "token"), _count(3, "reachable marking")
+        ('1 token', '3 reachable markings')
+    """
+    return f"{number} {noun}" if number == 1 else f"{number} {noun}s"
 
 
 def plain(value: Any) -> Any:

@@ -272,6 +272,8 @@ class _Reader:
         self.tokens: dict[str, int] = {}
         self.subprocess_pages: list[Element] = []
         self.pages: list[str] = []
+        self.page_of: dict[Element, str | None] = {}  # the page each node or arc element is on
+        self.node_page: dict[str, str | None] = {}   # the page of each node id
         self.notes: dict[tuple[str, str], list[str]] = {}
 
     # Reporting ----------------------------------------------------------------------
@@ -380,10 +382,14 @@ class _Reader:
         allowed = _NET_TAGS if container is net_element else _PAGE_TAGS
         if _child(container, "net") is not None and container is not net_element:
             allowed = allowed | {"net"}
+        page = None if container is net_element else (container.get("id") or f"(line {_line(container)})")
         for child in container:
             name = _local(child.tag)
             if name in _NODE_TAGS:
                 node = self.register(child, name)
+                self.page_of[child] = page
+                if name != "arc":
+                    self.node_page[str(node)] = page
                 if name == "place":
                     self.places.append(child)
                 elif name == "transition":
@@ -430,7 +436,12 @@ class _Reader:
     # Nodes --------------------------------------------------------------------------
     def read_place(self, element: Element) -> None:
         node = str(element.get("id"))
-        tokens = self.count(_child(element, "initialMarking"), "initial marking", node, minimum=0)
+        marking = _child(element, "initialMarking")
+        multiset = _child(marking, "multiset")
+        if multiset is not None:
+            tokens = self.multiset_count(multiset, node)
+        else:
+            tokens = self.count(marking, "initial marking", node, minimum=0)
         if tokens:
             self.tokens[node] = tokens
         data = self.read_toolspecifics(element, "place", node, {})
@@ -441,7 +452,11 @@ class _Reader:
         capacity = _child(element, "capacity")
         if capacity is not None and self.count(capacity, "capacity", node, minimum=0):
             self.note("place", node, "place capacities are not representable; read as unbounded")
-        self.unknown(element, _PLACE_TAGS, "place", node)
+        allowed = _PLACE_TAGS
+        place_type = _child(element, "type")
+        if place_type is not None and place_type.get("domain") == "universal" and not len(place_type):
+            allowed = allowed | {"type"}  # SNAKES' "any value": nothing is lost in a P/T net
+        self.unknown(element, allowed, "place", node)
         try:
             self.net.add_place(node, label=data.get("label", _name_of(element)),
                                subnet=data.get("subnet"), meta=meta, channel=data.get("channel"))
@@ -676,6 +691,30 @@ class _Reader:
             self.fail(f"{what} must be a whole number, got {text!r}", where, node)
         return int(text)
 
+    def multiset_count(self, multiset: Element, node: str) -> int:
+        """SNAKES' native marking: ``<multiset><item><value>…</value><multiplicity>n``.
+
+        Black tokens (``<value><token/></value>``) count as tokens; coloured values
+        (``<object type="int">5</object>``...) count too, with a warning naming the
+        place and the values lost, since a P/T net holds no token values.
+        """
+        total, coloured = 0, []
+        for item in _children(multiset, "item"):
+            value = _child(item, "value")
+            times = _child(item, "multiplicity")
+            text = (times.text or "").strip() if times is not None else "1"
+            count = self.whole(text or "1", "multiplicity", node, times if times is not None else item)
+            total += count
+            inside = list(value) if value is not None else []
+            if not (len(inside) == 1 and _local(inside[0].tag) == "token"):
+                shown = " ".join("".join(part.itertext()).strip() or _local(part.tag) for part in inside) or "?"
+                coloured.append(shown if count == 1 else f"{shown} x{count}")
+        if coloured:
+            self.note("place", node, f"coloured token values ({', '.join(coloured[:5])}"
+                      f"{', ...' if len(coloured) > 5 else ''}) are not representable; read as {total}"
+                      " plain tokens")
+        return total
+
     def class_counts(self, text: str, what: str, node: str | None, where: Element | None) -> int:
         """PIPE writes counts as ``Default,1`` (token class, count, ...)."""
         parts = [part.strip() for part in text.split(",")]
@@ -737,6 +776,13 @@ class _Reader:
             label = arc_id or f"{source_ref} -> {target_ref}"
             source = self.node_of(source_ref, "source", element, label)
             target = self.node_of(target_ref, "target", element, label)
+            page = self.page_of.get(element)
+            for end in (source_ref, target_ref):
+                if end in self.node_page and self.node_page[end] != page:
+                    where = "the net" if self.node_page[end] is None else f"page {self.node_page[end]!r}"
+                    self.fail(f"arc on {'the net' if page is None else f'page {page!r}'} joins {end!r} on {where};"
+                              " ISO/IEC 15909-2 joins nodes of other pages only through reference nodes",
+                              element, label)
             if (source in self.net.places) == (target in self.net.places):
                 kind = "places" if source in self.net.places else "transitions"
                 self.fail(f"arc joins two {kind} ({source!r} -> {target!r}); arcs join a place and a "

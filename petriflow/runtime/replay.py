@@ -15,7 +15,7 @@ from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 from petriflow.runtime.trace import Event, read_trace
 
-__all__ = ["markings", "replay", "describe"]
+__all__ = ["markings", "replay", "describe", "running_at"]
 
 
 def markings(events: Iterable[Event]) -> Iterator[tuple[Event, Marking]]:
@@ -62,31 +62,68 @@ def describe(event: Event) -> str:
     return f"{event.kind:6} {event.transition or ''}{who} {data}"
 
 
+def running_at(events: Iterable[Event]) -> dict[str, dict[str, int]]:
+    """``{transition: {place: tokens}}`` of the firings started and not yet ended after
+    ``events``: their actions are running and hold the tokens they consumed.
+
+    Examples:
+        >>> start = Event(1, 0.0, "start", "walk", None, {"firing": 1, "consumed": {"home": 1}})
+        >>> running_at([start])
+        {'walk': {'home': 1}}
+    """
+    open_firings: dict[int, tuple[str, dict[str, int]]] = {}
+    for event in events:
+        if event.kind == "start":
+            open_firings[event.data["firing"]] = (event.transition, dict(event.data.get("consumed", {})))
+        elif event.kind == "end":
+            open_firings.pop(event.data.get("firing"), None)
+    return {transition: held for transition, held in open_firings.values()}
+
+
 def replay(trace: str | Path, *, net_path: str | Path | None = None, draw: str | Path | None = None,
            at: int | None = None) -> int:
-    """Print the token game of ``trace`` (up to event ``at``); optionally draw the marking.
+    """Print the token game of ``trace`` (up to event ``at``); optionally draw the marking,
+    with the transitions still running at that event and the tokens they hold.
+
+    Every option is checked before anything is printed.
 
     Returns:
         The command's exit code (0).
     """
+    net = None
+    if draw is not None:
+        if net_path is None:
+            raise PetriflowError("--draw needs --net (the net the trace was recorded on)")
+        from petriflow.export import format_of
+        from petriflow.io import load_net
+
+        format_of(draw)  # the picture's format from its ending, before any work
+        net = load_net(net_path)
+    elif net_path is not None:
+        raise PetriflowError("--net is only used with --draw")
     events = read_trace(trace)
     if at is not None:
         if not 0 <= at < len(events):
             raise PetriflowError(f"--at must be an event number from 0 to {len(events) - 1}")
         events = events[: at + 1]
+    if net is not None:
+        unknown = sorted({e.transition for e in events if e.transition and e.transition not in net.transitions})
+        if unknown:
+            raise PetriflowError(f"{trace} was not recorded on {net_path}: it fires {', '.join(unknown[:3])},"
+                                 " which the net does not have")
     last = Marking()
     for event, marking in markings(events):
         shown = ", ".join(f"{p}={c}" for p, c in marking.items()) or "(empty)"
         print(f"{event.seq:6d}  t={event.time:10.3f}  {describe(event):48}  {shown}")
         last = marking
-    if draw is not None:
-        if net_path is None:
-            raise PetriflowError("--draw needs --net (the net the trace was recorded on)")
+    if draw is not None and net is not None:
         from petriflow.export import export_net
-        from petriflow.io import load_net
 
-        net = load_net(net_path)
-        fmt = Path(draw).suffix.lstrip(".").lower() or "svg"
-        export_net(net, draw, fmt, marking=net.check_marking(last))
-        print(f"drew the marking after event {events[-1].seq if events else 0} to {draw}")
+        running = running_at(events)
+        seq = events[-1].seq if events else 0
+        caption = f"the marking after event {seq} (t = {events[-1].time:g} s)" if events else None
+        if running:
+            caption += "; blue: actions running, holding the tokens they took"
+        export_net(net, draw, marking=net.check_marking(last), running=running, caption=caption)
+        print(f"drew the marking after event {seq} to {draw}")
     return 0

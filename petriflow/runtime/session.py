@@ -64,6 +64,7 @@ class RunOutcome:
         events: every event, when the run was asked to keep them (else empty).
         wall: wall-clock seconds the run took.
         written: the files written.
+        seed: the run's random seed (conflicts, action randomness, channel losses).
     """
 
     result: RunResult
@@ -71,6 +72,7 @@ class RunOutcome:
     events: list[Event]
     wall: float
     written: list[str] = field(default_factory=list)
+    seed: int | None = None
 
     @property
     def realtime_factor(self) -> float:
@@ -260,7 +262,7 @@ def _observed_run(scheduler: Scheduler, net: Net, *, journal: Journal | None, tr
     finally:
         if "progress" in observers:
             observers["progress"].close()
-    outcome = RunOutcome(result, net, observers.get("events", []), wall)
+    outcome = RunOutcome(result, net, observers.get("events", []), wall, seed=scheduler.seed)
     for name, path in (("trace", trace), ("xes", xes)):
         if name in observers:
             observers[name].close()

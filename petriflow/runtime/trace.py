@@ -30,7 +30,7 @@ from petriflow.errors import NetFormatError
 from petriflow.outcome import Name, Outcome
 
 __all__ = ["Event", "EventKind", "summarize", "TraceWriter", "XesWriter", "read_trace", "write_xes",
-           "EVENT_KINDS"]
+           "EVENT_KINDS", "XES_EPOCH"]
 
 
 class EventKind(Name):
@@ -224,23 +224,32 @@ _XES_HEAD = [
 ]
 
 
+#: The moment simulated time 0 stands for in XES timestamps (events are stamped with
+#: this epoch plus their simulated seconds).
+XES_EPOCH = "2000-01-01T00:00:00.000+00:00"
+
+
 class XesWriter:
     """Writes the completed firings of a run as an XES event log with one trace, as
     the run goes (an observer: ``scheduler.on_event(writer)``).
 
     One XES event per firing that ended (``lifecycle:transition`` ``complete``), in
-    the order the firings ended, stamped with the time they ended (the time they
-    started is ``petriflow:start``). Ordered by completion, the log is a firing
-    sequence of the net with atomic transitions: a firing's inputs were produced by
-    firings that ended before it started. Its ``concept:name`` is the transition's
-    label (or, for a non-ok outcome, the label of its outcome variant
-    ``label@outcome``); silent transitions and cancelled firings are left out, as
-    process mining expects. Only the firings still running are held in memory; the
-    file is written under a temporary name and renamed by :meth:`close`.
+    the order the firings ended, stamped with the time it ended (``time:timestamp``)
+    and the time it started (``start_timestamp``, the attribute PM4Py reads for
+    interval logs, so activity durations and waiting times come out right). Times are
+    simulated seconds after :data:`XES_EPOCH` (the log says so in ``petriflow:epoch``).
+    ``org:resource`` is the agent that ran the firing (the net's id for transitions
+    outside any agent's subnet). Ordered by completion, the log is a firing sequence
+    of the net with atomic transitions: a firing's inputs were produced by firings
+    that ended before it started. ``concept:name`` is the transition's label (or, for
+    a non-ok outcome, the label of its outcome variant ``label@outcome``); silent
+    transitions and cancelled firings are left out, as process mining expects. Only
+    the firings still running are held in memory; the file is written under a
+    temporary name and renamed by :meth:`close`.
 
     Args:
         path: the ``.xes`` file.
-        case: the trace's ``concept:name``.
+        case: the trace's ``concept:name`` (and the resource of agent-less firings).
         labels: ``{transition: label}`` (default: the id).
         silent: transitions to leave out.
     """
@@ -250,10 +259,13 @@ class XesWriter:
         self.path = Path(path)
         self.labels = labels or {}
         self.silent = set(silent)
+        self.case = case
         self.count = 0
         self._out = _PartialFile(path)
         self._file = self._out.file
         self._file.write("\n".join(_XES_HEAD) + "\n")
+        self._file.write(f'  <date key="petriflow:epoch" value="{XES_EPOCH}"/>\n')
+        self._file.write('  <string key="petriflow:clock" value="simulated seconds after petriflow:epoch"/>\n')
         self._file.write(f'  <trace>\n    <string key="concept:name" value={quoteattr(case)}/>\n')
         self._open: dict[int, Event] = {}  # firing -> its start event, while it runs
 
@@ -278,10 +290,10 @@ class XesWriter:
                  f'      <string key="concept:name" value={quoteattr(name)}/>',
                  '      <string key="lifecycle:transition" value="complete"/>',
                  f'      <date key="time:timestamp" value="{_timestamp(end.time)}"/>',
-                 f'      <float key="petriflow:start" value="{start.time!r}"/>']
-        if start.agent:
-            lines.append(f'      <string key="org:resource" value={quoteattr(start.agent)}/>')
-        lines.append("    </event>\n")
+                 f'      <date key="start_timestamp" value="{_timestamp(start.time)}"/>',
+                 f'      <string key="org:resource" value={quoteattr(start.agent or self.case)}/>',
+                 f'      <string key="petriflow:transition" value={quoteattr(transition)}/>',
+                 "    </event>\n"]
         self._file.write("\n".join(lines))
         self.count += 1
 
@@ -312,9 +324,13 @@ def write_xes(events: Iterable[Event], path: str | Path, *, case: str = "run",
 
 
 def _timestamp(seconds: float) -> str:
-    """Simulated seconds as an ISO timestamp counted from 2000-01-01T00:00:00Z."""
-    from datetime import datetime, timedelta, timezone
+    """Simulated seconds as an ISO timestamp counted from :data:`XES_EPOCH`.
 
-    moment = datetime(2000, 1, 1, tzinfo=timezone.utc) + timedelta(seconds=seconds)
+    Examples:
+        >>> _timestamp(0.0), _timestamp(61.25)
+        ('2000-01-01T00:00:00.000+00:00', '2000-01-01T00:01:01.250+00:00')
+    """
+    from datetime import datetime, timedelta
+
+    moment = datetime.fromisoformat(XES_EPOCH) + timedelta(seconds=seconds)
     return moment.isoformat(timespec="milliseconds")
-

@@ -703,3 +703,62 @@ def test_petriflow_reads_what_pm4py_writes(pm4py, tmp_path):
     expected.set_final_marking({"end": 3})
     assert got.structure() == expected.structure()
     assert got.id == "made_by_pm4py"
+
+
+# Multisets and pages (real files from other tools) --------------------------------------
+
+
+def test_snakes_multiset_markings_are_read_as_counts():
+    """SNAKES' native marking: black tokens count; nothing is read as an empty place."""
+    net = read("""
+        <pnml><net id="N">
+          <place id="p"><type domain="universal"/><initialMarking><multiset>
+            <item><value><token/></value><multiplicity>2</multiplicity></item>
+          </multiset></initialMarking></place>
+          <transition id="t"/>
+          <arc id="a" source="p" target="t"><inscription><text>1</text></inscription></arc>
+        </net></pnml>""")
+    assert net.initial_marking == {"p": 2}
+
+
+def test_coloured_multiset_values_are_counted_with_a_warning_naming_the_place():
+    net, warned = read_warned("""
+        <pnml><net id="N">
+          <place id="q"><initialMarking><multiset>
+            <item><value><object type="int">1</object></value><multiplicity>1</multiplicity></item>
+            <item><value><object type="int">2</object></value><multiplicity>2</multiplicity></item>
+          </multiset></initialMarking></place>
+        </net></pnml>""")
+    assert net.initial_marking == {"q": 3}
+    assert warned == ["net.pnml: place 'q': coloured token values (1, 2 x2) are not representable; read as 3"
+                      " plain tokens"]
+
+
+def test_snakes_own_pnml_of_a_marked_net_reads_back_its_marking():
+    snakes_nets = pytest.importorskip("snakes.nets")
+    import snakes.pnml
+
+    made = snakes_nets.PetriNet("N")
+    made.add_place(snakes_nets.Place("p", [snakes_nets.dot] * 3))
+    assert loads_pnml(snakes.pnml.dumps(made)).initial_marking == {"p": 3}
+
+
+def test_an_arc_between_pages_is_refused_naming_the_arc():
+    """ISO/IEC 15909-2 joins nodes of different pages only through reference nodes."""
+    message = str(error_of(f"""
+        <pnml xmlns="{ISO}"><net id="n" type="{PTNET_TYPE}">
+          <page id="one"><place id="p"/></page>
+          <page id="two"><transition id="t"/><arc id="crossing" source="p" target="t"/></page>
+        </net></pnml>"""))
+    assert "'crossing': arc on page 'two' joins 'p' on page 'one'" in message and "reference nodes" in message
+
+
+def test_a_reference_node_on_the_arcs_page_joins_pages():
+    net, warned = read_warned(f"""
+        <pnml xmlns="{ISO}"><net id="n" type="{PTNET_TYPE}">
+          <page id="one"><place id="p"><initialMarking><text>1</text></initialMarking></place></page>
+          <page id="two"><referencePlace id="rp" ref="p"/><transition id="t"/>
+            <arc id="a" source="rp" target="t"/></page>
+        </net></pnml>""")
+    assert net.preset("t") == {"p": 1}
+    assert warned == ["net.pnml: net 'n': pages 'one', 'two' flattened into one page (every node kept)"]

@@ -225,3 +225,25 @@ def test_a_killed_writers_temporary_file_is_cleaned_up(tmp_path, ticker):
     os.utime(stale, (1, 1))
     run_files(ticker, until=0.1, trace=tmp_path / "t.jsonl")
     assert sorted(p.name for p in tmp_path.iterdir() if p.suffix != ".yaml") == ["t.jsonl"]
+
+
+def test_xes_durations_are_what_the_run_took(tmp_path):
+    """PM4Py reads activity durations (start_timestamp to time:timestamp) and the
+    performance DFG's waiting times as the run had them; every event names its agent."""
+    pm4py = pytest.importorskip("pm4py")
+    import warnings
+
+    outcome = run_files(PASSAGE, xes=tmp_path / "run.xes", keep_events=True)
+    starts = {e.data["firing"]: e for e in outcome.events if e.kind == "start"}
+    took = {starts[e.data["firing"]].transition: round(e.time - starts[e.data["firing"]].time, 6)
+            for e in outcome.events if e.kind == "end"}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        log = pm4py.read_xes(str(tmp_path / "run.xes"))
+        service = pm4py.get_service_time(log, start_timestamp_key="start_timestamp", aggregation_measure="mean")
+        dfg, _, _ = pm4py.discover_performance_dfg(log)
+    assert {t: round(v, 6) for t, v in service.items()} == took
+    ends = {e.transition: e.time for e in outcome.events if e.kind == "end"}
+    begins = {e.transition: e.time for e in outcome.events if e.kind == "start"}
+    assert dfg[("red_enter", "red_leave")]["mean"] == pytest.approx(begins["red_leave"] - ends["red_enter"])
+    assert set(log["org:resource"]) == {"red", "blue"}
