@@ -141,7 +141,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(f"{number:>6}  {transition}")
     ending = " (deadlock: no transition enabled)" if sim.is_dead else ""
     print(f"fired {len(fired)} transitions{ending}")
-    print(f"final marking: {_format_marking(sim.marking)}")
+    print(f"marking at the end: {_format_marking(sim.marking)}")
     return EXIT_OK
 
 

@@ -212,3 +212,37 @@ transitions:
     highlighted = [line for line in out_file.read_text().splitlines()
                    if HIGHLIGHT_COLOUR in line]
     assert any('"scan@dock"' in line for line in highlighted)
+
+
+def test_export_violation_on_a_sound_net_draws_nothing_and_exits_0(capsys, tmp_path, sequence_file):
+    """No violation is not a problem: exit 0, a line saying so, no file."""
+    out_file = tmp_path / "v.svg"
+    assert main(["export", str(sequence_file), "-o", str(out_file), "--violation"]) == 0
+    assert "no violation" in capsys.readouterr().err and not out_file.exists()
+
+
+def test_export_violation_says_what_the_red_path_is(capsys, tmp_path):
+    out_file = tmp_path / "v.dot"
+    assert main(["export", str(NETS / "smart" / "smart-paper.yaml"), "-o", str(out_file), "--violation"]) == 0
+    assert "red: deadlock: 1 reachable marking enables no transition" in out_file.read_text()
+
+
+def test_replay_checks_its_options_before_printing(capsys, tmp_path, sequence_file):
+    """--draw without --net, or --at out of range: one line, exit 2, nothing printed first."""
+    trace = tmp_path / "t.jsonl"
+    assert main(["run", str(sequence_file), "--trace", str(trace)]) == 0
+    capsys.readouterr()
+    assert main(["replay", str(trace), "--draw", str(tmp_path / "m.svg")]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "--draw needs --net" in captured.err
+    assert main(["replay", str(trace), "--at", "99"]) == 2
+    assert capsys.readouterr().out == ""
+    assert main(["replay", str(trace), "--net", str(sequence_file), "--draw", str(tmp_path / "m.gif")]) == 2
+    assert "cannot tell the format" in capsys.readouterr().err
+
+
+def test_run_summary_says_how_it_ended_and_the_seed(capsys, sequence_file):
+    assert main(["run", str(sequence_file), "--max-firings", "1", "--seed", "4"]) == 0
+    out = capsys.readouterr().out
+    assert "firings at t = 0 s after 1 firing (seed 4;" in out and "no simulated time passed" in out
+    assert "marking at the end: p=1" in out and "final marking" not in out
