@@ -405,7 +405,7 @@ def _write(path: Path, data: bytes) -> None:
     try:
         write_atomic(path, data)
     except OSError as exc:
-        raise PetriflowError(f"{path}: cannot write: {exc.strerror or exc}") from None
+        raise PetriflowError(f"{path}: cannot write: {getattr(exc, 'strerror', None) or exc}") from None
 
 
 def _layout_size(dot_source: str) -> tuple[float, float] | None:
@@ -553,7 +553,7 @@ def export_net(
         try:
             save_net(net, path, format)
         except OSError as exc:
-            raise PetriflowError(f"{path}: cannot write: {exc.strerror or exc}") from None
+            raise PetriflowError(f"{path}: cannot write: {getattr(exc, 'strerror', None) or exc}") from None
         return
     options = {"highlight": highlight, "caption": caption, "running": running}
     source = to_dot(net, marking, rankdir="LR" if rankdir == "auto" else rankdir, **options)

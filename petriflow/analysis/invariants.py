@@ -54,6 +54,12 @@ __all__ = [
 DEFAULT_MAX_ROWS = 2000
 
 
+#: The largest starting matrix (rows x columns) :func:`semiflows` takes: beyond it the
+#: dense elimination costs gigabytes and minutes, so invariants are reported as not
+#: computed (a note in ``petriflow check``) rather than exhausting the machine.
+MAX_CELLS = 2_000_000
+
+
 class InvariantLimit(PetriflowError):
     """Farkas' algorithm needed more intermediate rows than the limit allows."""
 
@@ -123,6 +129,9 @@ def semiflows(matrix: np.ndarray, *, max_rows: int = DEFAULT_MAX_ROWS) -> list[n
     """
     matrix = np.asarray(matrix, dtype=np.int64)
     n, m = matrix.shape
+    if n * (n + m) > MAX_CELLS:
+        raise InvariantLimit(f"a {n} x {n + m} Farkas matrix is more than {MAX_CELLS:,} entries:"
+                             " invariants not computed for a net this large")
     rows = np.concatenate([matrix, np.eye(n, dtype=np.int64)], axis=1)
     remaining = list(range(m))
     while remaining:
@@ -170,8 +179,13 @@ def _cached_semiflows(compiled: CompiledNet, kind: str, max_rows: int) -> list[n
     entry = _CACHE.setdefault(compiled, {})
     key = (kind, max_rows)
     if key not in entry:
-        matrix = compiled.incidence.T if kind == "p" else compiled.incidence
+        n_p, n_t = len(compiled.places), len(compiled.transitions)
+        n, m = (n_p, n_t) if kind == "p" else (n_t, n_p)
         try:
+            if n * (n + m) > MAX_CELLS:  # before the dense incidence matrix is even built
+                raise InvariantLimit(f"a {n} x {n + m} Farkas matrix is more than {MAX_CELLS:,} entries:"
+                                     " invariants not computed for a net this large")
+            matrix = compiled.incidence.T if kind == "p" else compiled.incidence
             entry[key] = semiflows(matrix, max_rows=max_rows)
         except InvariantLimit as exc:
             entry[key] = exc

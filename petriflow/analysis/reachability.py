@@ -376,6 +376,9 @@ _UINT = (np.uint8, np.uint16, np.uint32, np.uint64)
 #: first and key states on those columns only; smaller nets key on whole rows, which is
 #: as fast and skips the elimination. (Bitmask rows do so beyond 64 places.)
 _BASIS_FROM_PLACES = 16
+#: Nets whose incidence matrix has more entries than this key on every place: finding a
+#: basis of its columns (cubic elimination) would cost more than the keys save.
+_BASIS_MAX_ENTRIES = 1_000_000
 
 
 def warm_up() -> None:
@@ -410,16 +413,31 @@ def _resets_of(compiled: CompiledNet) -> list[tuple[int, ...]]:
     return list(getattr(compiled, "reset", None) or [()] * len(compiled.transitions))
 
 
+def _changes(compiled: CompiledNet) -> list[list[tuple[int, int]]]:
+    """Per row, ``(place, post - pre)`` of the places whose count it changes: the
+    incidence matrix row by row, sparse (a dense one of a large net costs gigabytes)."""
+    rows = []
+    for pre, post in zip(compiled.pre, compiled.post):
+        delta: dict[int, int] = {}
+        for p, w in pre:
+            delta[p] = delta.get(p, 0) - w
+        for p, w in post:
+            delta[p] = delta.get(p, 0) + w
+        rows.append(sorted((p, d) for p, d in delta.items() if d))
+    return rows
+
+
 def _layout(compiled: CompiledNet, has_resets: bool,
             threshold: int) -> tuple[list[int], list[int], int]:
     """``(column -> place, place -> column, number of key columns)``.
 
     Without reset arcs every reachable marking is ``M0 + x·C``, so its counts on the
     places whose incidence columns form a basis determine the rest: those come first and
-    are the key. Small nets and nets with reset arcs key on every place.
+    are the key. Small nets, very large ones and nets with reset arcs key on every place.
     """
     n_places = len(compiled.places)
-    if has_resets or n_places <= threshold or not compiled.incidence.any():
+    too_big = n_places * len(compiled.transitions) > _BASIS_MAX_ENTRIES  # elimination is cubic
+    if has_resets or n_places <= threshold or too_big or not any(_changes(compiled)):
         identity = list(range(n_places))
         return identity, identity, n_places
     basis = pivot_columns(compiled.incidence)
@@ -630,10 +648,9 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states
         return (at, np.array([col[p] for p, _ in flat], dtype=np.int64),
                 np.array([w for _, w in flat], dtype=np.int64))
 
-    incidence = compiled.incidence
-    changes = [[(int(p), int(row[p])) for p in np.flatnonzero(row)] for row in incidence]
+    changes = _changes(compiled)
     reset_at, reset_place, _ = csr([[(p, 0) for p in places] for places in resets])
-    conservative = bool((incidence.sum(axis=1) == 0).all()) if incidence.size else True
+    conservative = all(sum(d for _, d in row) == 0 for row in changes)
     check = detect_unbounded and not conservative
     fixed = (*csr(compiled.pre), *csr(compiled.post), *csr(changes), reset_at, reset_place,
              n_key)
@@ -642,7 +659,7 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states
     need = int(start.max(initial=0))
     dtype = next((d for d in _UINT if need <= np.iinfo(d).max), np.uint64)
     while True:
-        top = min(int(np.iinfo(dtype).max), 2**63 - 1)
+        top = min(int(np.iinfo(dtype).max), 2**62)  # with weights <= 2**60 no sum can wrap int64
         buffers = _Buffers(kernel, start.astype(dtype), max_states, n_t, 2, 0,
                            (np.int64, np.int64) if check else ())
         unused = np.zeros(1, dtype=np.int64)     # same array types: one compiled loop

@@ -67,6 +67,7 @@ from petriflow.analysis.soundness import (
     workflow_structure,
 )
 from petriflow.engine import CompiledNet
+from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 from petriflow.net import Net
 
@@ -137,6 +138,7 @@ def check_net(net: Net, *, max_states: int = DEFAULT_MAX_STATES) -> dict[str, An
         >>> result["workflow_net"], result["sound"], result["states"], result["violations"]
         (True, True, 3, [])
     """
+    _check_range(net)
     compiled = CompiledNet(net)
     structure = workflow_structure(net)
     start = net.initial_marking
@@ -359,9 +361,10 @@ def format_report(result: dict[str, Any]) -> str:
     invariants = result.get("invariants") or {}
     p_flows, t_flows = invariants.get("p_semiflows"), invariants.get("t_semiflows")
     lines.append(
-        f"  P-semiflows: {'too many' if p_flows is None else len(p_flows)}"
+        f"  P-semiflows: {'not computed' if p_flows is None else len(p_flows)}"
         f"{' (cover every place)' if invariants.get('covered_by_p_semiflows') else ''};"
-        f" T-semiflows: {'too many' if t_flows is None else len(t_flows)}")
+        f" T-semiflows: {'not computed' if t_flows is None else len(t_flows)}"
+        + (f" ({invariants['note']})" if invariants.get("note") and (p_flows is None or t_flows is None) else ""))
     for violation in result["violations"]:
         if violation["kind"] == "not_wf_net" and not result["workflow_net"]:
             continue
@@ -369,6 +372,28 @@ def format_report(result: dict[str, Any]) -> str:
         if violation["transitions"]:
             lines.append(f"      witness: {' '.join(violation['transitions'])}")
     return "\n".join(lines)
+
+
+#: The largest arc weight or initial token count the analysis takes: counts are exact
+#: 64-bit integers inside the compiled exploration, and a weight this size keeps every
+#: sum exact (larger values are refused, never wrapped).
+MAX_EXACT = 2**60
+
+
+def _check_range(net: Net) -> None:
+    """Refuse weights and initial tokens beyond the analysis's exact range (exit 2).
+
+    Raises:
+        PetriflowError: naming the arc or place.
+    """
+    for arc in net.arcs:
+        if arc.weight > MAX_EXACT:
+            raise PetriflowError(f"arc {arc.source!r} -> {arc.target!r}: weight {arc.weight} is beyond what"
+                                 f" the analysis counts exactly (at most 2**60)")
+    for place, count in net.initial_marking.items():
+        if count > MAX_EXACT:
+            raise PetriflowError(f"place {place!r}: {count} initial tokens are beyond what the analysis"
+                                 f" counts exactly (at most 2**60)")
 
 
 def _count(number: int, noun: str) -> str:

@@ -27,7 +27,7 @@ def _format_of(path: Path) -> str:
         with path.open("rb") as handle:
             head = handle.read(512).lstrip()
     except OSError as exc:
-        raise NetFormatError(f"cannot read: {exc.strerror or exc}", path=str(path)) from None
+        raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
     return "pnml" if head.startswith(b"<") else "yaml"
 
 

@@ -53,6 +53,7 @@ from defusedxml import DefusedXmlException
 from defusedxml.ElementTree import DefusedXMLParser
 
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
+from petriflow.io.files import parse_json
 from petriflow.net import OPERATOR_KINDS, OUTCOMES, Net, Operator
 
 __all__ = [
@@ -618,9 +619,9 @@ class _Reader:
                 found.setdefault("lines", {})[name] = _line(child)
             elif name == "run" and kind == "net":
                 try:
-                    run = json.loads(text)
-                except json.JSONDecodeError as exc:
-                    self.fail(f"petriflow run is not valid JSON: {exc.msg}", child, node)
+                    run = parse_json(text)
+                except ValueError as exc:
+                    self.fail(f"petriflow run: {exc}", child, node)
                 if not isinstance(run, (str, dict)):
                     self.fail("petriflow run must be a JSON string (a file) or object (the configuration)",
                               child, node)
@@ -658,9 +659,9 @@ class _Reader:
 
     def json_of(self, element: Element, kind: type, what: str, node: str | None) -> Any:
         try:
-            value = json.loads(element.text or "")
-        except json.JSONDecodeError as exc:
-            self.fail(f"petriflow {what} is not valid JSON: {exc.msg}", element, node)
+            value = parse_json(element.text or "")
+        except ValueError as exc:
+            self.fail(f"petriflow {what}: {exc}", element, node)
         if not isinstance(value, kind):
             self.fail(f"petriflow {what} must be a JSON {'object' if kind is dict else 'string'}",
                       element, node)
@@ -920,5 +921,5 @@ def load_pnml(path: str | Path) -> Net:
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
-        raise NetFormatError(f"cannot read: {exc.strerror or exc}", path=name) from None
+        raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=name) from None
     return _loads(data, name, stacklevel=3)

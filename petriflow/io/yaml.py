@@ -31,7 +31,7 @@ from typing import Any, Mapping
 import yaml
 
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
-from petriflow.net import OUTCOMES, Net, Operator, Transition
+from petriflow.net import OPERATOR_KINDS, OUTCOMES, Net, Operator, Transition
 from petriflow.workflow import add_operator, operator_groups
 
 __all__ = ["FORMAT_VERSION", "load_yaml", "loads_net", "dumps_net", "save_yaml", "net_to_dict"]
@@ -67,49 +67,93 @@ _MAP = "tag:yaml.org,2002:map"
 _MERGE = "tag:yaml.org,2002:merge"
 
 
+#: Deepest nesting of lists and mappings a file may have.
+MAX_DEPTH = 64
+#: Most values a file may hold once its aliases are expanded (an alias bomb's guard).
+MAX_VALUES = 1_000_000
+
+
 class _Builder:
     """Turns composed YAML nodes into plain data with line numbers.
 
     Composing is libyaml's (fast); building is this small walk: strings are taken as
     they are, other scalars through PyYAML's safe constructor; a node reached twice
-    through an alias is built once and shared, so aliases never multiply work.
+    through an alias is built once and shared, so aliases never multiply work. The
+    walk refuses what would exhaust the machine later: nesting deeper than
+    :data:`MAX_DEPTH`, more than :data:`MAX_VALUES` values once aliases are expanded
+    (an "alias bomb"), an alias inside itself, and numbers too long to convert.
     """
 
     def __init__(self) -> None:
         self.scalars = yaml.SafeLoader("")
         self.built: dict[int, Any] = {}
+        self.sizes: dict[int, int] = {}
+        self.open: set[int] = set()
+        self.total = 0
 
-    def build(self, node: yaml.Node) -> Any:
+    def fail(self, message: str, node: yaml.Node) -> NetFormatError:
+        return NetFormatError(message, line=node.start_mark.line + 1)
+
+    def scalar(self, node: yaml.Node) -> Any:
+        try:
+            return self.scalars.construct_object(node)
+        except (ValueError, OverflowError) as exc:  # e.g. an integer of more than 4,300 digits
+            why = "a number of more than 4,300 digits" if "digits" in str(exc) else str(exc)
+            raise self.fail(f"value {node.value[:20]!r}{'...' if len(node.value) > 20 else ''} cannot be"
+                            f" read: {why}", node) from None
+
+    def build(self, node: yaml.Node, depth: int = 0) -> Any:
         kind = node.__class__
         if kind is yaml.ScalarNode:
-            return node.value if node.tag == _STR else self.scalars.construct_object(node)
-        done = self.built.get(id(node))
-        if done is not None:
-            return done
+            self.total += 1
+            return node.value if node.tag == _STR else self.scalar(node)
+        key = id(node)
+        if key in self.open:
+            raise self.fail("an alias refers to a value that contains it (a recursive alias)", node)
+        if key in self.built:  # an alias: shared, but counted as if it were copied
+            self.total += self.sizes[key]
+            if self.total > MAX_VALUES:
+                raise self.fail(f"more than {MAX_VALUES:,} values once aliases are expanded (an alias bomb?)",
+                                node)
+            return self.built[key]
+        if depth > MAX_DEPTH:
+            raise self.fail(f"nested more than {MAX_DEPTH} levels deep", node)
+        before = self.total
+        self.open.add(key)
+        try:
+            result = self.container(node, kind, depth)
+        finally:
+            self.open.discard(key)
+        self.sizes[key] = self.total - before
+        self.built[key] = result
+        return result
+
+    def container(self, node: yaml.Node, kind: type, depth: int) -> Any:
+        self.total += 1
         if node.tag not in (_SEQ, _MAP):  # !!set, !!omap...: PyYAML's safe constructor, or its error
             return self.scalars.construct_object(node, deep=True)
         if kind is yaml.SequenceNode:
-            result = self.built[id(node)] = _LineList()
+            result = _LineList()
             result.line = node.start_mark.line + 1
-            result.extend(self.build(child) for child in node.value)
+            result.extend(self.build(child, depth + 1) for child in node.value)
             return result
         if kind is not yaml.MappingNode:  # pragma: no cover - the composer makes only these
-            raise NetFormatError(f"unexpected YAML node {node.tag}", line=node.start_mark.line + 1)
+            raise self.fail(f"unexpected YAML node {node.tag}", node)
         if any(key.tag == _MERGE for key, _ in node.value):
             self.scalars.flatten_mapping(node)
-        mapping = self.built[id(node)] = _LineDict()
+        mapping = _LineDict()
         mapping.line = node.start_mark.line + 1
         mapping.key_lines = {}
         for key_node, value_node in node.value:
-            key = self.build(key_node)
+            key = self.build(key_node, depth + 1)
             try:
                 hash(key)
             except TypeError:
-                raise NetFormatError("a mapping key must be a plain value", line=key_node.start_mark.line + 1) from None
+                raise self.fail("a mapping key must be a plain value", key_node) from None
             if key in mapping:
-                raise NetFormatError(f"duplicate key {key!r}", line=key_node.start_mark.line + 1)
+                raise self.fail(f"duplicate key {key!r}", key_node)
             mapping.key_lines[key] = key_node.start_mark.line + 1
-            mapping[key] = self.build(value_node)
+            mapping[key] = self.build(value_node, depth + 1)
         return mapping
 
 
@@ -156,12 +200,12 @@ class _Reader:
         version = data.get("petriflow")
         if version is None:
             self.fail("missing 'petriflow: 1' version key", data)
-        if version != FORMAT_VERSION:
+        if type(version) is not int or version != FORMAT_VERSION:
             self.fail(f"unsupported format version {version!r}; this petriflow reads {FORMAT_VERSION}", data)
         if "net" in data:
             self.net.id = str(data["net"])
-        self.net.label = data.get("label")
-        self.net.meta = _plain(data.get("meta") or {})
+        self.net.label = _text(data.get("label"), "the net's label", lambda m: self.fail(m, data))
+        self.net.meta = _meta(data.get("meta"), lambda m: self.fail(m, data))
         if data.get("run") is not None:
             run = data["run"]
             if not isinstance(run, (str, dict)):
@@ -207,7 +251,8 @@ class _Reader:
         sid = str(item["id"])
         if sid in self.net.subnets:
             self.fail("duplicate subnet id", item, sid)
-        self.net.add_subnet(sid, item.get("label"), item.get("agent"))
+        fail = (lambda m: self.fail(m, item, sid))
+        self.net.add_subnet(sid, _text(item.get("label"), "label", fail), _text(item.get("agent"), "agent", fail))
         places = self.as_list(item.get("places"), "places", item)
         for place in places:
             self.read_place(place, sid, _line(places))
@@ -228,8 +273,9 @@ class _Reader:
         channel = item.get("channel")
         if channel is not None and not isinstance(channel, str):
             self.fail("'channel' must be a channel name (a string)", item, pid)
-        self.net.add_place(pid, tokens=tokens, label=item.get("label"), subnet=subnet,
-                           meta=_plain(item.get("meta") or {}), channel=channel)
+        fail = (lambda m: self.fail(m, item, pid))
+        self.net.add_place(pid, tokens=tokens, label=_text(item.get("label"), "label", fail), subnet=subnet,
+                           meta=_meta(item.get("meta"), fail), channel=channel)
         self.net.lines[pid] = item.line
 
     def read_branches(self, value: Any, item: Any, tid: str, key: str) -> dict[str, int]:
@@ -287,14 +333,14 @@ class _Reader:
         attributes: dict[str, Any] = dict(
             timeout=None if timeout is None else float(timeout),
             cancels=tuple(str(c) for c in cancels),
-            label=item.get("label"),
+            label=_text(item.get("label"), "label", lambda m: self.fail(m, item, tid)),
             action=item.get("action"),
             params=_plain(params),
             guard=item.get("guard"),
             subnet=subnet,
             silent=bool(item.get("silent", False)),
             priority=priority,
-            meta=_plain(item.get("meta") or {}),
+            meta=_meta(item.get("meta"), lambda m: self.fail(m, item, tid)),
         )
         for key in ("action", "guard"):
             if attributes[key] is not None and not isinstance(attributes[key], str):
@@ -326,6 +372,10 @@ class _Reader:
             if operator is not None:
                 if not isinstance(operator, dict) or "group" not in operator:
                     self.fail("'operator' must be a mapping with 'group' (and 'split'/'join')", item, tid)
+                for side in ("split", "join"):
+                    if operator.get(side) is not None and operator.get(side) not in OPERATOR_KINDS:
+                        self.fail(f"operator {side} must be one of {', '.join(OPERATOR_KINDS)}, got"
+                                  f" {operator.get(side)!r}", item, tid)
                 attributes["operator"] = Operator(str(operator["group"]), operator.get("split"),
                                                   operator.get("join"))
             self.net.add_transition(tid, **attributes)
@@ -398,12 +448,43 @@ class _Reader:
 
 
 def _plain(value: Any) -> Any:
-    """Strip the line-recording containers so parameters are plain dicts and lists."""
+    """Strip the line-recording containers so parameters are plain dicts and lists
+    (:func:`parse_yaml` has bounded the size and depth already)."""
     if isinstance(value, dict):
         return {k: _plain(v) for k, v in value.items()}
     if isinstance(value, list):
         return [_plain(v) for v in value]
     return value
+
+
+def _text(value: Any, what: str, fail) -> str | None:
+    """A label or name: text (a number is taken as its text); ``None`` when absent."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        fail(f"{what} must be text, got {value!r}")
+    return str(value)
+
+
+def _meta(value: Any, fail) -> dict[str, Any]:
+    """Free-form ``meta`` data: a mapping with text keys (what PNML and JSON can keep)."""
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        fail(f"'meta' must be a mapping, got {type(value).__name__}")
+
+    def check(item: Any) -> None:
+        if isinstance(item, dict):
+            for key, inner in item.items():
+                if not isinstance(key, str):
+                    fail(f"'meta' keys must be text, got {key!r}")
+                check(inner)
+        elif isinstance(item, list):
+            for inner in item:
+                check(inner)
+
+    check(value)
+    return _plain(value)
 
 
 def loads_net(text: str, *, path: str | None = None, name: str | None = None) -> Net:
@@ -439,7 +520,7 @@ def load_yaml(path: str | Path) -> Net:
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise NetFormatError(f"cannot read: {exc.strerror or exc}", path=str(path)) from None
+        raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
     return loads_net(text, path=str(path))
 
 

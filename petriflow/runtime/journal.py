@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from petriflow.errors import PetriflowError
+from petriflow.io.files import parse_json
 from petriflow.runtime.trace import Event
 
 __all__ = ["Journal", "JournalError", "ResumeMismatch"]
@@ -31,6 +32,26 @@ CREATE TABLE IF NOT EXISTS event (
     line TEXT NOT NULL
 );
 """
+
+
+#: What a journal's run inputs hold, and the type of each.
+_INPUTS = {"net_file": str, "net_text": str, "config": dict, "seed": int}
+
+
+def _check_inputs(inputs: Any) -> dict[str, Any]:
+    """A journal's run inputs, checked (a damaged or foreign file fails here, not later)."""
+    if not isinstance(inputs, dict):
+        raise ValueError("the run inputs are not an object")
+    for key, kind in _INPUTS.items():
+        if not isinstance(inputs.get(key), kind) or isinstance(inputs.get(key), bool):
+            raise ValueError(f"the run inputs' {key!r} is missing or not a {kind.__name__}")
+    for key in ("world_file", "world_base", "world_text"):
+        if inputs.get(key) is not None and not isinstance(inputs[key], str):
+            raise ValueError(f"the run inputs' {key!r} is not text")
+    until = inputs.get("until")
+    if until is not None and (isinstance(until, bool) or not isinstance(until, (int, float)) or not until >= 0):
+        raise ValueError("the run inputs' 'until' is not a time")
+    return inputs
 
 
 class JournalError(PetriflowError):
@@ -70,12 +91,15 @@ class Journal:
             raise JournalError(f"{self.path}: not a petriflow journal ({exc})") from None
         self._pending: list[Event] = []
         if resuming:
-            rows = dict(self._db.execute("SELECT key, value FROM run"))
-            if "inputs" not in rows:
+            try:
+                rows = dict(self._db.execute("SELECT key, value FROM run"))
+                self.journaled = self._db.execute("SELECT count(*) FROM event").fetchone()[0]
+                self.inputs = _check_inputs(parse_json(rows["inputs"])) if "inputs" in rows else None
+            except (sqlite3.DatabaseError, ValueError, TypeError) as exc:
+                raise JournalError(f"{self.path}: not a petriflow journal, or a damaged one ({exc})") from None
+            if self.inputs is None:
                 raise JournalError(f"{self.path}: not a petriflow journal (no run inputs)")
-            self.inputs = json.loads(rows["inputs"])
             self.finished = rows.get("finished") == "1"
-            self.journaled = self._db.execute("SELECT count(*) FROM event").fetchone()[0]
         else:
             self.inputs = inputs
             self.finished = False

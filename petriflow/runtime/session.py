@@ -310,7 +310,7 @@ def _make_folders(*outputs: str | Path | None) -> None:
             try:
                 Path(output).parent.mkdir(parents=True, exist_ok=True)
             except OSError as exc:
-                raise NetFormatError(f"cannot create its folder: {exc.strerror or exc}", path=str(output)) from None
+                raise NetFormatError(f"cannot create its folder: {getattr(exc, 'strerror', None) or exc}", path=str(output)) from None
 
 
 def run_files(net_path: str | Path, *, world: str | Path | None = None, config: str | Path | None = None,

@@ -30,7 +30,7 @@ from petriflow.errors import NetFormatError
 from petriflow.outcome import Name, Outcome
 
 __all__ = ["Event", "EventKind", "summarize", "TraceWriter", "XesWriter", "read_trace", "write_xes",
-           "EVENT_KINDS", "XES_EPOCH"]
+           "check_event", "EVENT_KINDS", "XES_EPOCH"]
 
 
 class EventKind(Name):
@@ -192,24 +192,70 @@ class TraceWriter:
         self._out.finish(keep)
 
 
+def _counts(value: Any) -> bool:
+    return isinstance(value, dict) and all(isinstance(k, str) and type(v) is int and v >= 0
+                                           for k, v in value.items())
+
+
+#: What each kind of event must carry for replay, beside the common fields.
+_NEEDS = {
+    "run": {"marking": _counts},
+    "start": {"firing": lambda v: type(v) is int, "consumed": _counts},
+    "end": {"firing": lambda v: type(v) is int, "outcome": lambda v: v in {o.value for o in Outcome},
+            "produced": _counts},
+    "cancel": {"withdrawn": _counts},
+    "message": {"place": lambda v: isinstance(v, str), "fate": lambda v: isinstance(v, str)},
+}
+
+
+def check_event(data: Any) -> Event:
+    """An :class:`Event` from one decoded trace line, checked field by field.
+
+    Raises:
+        ValueError: saying which field is missing or of the wrong type.
+    """
+    if not isinstance(data, dict):
+        raise ValueError("a trace line is a JSON object")
+    for key, wanted in (("seq", int), ("time", (int, float)), ("kind", str)):
+        if not isinstance(data.get(key), wanted) or isinstance(data.get(key), bool):
+            raise ValueError(f"'{key}' is missing or not a {'number' if key == 'time' else wanted.__name__}")
+    if not math.isfinite(data["time"]):
+        raise ValueError("'time' is not a finite number")
+    if data["kind"] not in EVENT_KINDS:
+        raise ValueError(f"unknown kind {data['kind']!r} (one of {', '.join(EVENT_KINDS)})")
+    for key in ("transition", "agent"):
+        if data.get(key) is not None and not isinstance(data[key], str):
+            raise ValueError(f"'{key}' must be text or null")
+    details = data.get("data") or {}
+    if not isinstance(details, dict):
+        raise ValueError("'data' must be an object")
+    for key, good in _NEEDS.get(data["kind"], {}).items():
+        if key not in details or not good(details[key]):
+            raise ValueError(f"a {data['kind']} event's '{key}' is missing or malformed")
+    return Event(data["seq"], data["time"], data["kind"], data.get("transition"), data.get("agent"), details)
+
+
 def read_trace(path: str | Path) -> list[Event]:
     """Read a JSON Lines trace written by :class:`TraceWriter`.
 
     Raises:
-        NetFormatError: a line is not an event (naming the file and line).
+        NetFormatError: the file is unreadable, or a line is not an event (naming the
+            file, the line and what is wrong with it).
     """
+    from petriflow.io.files import parse_json
+
     events = []
     path = Path(path)
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
     except (OSError, UnicodeDecodeError) as exc:
-        raise NetFormatError(f"cannot read trace: {exc}", path=str(path)) from None
+        raise NetFormatError(f"cannot read trace: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
     for number, line in enumerate(lines, start=1):
         if not line.strip():
             continue
         try:
-            events.append(Event.from_dict(json.loads(line)))
-        except (json.JSONDecodeError, KeyError, TypeError) as exc:
+            events.append(check_event(parse_json(line)))
+        except ValueError as exc:
             raise NetFormatError(f"not a trace event: {exc}", path=str(path), line=number) from None
     return events
 
