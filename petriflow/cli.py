@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import warnings
 from pathlib import Path
@@ -230,8 +231,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.net is None:
             raise PetriflowError("give the net to run (or --resume --db RUN_DB)")
         for option, value in (("--until", args.until), ("--max-firings", args.max_firings)):
-            if value is not None and value < 0:
-                raise PetriflowError(f"{option} must be >= 0, got {value}")
+            if value is not None and not (math.isfinite(value) and value >= 0):
+                raise PetriflowError(f"{option} must be a finite number >= 0, got {value}")
         outcome = run_files(args.net, world=args.world, config=args.config, seed=args.seed,
                             until=args.until, trace=args.trace, xes=args.xes, db=args.db,
                             realtime=args.realtime, gui=args.gui, progress=not args.json,
@@ -262,8 +263,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"  error: {result.error}")
         for path in outcome.written:
             print(f"  wrote {path}")
-    problem = result.reason == "failed" or (
-        result.reason == "dead" and outcome.net.final_marking is not None
+    problem = result.reason in ("failed", "stalled") or (
+        outcome.net.final_marking is not None and result.reason != "final"
     )
     return EXIT_PROBLEM if problem else EXIT_OK
 
@@ -419,12 +420,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return args.handler(args)
     except PetriflowError as exc:
-        print(f"petriflow: {exc}", file=sys.stderr)
+        print("petriflow: " + " ".join(str(exc).split()), file=sys.stderr)  # one line, always
         return EXIT_BAD_INPUT
     except BrokenPipeError:
         return EXIT_OK
     except KeyboardInterrupt:
         return 130
+    except MemoryError:
+        print("petriflow: out of memory (for check, lower --max-states)", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except RecursionError:
+        print("petriflow: input nested too deeply to process", file=sys.stderr)
+        return EXIT_BAD_INPUT
 
 
 if __name__ == "__main__":

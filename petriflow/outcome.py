@@ -60,5 +60,8 @@ class StopReason(Name):
     """The firing limit was reached."""
     FAILED = "failed"
     """An action failed (or timed out) and its transition routes no failure."""
+    STALLED = "stalled"
+    """The run stepped tick by tick with actions running and no firing starting or
+    ending for the configuration's ``stall`` seconds (a robot that never arrives)."""
     FIRED = "fired"
     """:meth:`~petriflow.runtime.scheduler.Scheduler.fire_one`: the one firing ended."""

@@ -41,23 +41,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from petriflow.errors import DependencyNotInstalled, NetFormatError, did_you_mean
+from petriflow.errors import DependencyNotInstalled, NetFormatError, PetriflowError, did_you_mean
+from petriflow.worldfile import COLOURS, check_world
 
 __all__ = ["World", "Camera", "load_world", "COLOURS"]
-
-#: Named colours (RGBA) a description may use.
-COLOURS = {
-    "red": (0.9, 0.1, 0.1, 1.0),
-    "blue": (0.1, 0.2, 0.9, 1.0),
-    "yellow": (0.95, 0.85, 0.1, 1.0),
-    "green": (0.1, 0.75, 0.2, 1.0),
-    "black": (0.02, 0.02, 0.02, 1.0),
-    "white": (1.0, 1.0, 1.0, 1.0),
-    "grey": (0.45, 0.45, 0.45, 1.0),
-    "orange": (1.0, 0.55, 0.0, 1.0),
-}
-
-_KEYS = {"dt", "gravity", "plane", "boxes", "grid", "robots", "cameras", "meta"}
 
 
 @contextlib.contextmanager
@@ -157,41 +144,38 @@ class World:
 
     def __init__(self, description: dict[str, Any] | None = None, *, base: str | Path = ".",
                  gui: bool = False, path: str | None = None) -> None:
-        self.p = _pybullet()
         self.path = path
         self.base = Path(base)
-        description = dict(description or {})
-        for key in description:
-            if key not in _KEYS:
-                self._fail(f"unknown key {key!r}{did_you_mean(str(key), _KEYS)}")
-        self.dt = float(description.get("dt", 1.0 / 240.0))
-        if not self.dt > 0:
-            self._fail(f"dt must be > 0, got {self.dt}")
-        meta = description.get("meta")
-        if meta is not None and not isinstance(meta, dict):
-            self._fail(f"meta is a mapping, got {meta!r}")
+        description = check_world(description, path)  # every field, before pybullet is touched
+        self.p = _pybullet()
+        self.dt = description["dt"]
         #: Free-form data from the description's ``meta`` (kept for other components, unread here).
-        self.meta: dict[str, Any] = dict(meta or {})
+        self.meta: dict[str, Any] = dict(description["meta"])
         p = self.p
+        if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+            # pybullet would end the whole process (exit 1, no message) without an X display
+            raise PetriflowError("--gui needs a display, and DISPLAY is not set; run without --gui")
         with _quiet_stdout():
             self.client = p.connect(p.GUI if gui else p.DIRECT)
+        if self.client < 0:
+            raise PetriflowError("cannot open pybullet's GUI; run without --gui")
         p.resetSimulation(physicsClientId=self.client)
         p.setPhysicsEngineParameter(fixedTimeStep=self.dt, deterministicOverlappingPairs=1,
                                     physicsClientId=self.client)
-        p.setGravity(0, 0, float(description.get("gravity", -9.81)), physicsClientId=self.client)
+        p.setGravity(0, 0, description["gravity"], physicsClientId=self.client)
         self.bodies: dict[str, int] = {}
         self.agents: dict[str, str] = {}
         self.cameras: dict[str, Camera] = {}
         self.steps = 0
-        if description.get("plane", True):
+        if description["plane"]:
             self.bodies["plane"] = self._load_urdf("pybullet_data:plane.urdf", (0, 0, 0), 0.0, fixed=True)
-        for box in description.get("boxes") or []:
-            self.add_box(**self._checked(box, {"id", "size", "position", "yaw", "colour", "mass"}, "box"))
-        if description.get("grid"):
+        for box in description["boxes"]:
+            self.add_box(**box)
+        if description["grid"]:
             self._add_grid(description["grid"])
-        for robot in description.get("robots") or []:
+        for robot in description["robots"]:
             self._add_robot(robot)
-        for camera in description.get("cameras") or []:
+        for camera in description["cameras"]:
             self._add_camera(camera)
 
     # Building -----------------------------------------------------------------------

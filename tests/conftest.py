@@ -4,9 +4,21 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import os
+
 import pytest
+from hypothesis import HealthCheck, settings
 
 from petriflow.io.yaml import loads_net
+
+# Hypothesis profiles: "ci" (the default) keeps the fuzzers at a few hundred examples
+# each; HYPOTHESIS_PROFILE=nightly runs thousands (see docs/limits.md). Tests that set
+# their own max_examples keep it.
+settings.register_profile("ci", max_examples=150, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+settings.register_profile("nightly", max_examples=5000, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 REPO = Path(__file__).resolve().parents[1]
 NETS = REPO / "nets"

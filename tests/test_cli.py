@@ -242,7 +242,8 @@ def test_replay_checks_its_options_before_printing(capsys, tmp_path, sequence_fi
 
 
 def test_run_summary_says_how_it_ended_and_the_seed(capsys, sequence_file):
-    assert main(["run", str(sequence_file), "--max-firings", "1", "--seed", "4"]) == 0
+    """Stopped short of the net's final marking by a limit: exit 1, saying how it ended."""
+    assert main(["run", str(sequence_file), "--max-firings", "1", "--seed", "4"]) == 1
     out = capsys.readouterr().out
     assert "firings at t = 0 s after 1 firing (seed 4;" in out and "no simulated time passed" in out
     assert "marking at the end: p=1" in out and "final marking" not in out

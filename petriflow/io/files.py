@@ -64,8 +64,10 @@ def read_yaml_file(path: str | Path) -> Any:
     except NetFormatError as exc:
         raise exc.at(str(path)) from None
     except yaml.YAMLError as exc:
+        from petriflow.io.yaml import _yaml_problem
+
         mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
-        problem = getattr(exc, "problem", None) or getattr(exc, "context", None) or "malformed YAML"
+        problem = getattr(exc, "problem", None) or getattr(exc, "context", None) or _yaml_problem(exc)
         raise NetFormatError(f"malformed YAML: {problem}", path=str(path),
                              line=mark.line + 1 if mark else None) from None
 

@@ -688,6 +688,8 @@ class _Reader:
     def whole(self, text: str, what: str, node: str | None, where: Element | None) -> int:
         if re.fullmatch(r"-\d+", text):
             self.fail(f"{what} {text} is negative", where, node)
+        if re.fullmatch(r"\d{31,}", text):
+            self.fail(f"{what} has more than 30 digits ({text[:12]}...): too large to read", where, node)
         if not re.fullmatch(r"\d{1,30}", text):
             self.fail(f"{what} must be a whole number, got {text!r}", where, node)
         return int(text)

@@ -511,7 +511,15 @@ def loads_net(text: str, *, path: str | None = None, name: str | None = None) ->
         problem = exc.problem or exc.context or "malformed YAML"
         raise NetFormatError(f"malformed YAML: {problem}", path=path, line=line) from None
     except yaml.YAMLError as exc:
-        raise NetFormatError(f"malformed YAML: {exc}", path=path) from None
+        raise NetFormatError(f"malformed YAML: {_yaml_problem(exc)}", path=path) from None
+
+
+def _yaml_problem(exc: Exception) -> str:
+    """A YAML error's problem, on one line (a reader error names the bad character)."""
+    reason = getattr(exc, "reason", None)
+    if reason is not None:  # yaml.reader.ReaderError: a character YAML does not allow
+        return f"{reason} (character {getattr(exc, 'character', '?')!r} at position {getattr(exc, 'position', '?')})"
+    return " ".join(str(exc).split())
 
 
 def load_yaml(path: str | Path) -> Net:

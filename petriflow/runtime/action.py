@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import enum
 import inspect
+import math
 import random
 from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar, Generator
@@ -90,7 +91,13 @@ class Param:
     def check(self, name: str, value: Any, where: str) -> Any:
         types = self.type if isinstance(self.type, tuple) else (self.type,)
         if float in types and isinstance(value, int) and not isinstance(value, bool):
-            value = float(value)
+            try:
+                value = float(value)
+            except OverflowError:
+                raise NetFormatError(f"parameter {name!r} is too large a number, got {value!r}",
+                                     element=where) from None
+        if isinstance(value, float) and not math.isfinite(value):
+            raise NetFormatError(f"parameter {name!r} must be a finite number, got {value!r}", element=where)
         if self.type is not object and not isinstance(value, types):
             wanted = " or ".join(t.__name__ for t in types)
             raise NetFormatError(f"parameter {name!r} must be {wanted}, got {value!r}", element=where)

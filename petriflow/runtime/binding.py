@@ -48,8 +48,9 @@ from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, Port
 from petriflow.runtime.registry import Predicate, Registry, UnknownActionError, default_registry
+from petriflow.runtime.tokens import MAX_TOKENS
 
-__all__ = ["Binding", "BoundTransition", "bind"]
+__all__ = ["Binding", "BoundTransition", "bind", "check_sizes"]
 
 
 @dataclass(frozen=True)
@@ -97,6 +98,28 @@ def _line(net: Net, *keys: str) -> int | None:
         if line is not None:
             return line
     return None
+
+
+def check_sizes(net: Net, path: str | None = None) -> None:
+    """Refuse counts a run cannot hold (it keeps one entry per token; the token game
+    and the analysis only count, and take them).
+
+    Raises:
+        NetFormatError: ``file:line: 'element': ...`` for an initial marking or an arc
+            weight beyond :data:`~petriflow.runtime.tokens.MAX_TOKENS`.
+    """
+    path = path or net.path
+    for place, tokens in net.initial_marking.items():
+        if tokens > MAX_TOKENS:
+            raise NetFormatError(f"starts with {tokens} tokens; a run holds at most {MAX_TOKENS:,} "
+                                 "in one place (each token carries data)",
+                                 path=path, line=_line(net, place), element=place)
+    for arc in net.arcs:
+        if arc.weight > MAX_TOKENS:
+            transition = arc.target if arc.target in net.transitions else arc.source
+            raise NetFormatError(f"arc {arc.source!r} -> {arc.target!r} has weight {arc.weight}; a run moves "
+                                 f"at most {MAX_TOKENS:,} tokens per arc",
+                                 path=path, line=_line(net, transition), element=transition)
 
 
 def bind(net: Net, registry: Registry | None = None, *, path: str | None = None) -> Binding:

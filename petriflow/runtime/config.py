@@ -24,6 +24,8 @@ Examples:
 from __future__ import annotations
 
 import importlib
+import math
+import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,7 +38,33 @@ from petriflow.runtime.channels import ChannelModel, build_channel
 
 __all__ = ["RunConfig", "Fault", "FaultKind", "load_config"]
 
-_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions"}
+_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall"}
+
+#: Default of :attr:`RunConfig.stall`: simulated seconds a run may step tick by tick
+#: with actions running and no firing starting or ending before it is stopped.
+DEFAULT_STALL = 3600.0
+#: Folders (besides a configuration's own) its ``world`` and ``actions`` files may be
+#: in: the ``PETRIFLOW_PATH`` environment variable, folders separated like ``PATH``.
+PATH_VARIABLE = "PETRIFLOW_PATH"
+
+
+def _finite(value: Any, low: float = 0.0, low_open: bool = False) -> bool:
+    return (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+            and (value > low if low_open else value >= low))
+
+
+def allowed_folders(folder: Path | None) -> list[Path]:
+    """The folders a configuration in ``folder`` may name files in."""
+    folders = [folder.resolve()] if folder is not None else []
+    extra = os.environ.get(PATH_VARIABLE, "")
+    folders += [Path(p).resolve() for p in extra.split(os.pathsep) if p]
+    return folders
+
+
+def inside(path: Path, folders: list[Path]) -> bool:
+    """Whether ``path`` (resolved, links followed) is in one of ``folders``."""
+    target = path.resolve()
+    return any(target == f or f in target.parents for f in folders)
 
 
 class FaultKind(Name):
@@ -88,6 +116,12 @@ class RunConfig:
         actions: modules that register the actions the net uses, imported before
             binding (:meth:`import_actions`): absolute ``.py`` paths (modules found
             beside the configuration) or importable module names.
+        stall: simulated seconds a run may step with actions running and no firing
+            starting or ending before it stops (``stalled``); ``None``: never.
+
+    The files a configuration names (``world``, ``.py`` action modules) must be in its
+    own folder (or below it), or in a folder listed in ``PETRIFLOW_PATH``: a
+    configuration cannot make a run read (and journal) any file of the machine.
     """
 
     seed: int = 0
@@ -98,6 +132,7 @@ class RunConfig:
     faults: list[Fault] = field(default_factory=list)
     path: str | None = None
     actions: list[str] = field(default_factory=list)
+    stall: float | None = DEFAULT_STALL
 
     @classmethod
     def from_dict(cls, data: Any, path: str | None = None, *, base: str | None = None) -> "RunConfig":
@@ -125,11 +160,14 @@ class RunConfig:
         if isinstance(seed, bool) or not isinstance(seed, int):
             fail(f"seed must be a whole number, got {seed!r}")
         until = data.get("until")
-        if until is not None and (isinstance(until, bool) or not isinstance(until, (int, float)) or until < 0):
-            fail(f"until must be a number of seconds >= 0, got {until!r}")
+        if until is not None and not _finite(until):
+            fail(f"until must be a finite number of seconds >= 0, got {until!r}")
         dt = data.get("dt", 0.01)
-        if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not dt > 0:
-            fail(f"dt must be a number of seconds > 0, got {dt!r}")
+        if not _finite(dt, 1e-6) or dt > 3600:
+            fail(f"dt must be a number of seconds from 0.000001 to 3600, got {dt!r}")
+        stall = data.get("stall", DEFAULT_STALL)
+        if stall is not None and not _finite(stall, 0.0, low_open=True):
+            fail(f"stall must be a finite number of seconds > 0, or null (never), got {stall!r}")
         channels = data.get("channels") or {}
         if not isinstance(channels, dict) or not all(isinstance(v, dict) for v in channels.values()):
             fail("channels must map a channel name to its model, e.g. {radio: {model: range}}")
@@ -137,16 +175,25 @@ class RunConfig:
         world = data.get("world")
         if world is not None and not isinstance(world, str):
             fail(f"world must be a file name, got {world!r}")
+        allowed = allowed_folders(folder)
         if world is not None and folder is not None:
+            if not inside(folder / world, allowed):
+                fail(f"world {world!r} is outside the configuration's folder (list its folder in"
+                     f" {PATH_VARIABLE} to allow it)", "world")
             world = str(folder / world)
         actions = data.get("actions") or []
         if isinstance(actions, str):
             actions = [actions]
         if not isinstance(actions, list) or not all(isinstance(a, str) and a.strip() for a in actions):
             fail(f"actions must list modules (names or .py files), got {actions!r}")
+        located = [_locate_module(a, folder) for a in actions]
+        for given, where in zip(actions, located):
+            if Path(where).is_absolute() and folder is not None and not inside(Path(where), allowed):
+                fail(f"action module {given!r} is outside the configuration's folder (list its folder in"
+                     f" {PATH_VARIABLE} to allow it)", "actions")
         config = cls(seed, None if until is None else float(until), float(dt), world,
-                     {str(k): dict(v) for k, v in channels.items()}, faults, path,
-                     [_locate_module(a, folder) for a in actions])
+                     {str(k): dict(v) for k, v in channels.items()}, faults, path, located,
+                     None if stall is None else float(stall))
         config.channel_models()  # fail early on a bad model
         return config
 
@@ -176,15 +223,15 @@ class RunConfig:
                  f" for drop_link); got keys {sorted(entry)}")
         kind = kinds[0]
         at = entry.get("at")
-        if isinstance(at, bool) or not isinstance(at, (int, float)) or at < 0:
-            fail(f"fault {kind}: 'at' must be a time in seconds >= 0, got {at!r}")
+        if not _finite(at):
+            fail(f"fault {kind}: 'at' must be a finite time in seconds >= 0, got {at!r}")
         until = entry.get("until")
         if kind == "drop_link":
             link = entry[kind]
             if not (isinstance(link, list) and len(link) == 2 and all(isinstance(a, str) for a in link)):
                 fail(f"drop_link takes two agent names, got {link!r}")
-            if until is not None and (not isinstance(until, (int, float)) or until < at):
-                fail(f"drop_link: 'until' must be a time >= 'at', got {until!r}")
+            if until is not None and (not _finite(until) or until < at):
+                fail(f"drop_link: 'until' must be a finite time >= 'at', got {until!r}")
             return Fault(kind, float(at), None, tuple(link), None if until is None else float(until))
         if until is not None:
             fail(f"fault {kind}: 'until' only applies to drop_link")
@@ -228,7 +275,7 @@ class RunConfig:
                 entry["until"] = f.until
             faults.append(entry)
         return {"seed": self.seed, "until": self.until, "dt": self.dt, "world": self.world,
-                "channels": self.channels, "faults": faults, "actions": list(self.actions)}
+                "channels": self.channels, "faults": faults, "actions": list(self.actions), "stall": self.stall}
 
 
 def _locate_module(entry: str, folder: Path | None) -> str:

@@ -15,9 +15,15 @@ steps. The resumed trace is therefore the uninterrupted trace, event for event.
 from __future__ import annotations
 
 import json
+import os
 import sqlite3
 from pathlib import Path
 from typing import Any
+
+try:  # POSIX: one writer per journal
+    import fcntl
+except ImportError:  # pragma: no cover - Windows
+    fcntl = None
 
 from petriflow.errors import PetriflowError
 from petriflow.io.files import parse_json
@@ -80,14 +86,29 @@ class Journal:
         resuming = inputs is None
         if resuming and not self.path.is_file():
             raise JournalError(f"{self.path}: no such journal")
-        if not resuming and self.path.exists():
-            raise JournalError(f"{self.path}: already exists; use --resume to continue it or pick a new file")
+        try:
+            if resuming:
+                self._lock = os.open(self.path, os.O_RDWR)
+            else:  # created here and now, or refused: two runs never share a new journal
+                self._lock = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o666)
+        except FileExistsError:
+            raise JournalError(f"{self.path}: already exists; use --resume to continue it or pick a new file") \
+                from None
+        except OSError as exc:
+            raise JournalError(f"{self.path}: cannot open: {exc.strerror or exc}") from None
+        if fcntl is not None:
+            try:
+                fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                os.close(self._lock)
+                raise JournalError(f"{self.path}: in use by another run (one writer at a time)") from None
         try:
             self._db = sqlite3.connect(str(self.path), isolation_level=None)
             self._db.execute("PRAGMA journal_mode=WAL")
             self._db.execute("PRAGMA synchronous=NORMAL")
             self._db.executescript(_SCHEMA)
         except sqlite3.DatabaseError as exc:
+            self._release()
             raise JournalError(f"{self.path}: not a petriflow journal ({exc})") from None
         self._pending: list[Event] = []
         if resuming:
@@ -96,8 +117,10 @@ class Journal:
                 self.journaled = self._db.execute("SELECT count(*) FROM event").fetchone()[0]
                 self.inputs = _check_inputs(parse_json(rows["inputs"])) if "inputs" in rows else None
             except (sqlite3.DatabaseError, ValueError, TypeError) as exc:
+                self.close()
                 raise JournalError(f"{self.path}: not a petriflow journal, or a damaged one ({exc})") from None
             if self.inputs is None:
+                self.close()
                 raise JournalError(f"{self.path}: not a petriflow journal (no run inputs)")
             self.finished = rows.get("finished") == "1"
         else:
@@ -121,9 +144,14 @@ class Journal:
         offset = seq - self._chunk_start
         if not 0 <= offset < len(self._chunk):
             self._chunk_start = seq
-            self._chunk = [line for (line,) in self._db.execute(
-                "SELECT line FROM event WHERE seq >= ? ORDER BY seq LIMIT 4096", (seq,))]
+            try:
+                self._chunk = [line for (line,) in self._db.execute(
+                    "SELECT line FROM event WHERE seq >= ? ORDER BY seq LIMIT 4096", (seq,))]
+            except sqlite3.DatabaseError as exc:
+                raise JournalError(f"{self.path}: a damaged journal ({exc})") from None
             offset = 0
+        if offset >= len(self._chunk):
+            raise JournalError(f"{self.path}: a damaged journal (event {seq} is missing)")
         return self._chunk[offset]
 
     def record(self, event: Event) -> None:
@@ -144,12 +172,15 @@ class Journal:
         """Write the buffered events in one transaction (a firing boundary)."""
         if not self._pending:
             return
-        with self._db:
-            self._db.execute("BEGIN")
-            self._db.executemany(
-                "INSERT INTO event (seq, line) VALUES (?, ?)",
-                [(e.seq, e.to_json()) for e in self._pending],
-            )
+        try:
+            with self._db:
+                self._db.execute("BEGIN")
+                self._db.executemany(
+                    "INSERT INTO event (seq, line) VALUES (?, ?)",
+                    [(e.seq, e.to_json()) for e in self._pending],
+                )
+        except sqlite3.DatabaseError as exc:
+            raise JournalError(f"{self.path}: cannot write the journal: {exc}") from None
         self.journaled += len(self._pending)
         self._pending.clear()
 
@@ -162,4 +193,27 @@ class Journal:
         self.finished = True
 
     def close(self) -> None:
-        self._db.close()
+        """Close the database and release the journal's lock."""
+        try:
+            self._db.close()
+        finally:
+            self._release()
+
+    def __enter__(self) -> "Journal":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def discard(self) -> None:
+        """Remove the journal's files (a run that never started; call after :meth:`close`)."""
+        for suffix in ("", "-wal", "-shm"):
+            try:
+                os.unlink(f"{self.path}{suffix}")
+            except FileNotFoundError:
+                pass
+
+    def _release(self) -> None:
+        if getattr(self, "_lock", None) is not None:
+            os.close(self._lock)  # closing the descriptor releases its flock
+            self._lock = None

@@ -58,7 +58,7 @@ from petriflow.marking import Marking
 from petriflow.net import Net
 from petriflow.outcome import Outcome, StopReason
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Status
-from petriflow.runtime.binding import Binding, bind
+from petriflow.runtime.binding import Binding, bind, check_sizes
 from petriflow.runtime.channels import Channels
 from petriflow.runtime.config import RunConfig
 from petriflow.runtime.faults import Faults
@@ -104,7 +104,9 @@ class RunResult:
             net's final marking was reached with nothing running or pending),
             ``dead`` (nothing can fire, run or arrive any more), ``until`` (the time
             limit), ``firings`` (the firing limit), ``failed`` (an action failed with
-            no failure route; see ``error``) or ``fired`` (:meth:`Scheduler.fire_one`).
+            no failure route; see ``error``), ``stalled`` (actions stepped tick by tick
+            for the configuration's ``stall`` seconds with no firing starting or
+            ending; see ``error``) or ``fired`` (:meth:`Scheduler.fire_one`).
         time: simulated seconds at the end.
         firings: transitions fired.
         marking: token counts at the end.
@@ -204,6 +206,7 @@ class Scheduler:
         self.binding = binding if binding is not None else bind(net, registry, path=path)
         self.registry = self.binding.registry
         self.config.check(net)
+        check_sizes(net, path)
         self.kernel = Kernel(float(getattr(world, "dt", None) or self.config.dt))
         compiled = self.compiled = CompiledNet(net)
         self.tokens = TokenStore(compiled, net.initial_marking, net.final_marking)
@@ -239,6 +242,7 @@ class Scheduler:
         self._handlers: list[EventHandler] = []
         self._seq = 0
         self.firings = 0
+        self._progress = 0  # the tick of the last firing start or end (the stall watchdog's)
         self._fired_now = 0
         self._rng = random.Random(f"{self.seed}:conflicts")
         self._seed_prefix = f"{self.seed}:"
@@ -363,6 +367,7 @@ class Scheduler:
         tid = self._ids[t]
         self.firings += 1
         number = self.firings
+        self._progress = self.kernel.tick
         row = self._row[t]
         compiled = self.compiled
         inputs, withdrawn = self.tokens.consume(row)
@@ -478,6 +483,7 @@ class Scheduler:
     def _finish(self, number: int, t: int, ctx: ActionContext, outcome: Outcome) -> None:
         """Produce the outputs of ``outcome`` and record the end of the firing."""
         tid = self._ids[t]
+        self._progress = self.kernel.tick
         row = self._route[t][outcome]
         if row is None and outcome is not Outcome.CANCELLED and outcome is not Outcome.OK:
             reason = ctx.reason or outcome.value
@@ -630,6 +636,7 @@ class Scheduler:
         until = self.config.until if until is None else until
         kernel = self.kernel
         limit = None if until is None else kernel.ticks_at(until)
+        stall = None if self.config.stall is None else kernel.ticks_at(self.config.stall)
         self._max_firings = max_firings
         self.start()
         if self._closed:
@@ -647,6 +654,10 @@ class Scheduler:
                 if limit is not None and tick > limit:
                     self._advance(limit, realtime)
                     return self._end(StopReason.UNTIL)
+                if stall is not None and tick == kernel.tick + 1 and tick - self._progress > stall:
+                    running = ", ".join(self.running())
+                    return self._end(StopReason.STALLED, f"no firing started or ended for"
+                                     f" {self.config.stall:g} s of simulated time while {running} ran")
                 self._advance(tick, realtime)
                 self._instant()
         except _Unrouted as exc:

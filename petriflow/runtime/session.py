@@ -41,7 +41,7 @@ from typing import Any, TextIO
 
 from petriflow.errors import NetFormatError
 from petriflow.net import Net
-from petriflow.runtime.binding import Binding, bind
+from petriflow.runtime.binding import Binding, bind, check_sizes
 from petriflow.runtime.config import RunConfig, load_config
 from petriflow.runtime.journal import Journal, JournalError
 from petriflow.runtime.registry import Registry
@@ -196,20 +196,65 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
     return Prepared(net, text, run_config, binding, world_path)
 
 
-def _world_from(inputs: dict[str, Any], gui: bool):
+def _world_data(inputs: dict[str, Any]) -> dict[str, Any] | None:
+    """The world description in ``inputs``, parsed and checked (no pybullet needed)."""
     if inputs.get("world_text") is None:
         return None
     import yaml
 
-    from petriflow.world import World
+    from petriflow.io.yaml import parse_yaml
+    from petriflow.worldfile import check_world
 
     try:
-        data = yaml.safe_load(inputs["world_text"])
+        data = parse_yaml(inputs["world_text"])
+    except NetFormatError as exc:
+        raise exc.at(inputs["world_file"]) from None
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise NetFormatError(f"malformed YAML: {getattr(exc, 'problem', exc)}", path=inputs["world_file"],
+        from petriflow.io.yaml import _yaml_problem
+
+        mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+        problem = getattr(exc, "problem", None) or _yaml_problem(exc)
+        raise NetFormatError(f"malformed YAML: {problem}", path=inputs["world_file"],
                              line=mark.line + 1 if mark else None) from None
+    return check_world(data, inputs["world_file"])
+
+
+def _world_from(inputs: dict[str, Any], gui: bool):
+    data = _world_data(inputs)
+    if data is None:
+        return None
+    from petriflow.world import World
+
     return World(data, base=inputs["world_base"], gui=gui, path=inputs["world_file"])
+
+
+def _check_outputs(outputs: dict[str, str | Path | None], read: list[Path | str | None]) -> None:
+    """Refuse two outputs on one file, an output that is one of the run's inputs, and an
+    output whose folder cannot be made or written (before anything is created).
+
+    Raises:
+        NetFormatError: naming the option and the file.
+    """
+    import os
+
+    seen: dict[Path, str] = {}
+    inputs = {Path(p).resolve() for p in read if p is not None}
+    for option, path in outputs.items():
+        if path is None:
+            continue
+        where = Path(path).resolve()
+        if where in seen:
+            raise NetFormatError(f"{option} and {seen[where]} name the same file", path=str(path))
+        if where in inputs:
+            raise NetFormatError(f"{option} would overwrite an input of the run", path=str(path))
+        if where.is_dir():
+            raise NetFormatError(f"{option} names a folder, not a file", path=str(path))
+        seen[where] = option
+        folder = where.parent
+        while not folder.exists() and folder != folder.parent:
+            folder = folder.parent
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise NetFormatError(f"{option}: cannot write into {folder}", path=str(path))
 
 
 def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: Path | None,
@@ -334,6 +379,12 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     inputs["max_firings"] = max_firings
     inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())
                          for name, path in (("trace", trace), ("xes", xes))}
+    # everything is checked before the first file is made: the world too (a journal
+    # must never hold a run that cannot start)
+    _check_outputs({"--trace": trace, "--xes": xes, "--db": db},
+                   [net_path, prepared.world, prepared.config.path])
+    check_sizes(prepared.net, str(net_path))
+    _world_data(inputs)
     _make_folders(trace, xes, db)
     journal = Journal(db, inputs) if db is not None else None
     try:
@@ -341,6 +392,12 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
                         trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
                         realtime=realtime, gui=gui, progress=progress, max_firings=max_firings,
                         keep_events=keep_events)
+    except BaseException:
+        if journal is not None and journal.journaled == 0:  # it never started: leave no journal behind
+            journal.close()
+            journal.discard()
+            journal = None
+        raise
     finally:
         if journal is not None:
             journal.close()
@@ -362,9 +419,10 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
         if journal.finished:
             raise JournalError(f"{db}: the run already finished ({journal.journaled} events)")
         inputs = journal.inputs
-        started_with = inputs.get("outputs") or {}
+        started_with = inputs.get("outputs") if isinstance(inputs.get("outputs"), dict) else {}
         trace = trace if trace is not None else started_with.get("trace")
         xes = xes if xes is not None else started_with.get("xes")
+        _check_outputs({"--trace": trace, "--xes": xes, "--db": db}, [])
         _make_folders(trace, xes)
         net = _net_from_text(inputs["net_text"], inputs["net_file"])
         config = RunConfig.from_dict(inputs["config"])

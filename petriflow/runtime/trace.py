@@ -148,8 +148,8 @@ class _PartialFile:
     def finish(self, keep: bool = True) -> None:
         """Close the file and rename it into place (ordinary file mode), or drop it.
 
-        Temporary files of the same name left by killed writers (untouched since this
-        one began) are removed once the file is in place.
+        Temporary files of the same name left by killed writers (untouched for a minute
+        before this one began) are removed once the file is in place.
         """
         self.file.close()
         if not keep:
@@ -158,8 +158,8 @@ class _PartialFile:
         os.chmod(self._partial, 0o666 & ~_umask())
         os.replace(self._partial, self.path)
         for stale in self.path.parent.glob(f".{glob.escape(self.path.name)}.*.partial"):
-            try:
-                if stale.stat().st_mtime < self._started:
+            try:  # untouched for a minute before this writer began: its writer is gone
+                if stale.stat().st_mtime < self._started - 60:
                     stale.unlink()
             except OSError:  # gone already, or not ours to remove
                 pass

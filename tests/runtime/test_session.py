@@ -94,7 +94,8 @@ def test_crash_mid_run_then_resume_gives_the_uninterrupted_trace(tmp_path, monke
     with pytest.raises(Crash):
         run_files(PASSAGE, db=tmp_path / "run.sqlite", seed=2)
     monkeypatch.undo()
-    journaled = Journal(tmp_path / "run.sqlite").journaled
+    with Journal(tmp_path / "run.sqlite") as journal:
+        journaled = journal.journaled
     assert 0 < journaled < len(lines(tmp_path / "whole.jsonl"))
     resume(tmp_path / "run.sqlite", trace=tmp_path / "resumed.jsonl")
     assert lines(tmp_path / "resumed.jsonl") == lines(tmp_path / "whole.jsonl")
@@ -122,7 +123,8 @@ def test_killed_process_resumes_without_lost_or_duplicated_firings(tmp_path, tic
         os.kill(child.pid, signal.SIGKILL)
     finally:
         child.wait()
-    partial = Journal(db).journaled
+    with Journal(db) as journal:
+        partial = journal.journaled
     assert 8 <= partial < len(lines(tmp_path / "whole.jsonl"))
     assert main(["run", "--resume", "--db", str(db), "--trace", str(tmp_path / "resumed.jsonl")]) == 0
     assert lines(tmp_path / "resumed.jsonl") == lines(tmp_path / "whole.jsonl")

@@ -1,0 +1,295 @@
+"""Hostile and malformed input: one line, exit 2, nothing created; no hang, no wrong
+answer. Each test is one family of cases the reliability review found."""
+
+from __future__ import annotations
+
+import os
+import stat
+
+import pytest
+
+from petriflow.cli import main
+from petriflow.runtime.journal import Journal
+from petriflow.runtime.session import resume, run_files
+from tests.conftest import NETS
+
+PASSAGE = NETS / "passage" / "passage.yaml"
+
+TICKER = """petriflow: 1
+places: [{id: p, tokens: 1}, count]
+transitions:
+  - {id: tick, action: core.wait, params: {seconds: 0.5}, in: [p], out: [p, count]}
+"""
+
+
+def one_line_error(capsys, argv, *fragments) -> str:
+    """Run the CLI: exit 2, one line on stderr containing every fragment, no traceback."""
+    code = main([str(a) for a in argv])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert err.startswith("petriflow: ") and err.count("\n") == 1, err
+    for fragment in fragments:
+        assert fragment in err, err
+    return err
+
+
+@pytest.fixture
+def ticker(tmp_path):
+    path = tmp_path / "ticker.yaml"
+    path.write_text(TICKER)
+    return path
+
+
+# Outputs ------------------------------------------------------------------------------
+def test_two_outputs_on_one_file_are_refused(tmp_path, ticker, capsys):
+    same = tmp_path / "x"
+    one_line_error(capsys, ["run", ticker, "--trace", same, "--db", same], "--db and --trace name the same file")
+    assert not same.exists()
+
+
+def test_an_output_over_an_input_is_refused(tmp_path, ticker, capsys):
+    one_line_error(capsys, ["run", ticker, "--trace", ticker], "would overwrite an input")
+    assert ticker.read_text() == TICKER
+
+
+def test_two_writers_of_one_trace_each_finish_a_whole_file(tmp_path):
+    """Unique temporary names: the second writer's rename wins, the first's is intact too."""
+    from petriflow.runtime.trace import TraceWriter, read_trace
+
+    first, second = TraceWriter(tmp_path / "t.jsonl"), TraceWriter(tmp_path / "t.jsonl")
+    run_files(_ticker(tmp_path), until=0.5, trace=tmp_path / "other.jsonl")
+    events = read_trace(tmp_path / "other.jsonl")
+    for event in events:
+        first(event)
+        second(event)
+    first.close()
+    second.close()
+    assert len(read_trace(tmp_path / "t.jsonl")) == len(events)
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.endswith(".partial")) == []
+
+
+def _ticker(folder):
+    path = folder / "ticker.yaml"
+    path.write_text(TICKER)
+    return path
+
+
+def test_a_journal_has_one_writer_at_a_time(tmp_path, ticker, capsys):
+    """A second resume of a journal in use is refused with one line."""
+    db = tmp_path / "run.sqlite"
+    run_files(ticker, until=0.5, db=db)
+    with Journal(db):  # a run holding it
+        one_line_error(capsys, ["run", "--resume", "--db", db], "in use by another run")
+
+
+def test_a_run_that_cannot_start_leaves_no_journal(tmp_path, capsys):
+    """Bad world, unknown fault agent, NaN limits: refused before the journal exists."""
+    net = tmp_path / "net.yaml"
+    net.write_text(TICKER.replace("petriflow: 1\n", "petriflow: 1\nrun: {world: world.yaml}\n"))
+    (tmp_path / "world.yaml").write_text("dt: fast\n")
+    db = tmp_path / "run.sqlite"
+    one_line_error(capsys, ["run", net, "--db", db], "world.yaml:1: dt must be a number of seconds")
+    assert not db.exists()
+    one_line_error(capsys, ["run", _ticker(tmp_path), "--until", "nan", "--db", db], "--until must be a finite")
+    assert not db.exists()
+
+
+def test_files_are_written_with_ordinary_modes(tmp_path, ticker):
+    previous = os.umask(0o022)
+    try:
+        run_files(ticker, until=0.5, trace=tmp_path / "t.jsonl", xes=tmp_path / "t.xes")
+        assert main(["export", str(ticker), "-o", str(tmp_path / "n.pnml")]) == 0
+    finally:
+        os.umask(previous)
+    for name in ("t.jsonl", "t.xes", "n.pnml"):
+        assert stat.S_IMODE((tmp_path / name).stat().st_mode) == 0o644, name
+
+
+# Numbers -------------------------------------------------------------------------------
+def test_huge_weights_are_refused_by_the_analysis_never_wrapped(tmp_path, capsys):
+    net = tmp_path / "w.yaml"
+    net.write_text("petriflow: 1\nplaces: [{id: p, tokens: 1}, q]\n"
+                   f"transitions: [{{id: t, in: [p], out: {{q: {2**62}, p: 1}}}}]\n")
+    one_line_error(capsys, ["check", net, "--json"], "weight 4611686018427387904 is beyond what the analysis counts")
+
+
+@pytest.mark.parametrize("places, out, fragment", [
+    (f"[{{id: p, tokens: {10**21}}}, q]", "[q]", ":2: 'p': starts with 1000000000000000000000 tokens"),
+    ("[{id: p, tokens: 1}, q]", f"{{q: {10**11}}}", ":3: 't': arc 't' -> 'q' has weight 100000000000"),
+])
+def test_counts_a_run_cannot_hold_are_refused_before_it_starts(tmp_path, capsys, places, out, fragment):
+    net = tmp_path / "n.yaml"
+    net.write_text(f"petriflow: 1\nplaces: {places}\ntransitions: [{{id: t, in: [p], out: {out}}}]\n")
+    one_line_error(capsys, ["run", net, "--db", tmp_path / "j"], fragment)
+    assert not (tmp_path / "j").exists()
+    assert main(["simulate", str(net), "--steps", "1"]) == 0  # the token game only counts
+
+
+@pytest.mark.parametrize("tokens, fragment", [(2**63, f"place 'p': {2**63} initial tokens are beyond"),
+                                              (10**30, "initial marking has more than 30 digits")])
+def test_huge_pnml_markings_are_refused(tmp_path, capsys, tokens, fragment):
+    net = tmp_path / "big.pnml"
+    net.write_text('<pnml><net id="n" type="http://www.pnml.org/version-2009/grammar/ptnet"><page id="g">'
+                   f'<place id="p"><initialMarking><text>{tokens}</text></initialMarking></place>'
+                   '<transition id="t"/><arc id="a" source="p" target="t"/></page></net></pnml>')
+    one_line_error(capsys, ["check", net], fragment)
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("petriflow: 1\nplaces: [{id: a, tokens: " + "9" * 5000 + "}]\n", "a number of more than 4,300 digits"),
+    ("petriflow: true\nplaces: [a]\n", "unsupported format version True"),
+    ("petriflow: 1\nplaces: [{id: a, label: [1, 2]}]\n", "label must be text"),
+    ("petriflow: 1\nplaces: [{id: a, meta: {1: x}}]\n", "'meta' keys must be text"),
+    ("petriflow: 1\nplaces: [a, b]\ntransitions: [{id: t, in: [a], out: [b], operator: {group: g, split: weird}}]\n",
+     "operator split must be one of and, xor"),
+    ("petriflow: 1\nplaces: [{id: a, tokens: 1}, b]\n"
+     "transitions: [{id: t, action: core.wait, params: {seconds: .nan}, in: [a], out: [b]}]\n",
+     "must be a finite number"),
+    ("petriflow: 1\nmeta: " + "[" * 500 + "]" * 500 + "\nplaces: [a]\n", "nested more than 64 levels deep"),
+])
+def test_malformed_net_values_are_one_line(tmp_path, capsys, text, fragment):
+    net = tmp_path / "net.yaml"
+    net.write_text(text)
+    one_line_error(capsys, ["info", net], str(net), fragment)
+
+
+def test_an_alias_bomb_is_refused_at_once(tmp_path, capsys):
+    lines = ["petriflow: 1", "meta:", "  a: &a [x, x, x, x, x, x, x, x, x, x]"]
+    for k, name in enumerate("bcdefgh"):
+        previous = "abcdefgh"[k]
+        lines.append(f"  {name}: &{name} [" + ", ".join([f"*{previous}"] * 10) + "]")
+    lines.append("places: [a]")
+    net = tmp_path / "bomb.yaml"
+    net.write_text("\n".join(lines) + "\n")
+    one_line_error(capsys, ["check", net], "an alias bomb?")
+
+
+def test_invalid_utf8_is_one_line(tmp_path, capsys):
+    net = tmp_path / "net.yaml"
+    net.write_bytes(b"petriflow: 1\nplaces: [\xff\xfe]\n")
+    one_line_error(capsys, ["info", net], "cannot read")
+
+
+def test_a_large_chain_gets_a_note_not_gigabytes(tmp_path, capsys):
+    """Invariants of a net whose Farkas matrix is too large are skipped with a note."""
+    n = 1500
+    net = tmp_path / "chain.yaml"
+    net.write_text("petriflow: 1\nplaces: [{id: p0, tokens: 1}, " + ", ".join(f"p{i}" for i in range(1, n + 1))
+                   + "]\ntransitions:\n" + "".join(f"  - {{id: t{i}, in: [p{i}], out: [p{i + 1}]}}\n"
+                                                   for i in range(n)))
+    assert main(["check", str(net)]) in (0, 1)
+    assert "invariants not computed for a net this large" in capsys.readouterr().out
+
+
+# Worlds and configurations ---------------------------------------------------------------
+@pytest.mark.parametrize("world, fragment", [
+    ("robots: [{id: r, urdf: x.urdf, position: [.nan, .inf]}]", "position must be a finite number"),
+    ("dt: 1.0e-9", "dt must be a number of seconds from 0.0001 to 1"),
+    ("boxes: [{id: b, size: [1], position: [0, 0, 0]}]", "size must be 3 numbers > 0"),
+    ("robots: [{id: r, urdf: x.urdf, position: [a, b]}]", "position must be a number, got 'a'"),
+    ("dt: fast", "dt must be a number of seconds"),
+    ("boxes: 7", "'boxes' must be a list"),
+    ("cameras: [{id: top, width: -5}]", "width must be a whole number of pixels"),
+    ("dt: [", "malformed YAML"),
+    ("gravity: " + "9" * 5000, "a number of more than 4,300 digits"),
+])
+def test_malformed_worlds_are_one_line_before_anything_runs(tmp_path, capsys, world, fragment):
+    (tmp_path / "world.yaml").write_text(world + "\n")
+    net = tmp_path / "net.yaml"
+    net.write_text(TICKER.replace("petriflow: 1\n", "petriflow: 1\nrun: {world: world.yaml, until: 1}\n"))
+    one_line_error(capsys, ["run", net, "--db", tmp_path / "run.sqlite"], "world.yaml", fragment)
+    assert not (tmp_path / "run.sqlite").exists()
+
+
+@pytest.mark.parametrize("config, fragment", [
+    ("until: .nan", "until must be a finite number"),
+    ("faults: [{kill: r, at: .inf}]", "'at' must be a finite time"),
+    ("dt: .nan", "dt must be a number of seconds"),
+    ("world: ../../../../../../../../etc/passwd", "outside the configuration's folder"),
+    ("stall: -1", "stall must be a finite number"),
+])
+def test_malformed_run_configurations_are_one_line(tmp_path, capsys, ticker, config, fragment):
+    (tmp_path / "run.yaml").write_text(config + "\n")
+    one_line_error(capsys, ["run", ticker, "--config", tmp_path / "run.yaml", "--db", tmp_path / "j.sqlite"],
+                   fragment)
+    assert not (tmp_path / "j.sqlite").exists()
+
+
+def test_a_world_outside_the_folder_is_allowed_from_petriflow_path(tmp_path, monkeypatch, ticker):
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    (shared / "world.yaml").write_text("plane: false\n")
+    config = tmp_path / "conf"
+    config.mkdir()
+    (config / "run.yaml").write_text("world: ../shared/world.yaml\nuntil: 1\n")
+    monkeypatch.setenv("PETRIFLOW_PATH", str(shared))
+    assert run_files(ticker, config=config / "run.yaml").result.time == 1.0
+
+
+# Journals and traces -------------------------------------------------------------------------
+def test_damaged_journals_are_one_line(tmp_path, capsys):
+    garbage = tmp_path / "garbage.sqlite"
+    garbage.write_bytes(b"SQLite format 3\x00" + os.urandom(4000))
+    one_line_error(capsys, ["run", "--resume", "--db", garbage], "journal")
+    import sqlite3
+
+    for name, inputs in (("nonjson", "{not json"), ("missing", '{"net_text": "x"}'), ("deep", "[" * 200 + "]" * 200)):
+        db = tmp_path / f"{name}.sqlite"
+        with sqlite3.connect(db) as connection:
+            connection.executescript("CREATE TABLE run (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
+                                     "CREATE TABLE event (seq INTEGER PRIMARY KEY, line TEXT NOT NULL);")
+            connection.execute("INSERT INTO run VALUES ('inputs', ?)", (inputs,))
+        one_line_error(capsys, ["run", "--resume", "--db", db], "not a petriflow journal, or a damaged one")
+
+
+@pytest.mark.parametrize("line, fragment", [
+    ('{"seq": 0, "time": 0, "kind": "start", "data": {}}', "a start event's 'firing' is missing"),
+    ('{"seq": 0, "time": "soon", "kind": "run"}', "'time' is missing or not a number"),
+    ('{"seq": 0, "time": 0, "kind": "launch"}', "unknown kind 'launch'"),
+    ('[1, 2]', "a trace line is a JSON object"),
+    ("[" * 300 + "]" * 300, "nested more than 64 levels deep"),
+    ('{"seq": 0, "time": 0, "kind": "end", "data": {"firing": 1, "outcome": "ok", "produced": {"p": -1}}}',
+     "'produced' is missing or malformed"),
+])
+def test_malformed_traces_are_one_line_in_replay(tmp_path, capsys, line, fragment):
+    trace = tmp_path / "t.jsonl"
+    trace.write_text(line + "\n")
+    one_line_error(capsys, ["replay", trace], "t.jsonl:1: not a trace event", fragment)
+
+
+# Runs that would not end -------------------------------------------------------------------
+def test_a_run_stepping_without_progress_stops_as_stalled():
+    """An action polled every tick that never ends: stopped after the configured stall."""
+    from petriflow.io.yaml import loads_net
+    from petriflow.runtime.config import RunConfig
+    from petriflow.runtime.registry import Registry
+    from petriflow.runtime.scheduler import Scheduler
+    from petriflow.runtime.action import Status
+    from petriflow.testing import ScriptedAction, StubWorld
+
+    registry = Registry(load_plugins=False)
+    registry.register("test.forever", ScriptedAction.script([Status.RUNNING], needs_world=True))
+    net = loads_net("petriflow: 1\nplaces: [{id: a, tokens: 1}, b]\n"
+                    "transitions: [{id: walk, action: test.forever, in: [a], out: [b]}]\n")
+    result = Scheduler(net, world=StubWorld(dt=0.01), registry=registry,
+                       config=RunConfig.from_dict({"stall": 5})).run()
+    assert result.reason == "stalled" and result.time == pytest.approx(5.0)
+    assert "no firing started or ended for 5 s of simulated time while walk ran" in result.error
+
+
+def test_gui_without_a_display_is_one_line(capsys, monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    one_line_error(capsys, ["run", PASSAGE, "--gui", "--until", "0.1"], "--gui needs a display")
+
+
+def test_resume_does_not_depend_on_the_working_folder(tmp_path, monkeypatch):
+    """A journal started in one folder resumes from another (its paths are absolute)."""
+    db = tmp_path / "run.sqlite"
+    monkeypatch.chdir(NETS.parent)
+    run_files("nets/passage/passage.yaml", db=db, max_firings=2)
+    import sqlite3
+
+    with sqlite3.connect(db) as connection:  # pretend it was killed: not finished
+        connection.execute("DELETE FROM run WHERE key = 'finished'")
+    monkeypatch.chdir(tmp_path)
+    assert resume(db).result.firings == 2
