@@ -12,9 +12,9 @@ import json
 import math
 import sys
 import warnings
-from pathlib import Path
 from typing import Any, Sequence
 
+from petriflow import limits
 from petriflow.engine import Simulation, fire
 from petriflow.errors import NotEnabledError, PetriflowError
 from petriflow.io import load_net
@@ -254,8 +254,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.json:
         _print_json(summary)
     else:
-        pace = (f"{outcome.realtime_factor:.1f}x real time" if result.time > 0
-                else "no simulated time passed")
+        factor = outcome.realtime_factor
+        pace = ("no simulated time passed" if result.time <= 0 else
+                f"{factor:.1f}x real time" if factor < 1e6 else f"{factor:.3g}x real time")
         print(f"{outcome.net.id}: {result.reason} at t = {result.time:g} s after {result.firings}"
               f" firing{'' if result.firings == 1 else 's'} (seed {outcome.seed}; {outcome.wall:.2f} s wall, {pace})")
         print(f"  marking at the end: {_format_marking(result.marking)}")
@@ -418,6 +419,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     warnings.showwarning = _one_line_warning
     try:
+        limits.from_environment()
         return args.handler(args)
     except PetriflowError as exc:
         print("petriflow: " + " ".join(str(exc).split()), file=sys.stderr)  # one line, always
@@ -427,7 +429,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return 130
     except MemoryError:
-        print("petriflow: out of memory (for check, lower --max-states)", file=sys.stderr)
+        hint = "lower --max-states" if args.command == "check" else "see docs/limits.md"
+        print(f"petriflow: {args.command}: out of memory ({hint})", file=sys.stderr)
         return EXIT_BAD_INPUT
     except RecursionError:
         print("petriflow: input nested too deeply to process", file=sys.stderr)

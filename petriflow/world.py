@@ -42,7 +42,7 @@ from pathlib import Path
 from typing import Any
 
 from petriflow.errors import DependencyNotInstalled, NetFormatError, PetriflowError, did_you_mean
-from petriflow.worldfile import COLOURS, check_world
+from petriflow.worldfile import COLOURS, check_box, check_world
 
 __all__ = ["World", "Camera", "load_world", "COLOURS"]
 
@@ -182,27 +182,13 @@ class World:
     def _fail(self, message: str, element: str | None = None):
         raise NetFormatError(message, path=self.path, element=element)
 
-    def _checked(self, entry: Any, keys: set[str], what: str) -> dict[str, Any]:
-        if not isinstance(entry, dict):
-            self._fail(f"a {what} is a mapping, got {entry!r}")
-        for key in entry:
-            if key not in keys:
-                self._fail(f"unknown key {key!r} in {what}{did_you_mean(str(key), keys)}", entry.get("id"))
-        return dict(entry)
-
-    def _colour(self, colour: Any) -> tuple[float, ...]:
-        if isinstance(colour, str):
-            if colour not in COLOURS:
-                self._fail(f"unknown colour {colour!r}{did_you_mean(colour, COLOURS)}")
-            return COLOURS[colour]
-        if isinstance(colour, (list, tuple)) and len(colour) in (3, 4):
-            return tuple(float(c) for c in colour) + ((1.0,) if len(colour) == 3 else ())
-        self._fail(f"a colour is a name or [r, g, b(, a)], got {colour!r}")
-
     def _resolve(self, reference: str) -> str:
         package, sep, relative = reference.partition(":")
         if sep and not Path(reference).exists() and "/" not in package and "\\" not in package:
-            spec = importlib.util.find_spec(package)
+            try:
+                spec = importlib.util.find_spec(package)
+            except (ImportError, ValueError):  # a parent package that does not exist, a bad name
+                spec = None
             if spec is None or not spec.submodule_search_locations:
                 self._fail(f"unknown package {package!r} in {reference!r}")
             candidate = Path(list(spec.submodule_search_locations)[0]) / relative
@@ -224,27 +210,25 @@ class World:
 
     def add_box(self, id: str, size, position, yaw: float = 0.0, colour: Any = "grey",
                 mass: float = 0.0) -> int:
-        """Add a box of full extents ``size`` centred at ``position``."""
-        p = self.p
+        """Add a box of full extents ``size`` centred at ``position`` (checked as a
+        world file's box is; ``colour`` is a name or ``[r, g, b(, a)]``)."""
+        box = check_box({"id": id, "size": size, "position": position, "yaw": yaw, "colour": colour,
+                         "mass": mass}, self.path)
         if id in self.bodies:
             self._fail("duplicate body id", id)
-        half = [float(s) / 2 for s in size]
+        p = self.p
+        half = [s / 2 for s in box["size"]]
         shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=self.client)
-        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=self._colour(colour),
+        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=box["colour"],
                                      physicsClientId=self.client)
-        body = p.createMultiBody(float(mass), shape, visual, [float(c) for c in position],
-                                 p.getQuaternionFromEuler((0, 0, float(yaw))), physicsClientId=self.client)
+        body = p.createMultiBody(box["mass"], shape, visual, box["position"],
+                                 p.getQuaternionFromEuler((0, 0, box["yaw"])), physicsClientId=self.client)
         self.bodies[id] = body
         return body
 
-    def _add_grid(self, grid: Any) -> None:
-        grid = self._checked(grid, {"cell", "height", "origin", "rows", "colour"}, "grid")
-        cell = float(grid.get("cell", 0.25))
-        height = float(grid.get("height", 0.4))
-        ox, oy = (float(v) for v in grid.get("origin", (0.0, 0.0)))
-        rows = grid.get("rows") or []
-        if not all(isinstance(r, str) for r in rows):
-            self._fail("grid rows are strings of '#' (occupied) and '.' (free)")
+    def _add_grid(self, grid: dict[str, Any]) -> None:
+        cell, height, rows = grid["cell"], grid["height"], grid["rows"]
+        ox, oy = grid["origin"]
         for r, row in enumerate(rows):
             y = oy + (len(rows) - r - 0.5) * cell
             c = 0
@@ -257,32 +241,20 @@ class World:
                     c += 1
                 x = ox + (start + c) / 2 * cell
                 self.add_box(f"grid_{r}_{start}", ((c - start) * cell, cell, height), (x, y, height / 2),
-                             colour=grid.get("colour", "grey"))
+                             colour=grid["colour"])
 
-    def _add_robot(self, robot: Any) -> None:
-        robot = self._checked(robot, {"id", "urdf", "position", "yaw", "roll", "pitch", "colour", "agent", "z"},
-                              "robot")
-        if "id" not in robot or "urdf" not in robot:
-            self._fail("a robot needs 'id' and 'urdf'")
-        x, y = (float(v) for v in robot.get("position", (0, 0)))
-        body = self._load_urdf(robot["urdf"], (x, y, float(robot.get("z", 0.0))), float(robot.get("yaw", 0.0)),
-                               roll=float(robot.get("roll", 0.0)), pitch=float(robot.get("pitch", 0.0)))
-        if robot["id"] in self.bodies:
-            self._fail("duplicate body id", robot["id"])
+    def _add_robot(self, robot: dict[str, Any]) -> None:
+        x, y = robot["position"]
+        body = self._load_urdf(robot["urdf"], (x, y, robot["z"]), robot["yaw"], roll=robot["roll"],
+                               pitch=robot["pitch"])
         self.bodies[robot["id"]] = body
-        self.agents[robot.get("agent", robot["id"])] = robot["id"]
+        self.agents[robot["agent"]] = robot["id"]
         if "colour" in robot:
-            self.p.changeVisualShape(body, -1, rgbaColor=self._colour(robot["colour"]),
-                                     physicsClientId=self.client)
+            self.p.changeVisualShape(body, -1, rgbaColor=robot["colour"], physicsClientId=self.client)
 
-    def _add_camera(self, camera: Any) -> None:
-        camera = self._checked(camera, {"id", "position", "target", "up", "fov", "width", "height"}, "camera")
-        cid = camera.get("id", "camera")
-        self.cameras[cid] = Camera(
-            self, cid, tuple(camera.get("position", (0, 0, 5))), tuple(camera.get("target", (0, 0, 0))),
-            tuple(camera.get("up", (0, 1, 0))), float(camera.get("fov", 60)),
-            int(camera.get("width", 640)), int(camera.get("height", 480)),
-        )
+    def _add_camera(self, camera: dict[str, Any]) -> None:
+        self.cameras[camera["id"]] = Camera(self, camera["id"], camera["position"], camera["target"], camera["up"],
+                                            camera["fov"], camera["width"], camera["height"])
 
     # Running ------------------------------------------------------------------------
     def step(self) -> None:

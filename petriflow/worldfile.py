@@ -26,9 +26,10 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping
 
+from petriflow import limits
 from petriflow.errors import NetFormatError, did_you_mean
 
-__all__ = ["check_world", "COLOURS", "MIN_DT", "MAX_DT"]
+__all__ = ["check_world", "check_box", "COLOURS", "MIN_DT", "MAX_DT"]
 
 #: Named colours (RGBA) a description may use.
 COLOURS = {
@@ -46,8 +47,6 @@ COLOURS = {
 MIN_DT, MAX_DT = 1e-4, 1.0
 _FAR = 1e4          # metres: coordinates beyond this are a typo, not a scene
 _BIG = 1e3          # metres: the largest box extent
-_MAX_PIXELS = 4096
-_MAX_BODIES = 100_000
 
 _KEYS = {"dt", "gravity", "plane", "boxes", "grid", "robots", "cameras", "meta"}
 _BOX_KEYS = {"id", "size", "position", "yaw", "colour", "mass"}
@@ -99,8 +98,8 @@ class _Checker:
         if body in self.ids:
             self.fail("duplicate body id", item, body)
         self.ids.add(body)
-        if len(self.ids) > _MAX_BODIES:
-            self.fail(f"more than {_MAX_BODIES:,} bodies", item, body)
+        if len(self.ids) > limits.WORLD_BODIES:
+            self.fail(f"more than {limits.WORLD_BODIES:,} bodies", item, body)
         return body
 
     def colour(self, value: Any, item: Any, element: str | None) -> tuple[float, ...]:
@@ -125,6 +124,30 @@ def _list(check: _Checker, value: Any, what: str, parent: Any) -> list:
     if not isinstance(value, list):
         check.fail(f"'{what}' must be a list, got {value!r}", parent)
     return value
+
+
+def _box(check: _Checker, box: Mapping[str, Any], body: str) -> dict[str, Any]:
+    return {
+        "id": body,
+        "size": check.vector(box["size"], 3, "size", box, body, 0.0, _BIG, low_open=True,
+                             hint=" > 0 (x, y, z extents in m)"),
+        "position": check.vector(box["position"], 3, "position", box, body, hint=" (x, y, z in m)"),
+        "yaw": check.number(box.get("yaw", 0.0), "yaw", box, body),
+        "colour": check.colour(box.get("colour", "grey"), box, body),
+        "mass": check.number(box.get("mass", 0.0), "mass", box, body, 0.0, 1e6),
+    }
+
+
+def check_box(box: Mapping[str, Any], path: str | None = None) -> dict[str, Any]:
+    """One box (the fields of a world's ``boxes`` entry), checked as :func:`check_world`
+    checks it; its colour becomes RGBA.
+
+    Examples:
+        >>> check_box({"id": "crate", "size": [0.3, 0.3, 0.2], "position": [1, 0, 0.1], "colour": "black"})["colour"]
+        (0.02, 0.02, 0.02, 1.0)
+    """
+    check = _Checker(path)
+    return _box(check, box, check.text(box.get("id"), "id", box, None))
 
 
 def check_world(data: Any, path: str | None = None) -> dict[str, Any]:
@@ -163,16 +186,7 @@ def check_world(data: Any, path: str | None = None) -> dict[str, Any]:
         box = check.mapping(box, _BOX_KEYS, "box")
         if "id" not in box or "size" not in box or "position" not in box:
             check.fail("a box needs 'id', 'size' and 'position'", box, _id(box))
-        body = check.body_id(box["id"], box)
-        out["boxes"].append({
-            "id": body,
-            "size": check.vector(box["size"], 3, "size", box, body, 0.0, _BIG, low_open=True,
-                                 hint=" > 0 (x, y, z extents in m)"),
-            "position": check.vector(box["position"], 3, "position", box, body, hint=" (x, y, z in m)"),
-            "yaw": check.number(box.get("yaw", 0.0), "yaw", box, body),
-            "colour": check.colour(box.get("colour", "grey"), box, body),
-            "mass": check.number(box.get("mass", 0.0), "mass", box, body, 0.0, 1e6),
-        })
+        out["boxes"].append(_box(check, box, check.body_id(box["id"], box)))
     if world.get("grid") is not None:
         grid = check.mapping(world["grid"], _GRID_KEYS, "grid", "grid")
         rows = _list(check, grid.get("rows"), "rows", grid)
@@ -188,8 +202,8 @@ def check_world(data: Any, path: str | None = None) -> dict[str, Any]:
             "colour": check.colour(grid.get("colour", "grey"), grid, "grid"),
         }
         runs = sum(row.count(".#") + row.startswith("#") for row in rows)  # one box per run of '#'
-        if runs + len(check.ids) > _MAX_BODIES:
-            check.fail(f"more than {_MAX_BODIES:,} bodies", grid, "grid")
+        if runs + len(check.ids) > limits.WORLD_BODIES:
+            check.fail(f"more than {limits.WORLD_BODIES:,} bodies", grid, "grid")
     for robot in _list(check, world.get("robots"), "robots", world):
         robot = check.mapping(robot, _ROBOT_KEYS, "robot")
         if "id" not in robot or "urdf" not in robot:
@@ -223,8 +237,8 @@ def check_world(data: Any, path: str | None = None) -> dict[str, Any]:
         }
         for key, default in (("width", 640), ("height", 480)):
             value = camera.get(key, default)
-            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= _MAX_PIXELS:
-                check.fail(f"{key} must be a whole number of pixels from 1 to {_MAX_PIXELS}, got {value!r}",
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= limits.CAMERA_PIXELS:
+                check.fail(f"{key} must be a whole number of pixels from 1 to {limits.CAMERA_PIXELS}, got {value!r}",
                            camera, name)
             entry[key] = value
         look = [t - p for t, p in zip(entry["target"], entry["position"])]

@@ -293,3 +293,37 @@ def test_resume_does_not_depend_on_the_working_folder(tmp_path, monkeypatch):
         connection.execute("DELETE FROM run WHERE key = 'finished'")
     monkeypatch.chdir(tmp_path)
     assert resume(db).result.firings == 2
+
+
+# Limits --------------------------------------------------------------------------------
+@pytest.fixture
+def own_limits(monkeypatch):
+    """Changes to petriflow.limits made in the test are undone after it."""
+    from petriflow import limits
+
+    for name in limits.LIMITS:
+        monkeypatch.setattr(limits, name, getattr(limits, name))
+    return limits
+
+
+def test_limits_are_raised_and_lowered_from_the_environment(tmp_path, capsys, monkeypatch, own_limits):
+    net = tmp_path / "n.yaml"
+    net.write_text("petriflow: 1\nplaces: [{id: p, tokens: 20000000}, q]\ntransitions: [{id: t, in: [p], out: [q]}]\n")
+    one_line_error(capsys, ["run", net, "--max-firings", "1"], "a run holds at most 10,000,000 in one place")
+    monkeypatch.setenv("PETRIFLOW_LIMITS", "RUN_TOKENS=3e7")
+    assert main(["run", str(net), "--max-firings", "1"]) == 0
+    monkeypatch.setenv("PETRIFLOW_LIMITS", "RUN_TOKENS=3e7, YAML_DEPTH=2")
+    one_line_error(capsys, ["info", net], "nested more than 2 levels deep")
+    monkeypatch.setenv("PETRIFLOW_LIMITS", "RUN_TOKEN=1")
+    one_line_error(capsys, ["info", net], "PETRIFLOW_LIMITS: unknown limit 'RUN_TOKEN' (did you mean 'RUN_TOKENS'?)")
+
+
+def test_limits_are_raised_from_python(own_limits):
+    from petriflow.errors import NetFormatError
+    from petriflow.io.yaml import loads_net
+
+    deep = "petriflow: 1\nmeta: {x: " + "[" * 80 + "]" * 80 + "}\nplaces: [a]\n"
+    with pytest.raises(NetFormatError, match="nested more than 64 levels deep"):
+        loads_net(deep)
+    own_limits.YAML_DEPTH = 100
+    assert list(loads_net(deep).places) == ["a"]

@@ -37,6 +37,7 @@ from math import gcd
 
 import numpy as np
 
+from petriflow import limits
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.net import Net
@@ -53,11 +54,6 @@ __all__ = [
 #: Default cap on the rows of Farkas' intermediate matrix.
 DEFAULT_MAX_ROWS = 2000
 
-
-#: The largest starting matrix (rows x columns) :func:`semiflows` takes: beyond it the
-#: dense elimination costs gigabytes and minutes, so invariants are reported as not
-#: computed (a note in ``petriflow check``) rather than exhausting the machine.
-MAX_CELLS = 2_000_000
 
 
 class InvariantLimit(PetriflowError):
@@ -129,8 +125,8 @@ def semiflows(matrix: np.ndarray, *, max_rows: int = DEFAULT_MAX_ROWS) -> list[n
     """
     matrix = np.asarray(matrix, dtype=np.int64)
     n, m = matrix.shape
-    if n * (n + m) > MAX_CELLS:
-        raise InvariantLimit(f"a {n} x {n + m} Farkas matrix is more than {MAX_CELLS:,} entries:"
+    if n * (n + m) > limits.INVARIANT_CELLS:
+        raise InvariantLimit(f"a {n} x {n + m} Farkas matrix is more than {limits.INVARIANT_CELLS:,} entries:"
                              " invariants not computed for a net this large")
     rows = np.concatenate([matrix, np.eye(n, dtype=np.int64)], axis=1)
     remaining = list(range(m))
@@ -182,8 +178,8 @@ def _cached_semiflows(compiled: CompiledNet, kind: str, max_rows: int) -> list[n
         n_p, n_t = len(compiled.places), len(compiled.transitions)
         n, m = (n_p, n_t) if kind == "p" else (n_t, n_p)
         try:
-            if n * (n + m) > MAX_CELLS:  # before the dense incidence matrix is even built
-                raise InvariantLimit(f"a {n} x {n + m} Farkas matrix is more than {MAX_CELLS:,} entries:"
+            if n * (n + m) > limits.INVARIANT_CELLS:  # before the dense incidence matrix is even built
+                raise InvariantLimit(f"a {n} x {n + m} Farkas matrix is more than {limits.INVARIANT_CELLS:,} entries:"
                                      " invariants not computed for a net this large")
             matrix = compiled.incidence.T if kind == "p" else compiled.incidence
             entry[key] = semiflows(matrix, max_rows=max_rows)

@@ -64,6 +64,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from petriflow import limits
 from petriflow.analysis._linear import pivot_columns
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
@@ -378,7 +379,6 @@ _UINT = (np.uint8, np.uint16, np.uint32, np.uint64)
 _BASIS_FROM_PLACES = 16
 #: Nets whose incidence matrix has more entries than this key on every place: finding a
 #: basis of its columns (cubic elimination) would cost more than the keys save.
-_BASIS_MAX_ENTRIES = 1_000_000
 
 
 def warm_up() -> None:
@@ -436,7 +436,7 @@ def _layout(compiled: CompiledNet, has_resets: bool,
     are the key. Small nets, very large ones and nets with reset arcs key on every place.
     """
     n_places = len(compiled.places)
-    too_big = n_places * len(compiled.transitions) > _BASIS_MAX_ENTRIES  # elimination is cubic
+    too_big = n_places * len(compiled.transitions) > limits.BASIS_ENTRIES  # elimination is cubic
     if has_resets or n_places <= threshold or too_big or not any(_changes(compiled)):
         identity = list(range(n_places))
         return identity, identity, n_places

@@ -7,10 +7,9 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-__all__ = ["write_atomic", "read_yaml_file", "parse_json", "MAX_JSON_DEPTH"]
+from petriflow import limits
 
-#: Deepest nesting of lists and objects :func:`parse_json` accepts.
-MAX_JSON_DEPTH = 64
+__all__ = ["write_atomic", "read_yaml_file", "parse_json"]
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> None:
@@ -41,10 +40,15 @@ def _umask() -> int:
     return mask
 
 
-def read_yaml_file(path: str | Path) -> Any:
+def read_yaml_file(path: str | Path, *, lines: bool = False) -> Any:
     """Parse a YAML data file (world, run configuration) with the net reader's safe,
     bounded parser (:func:`petriflow.io.yaml.parse_yaml`): no tags run, no alias bombs,
     no nesting deeper than it allows, every error with its line.
+
+    Args:
+        path: the file.
+        lines: keep the parser's mappings and lists, which know their lines (for
+            checks that name them); else plain dicts and lists.
 
     Raises:
         NetFormatError: the file is unreadable or malformed, naming it and the line.
@@ -60,7 +64,8 @@ def read_yaml_file(path: str | Path) -> Any:
     except (OSError, UnicodeDecodeError) as exc:
         raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
     try:
-        return _plain(parse_yaml(text))
+        data = parse_yaml(text)
+        return data if lines else _plain(data)
     except NetFormatError as exc:
         raise exc.at(str(path)) from None
     except yaml.YAMLError as exc:
@@ -77,7 +82,7 @@ def parse_json(text: str) -> Any:
     journals), refusing what would exhaust the machine or crash later.
 
     Raises:
-        ValueError: malformed JSON, nesting deeper than :data:`MAX_JSON_DEPTH`, a number
+        ValueError: malformed JSON, nesting deeper than :data:`~petriflow.limits.JSON_DEPTH`, a number
             too long to convert, or ``NaN``/``Infinity`` (not JSON); the message says
             which (callers add the file and line).
 
@@ -97,7 +102,7 @@ def parse_json(text: str) -> Any:
     try:
         value = json.loads(text, parse_constant=no_constant)
     except RecursionError:
-        raise ValueError(f"nested more than {MAX_JSON_DEPTH} levels deep") from None
+        raise ValueError(f"nested more than {limits.JSON_DEPTH} levels deep") from None
     except json.JSONDecodeError as exc:
         raise ValueError(f"not valid JSON: {exc.msg} (column {exc.colno})") from None
     except ValueError as exc:  # an integer of more than 4,300 digits
@@ -106,7 +111,7 @@ def parse_json(text: str) -> Any:
     while stack:
         item, depth = stack.pop()
         if isinstance(item, (dict, list)):
-            if depth >= MAX_JSON_DEPTH:
-                raise ValueError(f"nested more than {MAX_JSON_DEPTH} levels deep")
+            if depth >= limits.JSON_DEPTH:
+                raise ValueError(f"nested more than {limits.JSON_DEPTH} levels deep")
             stack.extend((inner, depth + 1) for inner in (item.values() if isinstance(item, dict) else item))
     return value

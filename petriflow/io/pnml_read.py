@@ -41,7 +41,6 @@ and the elements.
 
 from __future__ import annotations
 
-import json
 import math
 import re
 import warnings
@@ -52,6 +51,7 @@ from xml.etree.ElementTree import Element, ParseError, TreeBuilder
 from defusedxml import DefusedXmlException
 from defusedxml.ElementTree import DefusedXMLParser
 
+from petriflow import limits
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
 from petriflow.io.files import parse_json
 from petriflow.net import OPERATOR_KINDS, OUTCOMES, Net, Operator
@@ -122,7 +122,6 @@ _GSPN_TAGS = {"rate", "timed", "infiniteServer", "priority"}
 _ARC_TAGS = {"inscription", "toolspecific", "arctype", "type", "name", "tagged"} | _LAYOUT_TAGS
 _NET_TAGS = {"name", "page", "toolspecific", "finalmarkings", "variables", "token"} | _LAYOUT_TAGS
 _PAGE_TAGS = {"name", "page", "toolspecific"} | _LAYOUT_TAGS
-_MAX_PAGE_DEPTH = 100
 _WOPED_LAYOUT = {
     "bounds", "scale", "treeWidth", "treeWidthRight", "treeHeightOverview",
     "overviewPanelVisible", "treePanelVisible", "verticalLayout", "timeUnit",
@@ -378,8 +377,8 @@ class _Reader:
         A page holding a ``<net>`` is a WoPeD subprocess: its net is set aside (see
         :meth:`read_subprocess_pages`), but any node beside that net is still read.
         """
-        if depth > _MAX_PAGE_DEPTH:
-            self.fail(f"pages nested more than {_MAX_PAGE_DEPTH} deep", container, container.get("id"))
+        if depth > limits.PNML_PAGE_DEPTH:
+            self.fail(f"pages nested more than {limits.PNML_PAGE_DEPTH} deep", container, container.get("id"))
         allowed = _NET_TAGS if container is net_element else _PAGE_TAGS
         if _child(container, "net") is not None and container is not net_element:
             allowed = allowed | {"net"}

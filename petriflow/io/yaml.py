@@ -30,6 +30,7 @@ from typing import Any, Mapping
 
 import yaml
 
+from petriflow import limits
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
 from petriflow.net import OPERATOR_KINDS, OUTCOMES, Net, Operator, Transition
 from petriflow.workflow import add_operator, operator_groups
@@ -67,12 +68,6 @@ _MAP = "tag:yaml.org,2002:map"
 _MERGE = "tag:yaml.org,2002:merge"
 
 
-#: Deepest nesting of lists and mappings a file may have.
-MAX_DEPTH = 64
-#: Most values a file may hold once its aliases are expanded (an alias bomb's guard).
-MAX_VALUES = 1_000_000
-
-
 class _Builder:
     """Turns composed YAML nodes into plain data with line numbers.
 
@@ -80,7 +75,8 @@ class _Builder:
     they are, other scalars through PyYAML's safe constructor; a node reached twice
     through an alias is built once and shared, so aliases never multiply work. The
     walk refuses what would exhaust the machine later: nesting deeper than
-    :data:`MAX_DEPTH`, more than :data:`MAX_VALUES` values once aliases are expanded
+    :data:`~petriflow.limits.YAML_DEPTH`, more than :data:`~petriflow.limits.YAML_VALUES`
+    values once aliases are expanded
     (an "alias bomb"), an alias inside itself, and numbers too long to convert.
     """
 
@@ -112,12 +108,12 @@ class _Builder:
             raise self.fail("an alias refers to a value that contains it (a recursive alias)", node)
         if key in self.built:  # an alias: shared, but counted as if it were copied
             self.total += self.sizes[key]
-            if self.total > MAX_VALUES:
-                raise self.fail(f"more than {MAX_VALUES:,} values once aliases are expanded (an alias bomb?)",
+            if self.total > limits.YAML_VALUES:
+                raise self.fail(f"more than {limits.YAML_VALUES:,} values once aliases are expanded (an alias bomb?)",
                                 node)
             return self.built[key]
-        if depth > MAX_DEPTH:
-            raise self.fail(f"nested more than {MAX_DEPTH} levels deep", node)
+        if depth > limits.YAML_DEPTH:
+            raise self.fail(f"nested more than {limits.YAML_DEPTH} levels deep", node)
         before = self.total
         self.open.add(key)
         try:

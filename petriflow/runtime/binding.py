@@ -44,11 +44,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from petriflow import limits
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, Port
 from petriflow.runtime.registry import Predicate, Registry, UnknownActionError, default_registry
-from petriflow.runtime.tokens import MAX_TOKENS
 
 __all__ = ["Binding", "BoundTransition", "bind", "check_sizes"]
 
@@ -106,19 +106,19 @@ def check_sizes(net: Net, path: str | None = None) -> None:
 
     Raises:
         NetFormatError: ``file:line: 'element': ...`` for an initial marking or an arc
-            weight beyond :data:`~petriflow.runtime.tokens.MAX_TOKENS`.
+            weight beyond :data:`~petriflow.limits.RUN_TOKENS`.
     """
     path = path or net.path
     for place, tokens in net.initial_marking.items():
-        if tokens > MAX_TOKENS:
-            raise NetFormatError(f"starts with {tokens} tokens; a run holds at most {MAX_TOKENS:,} "
+        if tokens > limits.RUN_TOKENS:
+            raise NetFormatError(f"starts with {tokens} tokens; a run holds at most {limits.RUN_TOKENS:,} "
                                  "in one place (each token carries data)",
                                  path=path, line=_line(net, place), element=place)
     for arc in net.arcs:
-        if arc.weight > MAX_TOKENS:
+        if arc.weight > limits.RUN_TOKENS:
             transition = arc.target if arc.target in net.transitions else arc.source
             raise NetFormatError(f"arc {arc.source!r} -> {arc.target!r} has weight {arc.weight}; a run moves "
-                                 f"at most {MAX_TOKENS:,} tokens per arc",
+                                 f"at most {limits.RUN_TOKENS:,} tokens per arc",
                                  path=path, line=_line(net, transition), element=transition)
 
 

@@ -31,10 +31,10 @@ from __future__ import annotations
 
 import math
 import random
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields, is_dataclass
 from typing import Any, Callable
 
-from petriflow.errors import NetFormatError, did_you_mean
+from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
 from petriflow.net import Net
 from petriflow.outcome import Name
 from petriflow.runtime.kernel import APPLY, Scheduled
@@ -96,7 +96,7 @@ class ChannelModel:
 class IdealChannel(ChannelModel):
     """Lossless channel with a fixed latency (seconds)."""
 
-    latency: float = 0.0
+    latency: float = field(default=0.0, metadata={"range": (0.0, 3600.0)})
 
     def deliver(self, message: Message, rng: Any) -> float | None:
         return self.latency
@@ -111,12 +111,12 @@ class RangeChannel(ChannelModel):
     with probability ``loss``. Without a known distance the link counts as in range.
     """
 
-    tx_power_dbm: float = -30.0
-    exponent: float = 2.0
-    threshold_dbm: float = -63.4375
-    loss: float = 0.0
-    latency: float = 0.005
-    bitrate: float = 1e6
+    tx_power_dbm: float = field(default=-30.0, metadata={"range": (-300.0, 300.0)})
+    exponent: float = field(default=2.0, metadata={"range": (0.1, 10.0)})
+    threshold_dbm: float = field(default=-63.4375, metadata={"range": (-300.0, 300.0)})
+    loss: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
+    latency: float = field(default=0.005, metadata={"range": (0.0, 3600.0)})
+    bitrate: float = field(default=1e6, metadata={"range": (1e-3, 1e15)})
 
     def rssi(self, distance: float) -> float:
         """Received signal strength at ``distance`` metres (dBm)."""
@@ -147,10 +147,10 @@ class BusChannel(ChannelModel):
         loss: extra loss probability per frame (a lossy radio such as ZigBee).
     """
 
-    baud: float = 115200.0
-    overhead_bits: int = 20
+    baud: float = field(default=115200.0, metadata={"range": (1e-3, 1e15)})
+    overhead_bits: int = field(default=20, metadata={"range": (0, 1_000_000)})
     arbitration: bool = True
-    loss: float = 0.0
+    loss: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
 
     def __post_init__(self) -> None:
         self._busy_until = -math.inf
@@ -185,17 +185,45 @@ def build_channel(name: str, spec: dict[str, Any], where: str = "channels") -> C
     """
     spec = dict(spec)
     model = spec.pop("model", "ideal")
-    if model not in CHANNEL_MODELS:
+    if not isinstance(model, str) or model not in CHANNEL_MODELS:
         raise NetFormatError(
             f"unknown channel model {model!r}{did_you_mean(str(model), CHANNEL_MODELS)}"
             f" (one of {', '.join(CHANNEL_MODELS)})",
             element=f"{where}.{name}",
         )
+    cls = CHANNEL_MODELS[model]
+    if is_dataclass(cls):
+        _check_parameters(cls, model, spec, f"{where}.{name}")
     try:
-        return CHANNEL_MODELS[model](**spec)
-    except TypeError as exc:
+        return cls(**spec)
+    except (TypeError, ValueError) as exc:
         raise NetFormatError(f"bad parameters for channel model {model!r}: {exc}",
                              element=f"{where}.{name}") from None
+
+
+def _check_parameters(cls: type, model: str, spec: dict[str, Any], element: str) -> None:
+    """Parameters of a dataclass model: known names, the declared type (a bool is not a
+    number), finite numbers within a field's ``metadata["range"]``."""
+    declared = {f.name: f for f in fields(cls) if f.init}
+    for key, value in spec.items():
+        if key not in declared:
+            raise NetFormatError(f"channel model {model!r} has no parameter {key!r}{did_you_mean(str(key), declared)}"
+                                 f" (it takes {', '.join(declared) or 'none'})", element=element)
+        kind = declared[key].type if isinstance(declared[key].type, str) else declared[key].type.__name__
+        if kind == "bool":
+            if not isinstance(value, bool):
+                raise NetFormatError(f"{key} must be true or false, got {value!r}", element=element)
+            continue
+        if kind not in ("float", "int"):
+            continue
+        whole = kind == "int"
+        if isinstance(value, bool) or not isinstance(value, int if whole else (int, float)) \
+                or not math.isfinite(value):
+            raise NetFormatError(f"{key} must be a {'whole' if whole else 'finite'} number, got {value!r}",
+                                 element=element)
+        low, high = declared[key].metadata.get("range", (-math.inf, math.inf))
+        if not low <= value <= high:
+            raise NetFormatError(f"{key} must be from {low:g} to {high:g}, got {value!r}", element=element)
 
 
 def receivers(net: Net) -> dict[str, str | None]:
@@ -294,6 +322,10 @@ class Channels:
             delay, why = None, "receiver not running"
         else:
             delay, why = model.deliver(message, self.rng), "channel model"
+            if delay is not None and (isinstance(delay, bool) or not isinstance(delay, (int, float))
+                                      or not 0 <= delay < math.inf):
+                raise PetriflowError(f"channel {channel!r}: model {type(model).__name__} gave a delay of {delay!r}"
+                                     " (a finite number of seconds >= 0, or None for lost)")
         info: dict[str, Any] = {"place": place, "channel": channel, "receiver": receiver, "size": message.size}
         if distance is not None:
             info["distance"] = round(distance, 6)

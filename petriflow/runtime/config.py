@@ -133,19 +133,26 @@ class RunConfig:
     path: str | None = None
     actions: list[str] = field(default_factory=list)
     stall: float | None = DEFAULT_STALL
+    lines: dict[str, int | None] = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
-    def from_dict(cls, data: Any, path: str | None = None, *, base: str | None = None) -> "RunConfig":
-        """Build from parsed YAML; errors name ``path`` and the bad key.
+    def from_dict(cls, data: Any, path: str | None = None, *, base: str | None = None,
+                  line: int | None = None) -> "RunConfig":
+        """Build from parsed YAML; errors name ``path``, the line and the bad key.
 
         Args:
-            data: the parsed configuration.
+            data: the parsed configuration (from :func:`~petriflow.io.yaml.parse_yaml`,
+                its mappings know their lines).
             path: its file (named in errors).
             base: the folder relative paths resolve against (default: ``path``'s).
+            line: the line named when ``data`` does not know one (a net's inline ``run:``).
         """
 
-        def fail(message: str, element: str | None = None):
-            raise NetFormatError(message, path=path, element=element)
+        def fail(message: str, element: str | None = None, item: Any = None, key: str | None = None):
+            at = getattr(item, "line", None)
+            if at is None and key is not None:
+                at = getattr(data, "key_lines", {}).get(key)
+            raise NetFormatError(message, path=path, element=element, line=at or line)
 
         folder = Path(base) if base is not None else (Path(path).parent if path is not None else None)
 
@@ -155,46 +162,59 @@ class RunConfig:
             fail("a run configuration is a mapping")
         for key in data:
             if key not in _KEYS:
-                fail(f"unknown key {key!r}{did_you_mean(str(key), _KEYS)}")
+                fail(f"unknown key {key!r}{did_you_mean(str(key), _KEYS)}", key=key)
         seed = data.get("seed", 0)
         if isinstance(seed, bool) or not isinstance(seed, int):
-            fail(f"seed must be a whole number, got {seed!r}")
+            fail(f"seed must be a whole number, got {seed!r}", key="seed")
         until = data.get("until")
         if until is not None and not _finite(until):
-            fail(f"until must be a finite number of seconds >= 0, got {until!r}")
+            fail(f"until must be a finite number of seconds >= 0, got {until!r}", key="until")
         dt = data.get("dt", 0.01)
         if not _finite(dt, 1e-6) or dt > 3600:
-            fail(f"dt must be a number of seconds from 0.000001 to 3600, got {dt!r}")
+            fail(f"dt must be a number of seconds from 0.000001 to 3600, got {dt!r}", key="dt")
         stall = data.get("stall", DEFAULT_STALL)
         if stall is not None and not _finite(stall, 0.0, low_open=True):
-            fail(f"stall must be a finite number of seconds > 0, or null (never), got {stall!r}")
+            fail(f"stall must be a finite number of seconds > 0, or null (never), got {stall!r}", key="stall")
         channels = data.get("channels") or {}
         if not isinstance(channels, dict) or not all(isinstance(v, dict) for v in channels.values()):
-            fail("channels must map a channel name to its model, e.g. {radio: {model: range}}")
-        faults = [cls._fault(entry, fail) for entry in data.get("faults") or []]
+            fail("channels must map a channel name to its model, e.g. {radio: {model: range}}", key="channels")
+        entries = data.get("faults") or []
+        if not isinstance(entries, list):
+            fail(f"faults must be a list, got {entries!r}", key="faults")
+        faults = [cls._fault(entry, lambda message, entry=entry: fail(message, item=entry, key="faults"))
+                  for entry in entries]
+        lines = {f"faults/{i}": getattr(entry, "line", None) for i, entry in enumerate(entries)}
+        lines.update({f"channels/{name}": getattr(channels, "key_lines", {}).get(name) for name in channels})
+        lines = {key: at or getattr(data, "key_lines", {}).get(key.split("/")[0]) or line
+                 for key, at in lines.items()}
         world = data.get("world")
         if world is not None and not isinstance(world, str):
-            fail(f"world must be a file name, got {world!r}")
+            fail(f"world must be a file name, got {world!r}", key="world")
         allowed = allowed_folders(folder)
         if world is not None and folder is not None:
             if not inside(folder / world, allowed):
                 fail(f"world {world!r} is outside the configuration's folder (list its folder in"
-                     f" {PATH_VARIABLE} to allow it)", "world")
+                     f" {PATH_VARIABLE} to allow it)", "world", key="world")
             world = str(folder / world)
         actions = data.get("actions") or []
         if isinstance(actions, str):
             actions = [actions]
         if not isinstance(actions, list) or not all(isinstance(a, str) and a.strip() for a in actions):
-            fail(f"actions must list modules (names or .py files), got {actions!r}")
+            fail(f"actions must list modules (names or .py files), got {actions!r}", key="actions")
         located = [_locate_module(a, folder) for a in actions]
         for given, where in zip(actions, located):
             if Path(where).is_absolute() and folder is not None and not inside(Path(where), allowed):
                 fail(f"action module {given!r} is outside the configuration's folder (list its folder in"
-                     f" {PATH_VARIABLE} to allow it)", "actions")
+                     f" {PATH_VARIABLE} to allow it)", "actions", key="actions")
         config = cls(seed, None if until is None else float(until), float(dt), world,
                      {str(k): dict(v) for k, v in channels.items()}, faults, path, located,
-                     None if stall is None else float(stall))
-        config.channel_models()  # fail early on a bad model
+                     None if stall is None else float(stall), lines)
+        try:
+            config.channel_models()  # fail early on a bad model
+        except NetFormatError as exc:
+            name = (exc.element or "").partition(".")[2]
+            raise NetFormatError(exc.message, path=path, line=lines.get(f"channels/{name}"),
+                                 element=exc.element) from None
         return config
 
     def import_actions(self) -> None:
@@ -220,7 +240,7 @@ class RunConfig:
         extra = set(entry) - set(_FAULT_KINDS) - {"at", "until"}
         if len(kinds) != 1 or extra:
             fail(f"a fault needs exactly one of {', '.join(_FAULT_KINDS)} plus 'at' (and 'until'"
-                 f" for drop_link); got keys {sorted(entry)}")
+                 f" for drop_link); got keys {sorted(str(k) for k in entry)}")
         kind = kinds[0]
         at = entry.get("at")
         if not _finite(at):
@@ -250,12 +270,12 @@ class RunConfig:
             NetFormatError: naming the configuration file and the unknown name.
         """
         agents = {(s.agent or s.id) for s in net.subnets.values()}
-        for fault in self.faults:
+        for i, fault in enumerate(self.faults):
             for agent in (fault.agent, *fault.link):
                 if agent is not None and agent not in agents:
                     raise NetFormatError(
                         f"fault {fault.kind} names unknown agent {agent!r}{did_you_mean(agent, agents)}",
-                        path=self.path,
+                        path=self.path, line=self.lines.get(f"faults/{i}"),
                     )
         used = {p.channel for p in net.places.values() if p.channel}
         for name in self.channels:
@@ -263,7 +283,7 @@ class RunConfig:
                 raise NetFormatError(
                     f"channel {name!r} is not used by any place of net {net.id!r}"
                     f"{did_you_mean(name, used)}",
-                    path=self.path,
+                    path=self.path, line=self.lines.get(f"channels/{name}"),
                 )
 
     def to_dict(self) -> dict[str, Any]:
@@ -322,4 +342,4 @@ def load_config(path: str | Path) -> RunConfig:
     """Read a run configuration YAML file (safe loader)."""
     from petriflow.io.files import read_yaml_file
 
-    return RunConfig.from_dict(read_yaml_file(path), str(path))
+    return RunConfig.from_dict(read_yaml_file(path, lines=True), str(path))

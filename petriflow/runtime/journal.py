@@ -15,6 +15,7 @@ steps. The resumed trace is therefore the uninterrupted trace, event for event.
 from __future__ import annotations
 
 import json
+import math
 import os
 import sqlite3
 from pathlib import Path
@@ -41,23 +42,42 @@ CREATE TABLE IF NOT EXISTS event (
 
 
 #: What a journal's run inputs hold, and the type of each.
-_INPUTS = {"net_file": str, "net_text": str, "config": dict, "seed": int}
+_INPUTS = {"net_file": (str, "text"), "net_text": (str, "text"), "config": (dict, "an object"),
+           "seed": (int, "an integer")}
 
 
 def _check_inputs(inputs: Any) -> dict[str, Any]:
     """A journal's run inputs, checked (a damaged or foreign file fails here, not later)."""
     if not isinstance(inputs, dict):
         raise ValueError("the run inputs are not an object")
-    for key, kind in _INPUTS.items():
+    for key, (kind, what) in _INPUTS.items():
         if not isinstance(inputs.get(key), kind) or isinstance(inputs.get(key), bool):
-            raise ValueError(f"the run inputs' {key!r} is missing or not a {kind.__name__}")
+            raise ValueError(f"the run inputs' {key!r} is missing or not {what}")
+    for key in ("until", "max_firings", "outputs"):
+        if key not in inputs:
+            raise ValueError(f"the run inputs' {key!r} is missing")
     for key in ("world_file", "world_base", "world_text"):
         if inputs.get(key) is not None and not isinstance(inputs[key], str):
             raise ValueError(f"the run inputs' {key!r} is not text")
     until = inputs.get("until")
-    if until is not None and (isinstance(until, bool) or not isinstance(until, (int, float)) or not until >= 0):
+    if until is not None and (isinstance(until, bool) or not isinstance(until, (int, float))
+                              or not 0 <= until < math.inf):
         raise ValueError("the run inputs' 'until' is not a time")
+    limit = inputs.get("max_firings")
+    if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 0):
+        raise ValueError("the run inputs' 'max_firings' is not a firing count")
+    outputs = inputs.get("outputs")
+    if outputs is not None and (not isinstance(outputs, dict) or not set(outputs) <= {"trace", "xes"}
+                                or not all(v is None or (isinstance(v, str) and v) for v in outputs.values())):
+        raise ValueError("the run inputs' 'outputs' are not {trace: file, xes: file}")
+    if inputs.get("world_text") is not None and not (inputs.get("world_file") and inputs.get("world_base")):
+        raise ValueError("the run inputs hold a world without its file")
     return inputs
+
+
+#: What reading a damaged database file raises: SQLite's errors, and ``ValueError``
+#: (``UnicodeDecodeError``) when its bytes are not the text they should be.
+_DAMAGE = (sqlite3.Error, ValueError)
 
 
 class JournalError(PetriflowError):
@@ -107,7 +127,7 @@ class Journal:
             self._db.execute("PRAGMA journal_mode=WAL")
             self._db.execute("PRAGMA synchronous=NORMAL")
             self._db.executescript(_SCHEMA)
-        except sqlite3.DatabaseError as exc:
+        except _DAMAGE as exc:
             self._release()
             raise JournalError(f"{self.path}: not a petriflow journal ({exc})") from None
         self._pending: list[Event] = []
@@ -116,7 +136,7 @@ class Journal:
                 rows = dict(self._db.execute("SELECT key, value FROM run"))
                 self.journaled = self._db.execute("SELECT count(*) FROM event").fetchone()[0]
                 self.inputs = _check_inputs(parse_json(rows["inputs"])) if "inputs" in rows else None
-            except (sqlite3.DatabaseError, ValueError, TypeError) as exc:
+            except (*_DAMAGE, TypeError) as exc:
                 self.close()
                 raise JournalError(f"{self.path}: not a petriflow journal, or a damaged one ({exc})") from None
             if self.inputs is None:
@@ -147,7 +167,7 @@ class Journal:
             try:
                 self._chunk = [line for (line,) in self._db.execute(
                     "SELECT line FROM event WHERE seq >= ? ORDER BY seq LIMIT 4096", (seq,))]
-            except sqlite3.DatabaseError as exc:
+            except _DAMAGE as exc:
                 raise JournalError(f"{self.path}: a damaged journal ({exc})") from None
             offset = 0
         if offset >= len(self._chunk):
@@ -179,7 +199,7 @@ class Journal:
                     "INSERT INTO event (seq, line) VALUES (?, ?)",
                     [(e.seq, e.to_json()) for e in self._pending],
                 )
-        except sqlite3.DatabaseError as exc:
+        except sqlite3.Error as exc:
             raise JournalError(f"{self.path}: cannot write the journal: {exc}") from None
         self.journaled += len(self._pending)
         self._pending.clear()
@@ -187,9 +207,12 @@ class Journal:
     def finish(self) -> None:
         """Commit the rest and mark the run finished."""
         self.commit()
-        with self._db:
-            self._db.execute("BEGIN")
-            self._db.execute("INSERT OR REPLACE INTO run VALUES ('finished', '1')")
+        try:
+            with self._db:
+                self._db.execute("BEGIN")
+                self._db.execute("INSERT OR REPLACE INTO run VALUES ('finished', '1')")
+        except sqlite3.Error as exc:
+            raise JournalError(f"{self.path}: cannot write the journal: {exc}") from None
         self.finished = True
 
     def close(self) -> None:

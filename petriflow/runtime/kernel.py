@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import heapq
 import math
-from typing import Any, Iterator
+from typing import Iterator
 
 __all__ = ["Kernel", "Scheduled", "Deadline", "POLL", "APPLY"]
 

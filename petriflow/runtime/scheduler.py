@@ -52,6 +52,7 @@ import time as wallclock
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from petriflow import limits
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
@@ -67,11 +68,7 @@ from petriflow.runtime.registry import Registry
 from petriflow.runtime.tokens import Agenda, TokenStore
 from petriflow.runtime.trace import Event, EventKind, summarize
 
-__all__ = ["Scheduler", "RunResult", "ZenoError", "EmptySchedule", "MAX_FIRINGS_PER_INSTANT"]
-
-#: Firings allowed at one instant before the run is declared Zeno (an endless
-#: cascade of instant transitions).
-MAX_FIRINGS_PER_INSTANT = 100_000
+__all__ = ["Scheduler", "RunResult", "ZenoError", "EmptySchedule"]
 
 EventHandler = Callable[[Event], None]
 
@@ -356,9 +353,9 @@ class Scheduler:
                 return
             self._fire(agenda.pick(draw))
             self._fired_now += 1
-            if self._fired_now > MAX_FIRINGS_PER_INSTANT:
+            if self._fired_now > limits.FIRINGS_PER_INSTANT:
                 raise ZenoError(
-                    f"more than {MAX_FIRINGS_PER_INSTANT} firings at t={self.now:g}s without time"
+                    f"more than {limits.FIRINGS_PER_INSTANT} firings at t={self.now:g}s without time"
                     " passing (a cycle of instant transitions?)"
                 )
 

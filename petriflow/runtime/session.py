@@ -163,7 +163,7 @@ def net_config(net: Net, path: Path) -> RunConfig | None:
             raise NetFormatError(f"run configuration {named!r} not found (looked for {file})", path=str(path),
                                  line=net.lines.get("run"))
         return load_config(file)
-    return RunConfig.from_dict(named, str(path), base=str(path.parent))
+    return RunConfig.from_dict(named, str(path), base=str(path.parent), line=net.lines.get("run"))
 
 
 def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = None,
@@ -425,9 +425,14 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
         _check_outputs({"--trace": trace, "--xes": xes, "--db": db}, [])
         _make_folders(trace, xes)
         net = _net_from_text(inputs["net_text"], inputs["net_file"])
-        config = RunConfig.from_dict(inputs["config"])
+        try:
+            config = RunConfig.from_dict(inputs["config"])
+        except NetFormatError as exc:
+            raise JournalError(f"{db}: a damaged journal: its run configuration: {exc}") from None
         config.import_actions()
         binding = bind(net, registry, path=inputs["net_file"])
+        check_sizes(net, inputs["net_file"])
+        config.check(net)
         return _execute(net, binding, config, inputs, journal=journal,
                         trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
                         realtime=realtime, gui=gui, progress=progress, max_firings=inputs.get("max_firings"))

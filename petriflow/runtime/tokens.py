@@ -30,13 +30,8 @@ from typing import Any, Callable, Iterable, Mapping, Sequence
 from petriflow.engine import CompiledNet
 from petriflow.marking import Marking
 
-__all__ = ["TokenStore", "Agenda", "MAX_TOKENS"]
+__all__ = ["TokenStore", "Agenda"]
 
-#: The most tokens a run starts with in one place, and the largest arc weight a run
-#: fires (checked by :func:`~petriflow.runtime.binding.bind`): the runtime keeps an
-#: entry (the token's data) per token, so a count stands for memory. The token game
-#: (``simulate``) and the analysis count without this limit.
-MAX_TOKENS = 10_000_000
 
 
 class Agenda:

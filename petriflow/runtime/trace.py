@@ -23,7 +23,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterable, Iterator
+from typing import Any, Iterable
 from xml.sax.saxutils import quoteattr
 
 from petriflow.errors import NetFormatError
@@ -216,9 +216,9 @@ def check_event(data: Any) -> Event:
     """
     if not isinstance(data, dict):
         raise ValueError("a trace line is a JSON object")
-    for key, wanted in (("seq", int), ("time", (int, float)), ("kind", str)):
+    for key, wanted, what in (("seq", int, "an integer"), ("time", (int, float), "a number"), ("kind", str, "text")):
         if not isinstance(data.get(key), wanted) or isinstance(data.get(key), bool):
-            raise ValueError(f"'{key}' is missing or not a {'number' if key == 'time' else wanted.__name__}")
+            raise ValueError(f"'{key}' is missing or not {what}")
     if not math.isfinite(data["time"]):
         raise ValueError("'time' is not a finite number")
     if data["kind"] not in EVENT_KINDS:

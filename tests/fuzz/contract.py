@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import contextlib
 import io
+import re
 import warnings
+
+from hypothesis import strategies as st
 
 from petriflow.cli import main
 
@@ -37,3 +40,37 @@ def assert_contract(*argv: object) -> int:
         lines = err.strip().splitlines()
         assert lines and lines[-1].startswith("petriflow: ") and "Traceback" not in err, err
     return code
+
+
+def mutate_yaml(draw: st.DrawFn, text: str, keys: list[str] = ()) -> bytes:
+    """``text`` (YAML) with one to three lines changed: a value made hostile, a line
+    deleted, duplicated, swapped or cut off, one of ``keys`` slipped into a flow
+    mapping; then, half the time, a few random bytes inserted."""
+    lines = text.splitlines()
+    for _ in range(draw(st.integers(1, 3))):
+        if not lines:
+            break
+        at = draw(st.integers(0, len(lines) - 1))
+        kind = draw(st.sampled_from(["value", "value", "delete", "duplicate", "swap", "key", "truncate"]))
+        if kind == "value":
+            values = list(re.finditer(r"(?<=: )[^,{}\[\]\n]+|(?<=[\[,] )[^,{}\[\]\n]+", lines[at]))
+            if values:
+                hit = draw(st.sampled_from(values))
+                lines[at] = lines[at][:hit.start()] + draw(st.sampled_from(HOSTILE_VALUES)) + lines[at][hit.end():]
+        elif kind == "delete":
+            del lines[at]
+        elif kind == "duplicate":
+            lines.insert(at, lines[at])
+        elif kind == "swap":
+            other = draw(st.integers(0, len(lines) - 1))
+            lines[at], lines[other] = lines[other], lines[at]
+        elif kind == "key" and keys:
+            lines[at] = re.sub(r"\{(\w+):", lambda m: "{" + draw(st.sampled_from(keys)) + ", " + m.group(1) + ":",
+                               lines[at], count=1)
+        else:
+            lines = lines[:at]
+    data = ("\n".join(lines) + "\n").encode()
+    if draw(st.booleans()):
+        cut = draw(st.integers(0, len(data)))
+        data = data[:cut] + draw(st.binary(max_size=4)) + data[cut:]
+    return data

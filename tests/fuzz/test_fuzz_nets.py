@@ -12,7 +12,7 @@ from petriflow.errors import PetriflowError
 from petriflow.io.pnml import dumps_pnml, loads_pnml
 from petriflow.io.yaml import loads_net
 from tests.conftest import NETS, ORACLE, SEQUENCE_YAML
-from tests.fuzz.contract import HOSTILE_VALUES, assert_contract
+from tests.fuzz.contract import HOSTILE_VALUES, assert_contract, mutate_yaml
 
 YAML_BASES = [
     SEQUENCE_YAML,
@@ -40,34 +40,8 @@ PNML_BASES = [dumps_pnml(loads_net(text)) for text in YAML_BASES] + [
 
 @st.composite
 def mutated_yaml(draw: st.DrawFn) -> bytes:
-    lines = draw(st.sampled_from(YAML_BASES)).splitlines()
-    for _ in range(draw(st.integers(1, 3))):
-        if not lines:
-            break
-        at = draw(st.integers(0, len(lines) - 1))
-        kind = draw(st.sampled_from(["value", "value", "delete", "duplicate", "swap", "key", "truncate"]))
-        if kind == "value":
-            values = list(re.finditer(r"(?<=: )[^,{}\[\]\n]+", lines[at]))
-            if values:
-                hit = draw(st.sampled_from(values))
-                lines[at] = lines[at][:hit.start()] + draw(st.sampled_from(HOSTILE_VALUES)) + lines[at][hit.end():]
-        elif kind == "delete":
-            del lines[at]
-        elif kind == "duplicate":
-            lines.insert(at, lines[at])
-        elif kind == "swap":
-            other = draw(st.integers(0, len(lines) - 1))
-            lines[at], lines[other] = lines[other], lines[at]
-        elif kind == "key":
-            lines[at] = lines[at].replace("{id:", "{" + draw(st.sampled_from(
-                ["tokens: -1, ", "weight: 0, ", "timeout: .nan, ", "cancels: [zz], ", "zz: 1, "])) + "id:", 1)
-        else:
-            lines = lines[:at]
-    data = ("\n".join(lines) + "\n").encode()
-    if draw(st.booleans()):
-        cut = draw(st.integers(0, len(data)))
-        data = data[:cut] + draw(st.binary(max_size=4)) + data[cut:]
-    return data
+    return mutate_yaml(draw, draw(st.sampled_from(YAML_BASES)),
+                       ["tokens: -1", "weight: 0", "timeout: .nan", "cancels: [zz]", "zz: 1"])
 
 
 @st.composite
