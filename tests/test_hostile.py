@@ -250,6 +250,8 @@ def test_damaged_journals_are_one_line(tmp_path, capsys):
     ("[" * 300 + "]" * 300, "nested more than 64 levels deep"),
     ('{"seq": 0, "time": 0, "kind": "end", "data": {"firing": 1, "outcome": "ok", "produced": {"p": -1}}}',
      "'produced' is missing or malformed"),
+    ('{"seq": 0, "time": 0, "kind": "end", "data": {"firing": 1, "outcome": [], "produced": {}}}',
+     "'outcome' is missing or malformed"),
 ])
 def test_malformed_traces_are_one_line_in_replay(tmp_path, capsys, line, fragment):
     trace = tmp_path / "t.jsonl"

@@ -201,7 +201,7 @@ def _counts(value: Any) -> bool:
 _NEEDS = {
     "run": {"marking": _counts},
     "start": {"firing": lambda v: type(v) is int, "consumed": _counts},
-    "end": {"firing": lambda v: type(v) is int, "outcome": lambda v: v in {o.value for o in Outcome},
+    "end": {"firing": lambda v: type(v) is int, "outcome": lambda v: isinstance(v, str) and v in {o.value for o in Outcome},
             "produced": _counts},
     "cancel": {"withdrawn": _counts},
     "message": {"place": lambda v: isinstance(v, str), "fate": lambda v: isinstance(v, str)},
