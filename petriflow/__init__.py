@@ -34,7 +34,7 @@ from petriflow.marking import Marking
 from petriflow.net import Arc, Net, Operator, Place, Subnet, Transition
 from petriflow.outcome import Outcome, StopReason
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Port, Status
-from petriflow.runtime.registry import action, guard
+from petriflow.runtime.registry import action, guard, metric
 from petriflow.runtime.session import run
 from petriflow.workflow import add_operator
 
@@ -45,5 +45,5 @@ __all__ = [
     "MarkingError", "Net", "NetFormatError", "NetStructureError", "NotEnabledError", "Operator",
     "Outcome", "Param", "PetriflowError", "Place", "Port", "Simulation", "Status", "StopReason",
     "Subnet", "Transition", "UnknownElementError", "action", "add_operator", "enabled", "fire",
-    "fire_sequence", "guard", "load_net", "run", "save_net",
+    "fire_sequence", "guard", "load_net", "metric", "run", "save_net",
 ]

@@ -410,6 +410,9 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--json", action="store_true", help="print JSON")
     check.add_argument("--max-states", type=int, default=None, metavar="N",
                        help="most markings to explore (default 2,000,000); beyond it, exit 2")
+    from petriflow.sweep.command import add_parser as add_sweep
+
+    add_sweep(sub)
     return parser
 
 

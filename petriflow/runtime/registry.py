@@ -38,8 +38,8 @@ from petriflow.errors import PetriflowError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, Param, generator_action
 
-__all__ = ["Registry", "ActionSpec", "UnknownActionError", "default_registry", "ENTRY_POINT_GROUP", "action",
-           "guard"]
+__all__ = ["Registry", "ActionSpec", "MetricSpec", "UnknownActionError", "default_registry", "ENTRY_POINT_GROUP",
+           "action", "guard", "metric"]
 
 log = logging.getLogger(__name__)
 
@@ -79,8 +79,37 @@ class ActionSpec:
         return self.target
 
 
+@dataclass
+class MetricSpec:
+    """A registered metric: a function of a finished run (see :mod:`petriflow.runtime.metrics`).
+
+    Attributes:
+        name: the name sweep files use (``core.firings``, ``bidding.time_s``).
+        target: ``f(record, **params)``, or a lazy ``"module:function"`` string.
+        events: whether it reads the run's events (the run then keeps them in memory).
+        doc: one line of documentation.
+    """
+
+    name: str
+    target: Callable[..., Any] | str
+    events: bool = False
+    doc: str = ""
+
+    def load(self) -> Callable[..., Any]:
+        """The metric function, importing a lazy target once."""
+        if isinstance(self.target, str):
+            module_name, _, attribute = self.target.partition(":")
+            try:
+                self.target = getattr(importlib.import_module(module_name), attribute)
+            except (ImportError, AttributeError) as exc:
+                raise UnknownActionError(f"metric {self.name!r}: cannot load {self.target!r}: {exc}") from exc
+            if not callable(self.target):
+                raise UnknownActionError(f"metric {self.name!r}: {self.target!r} is not callable")
+        return self.target
+
+
 class Registry:
-    """Maps action and guard names to code.
+    """Maps action, guard and metric names to code.
 
     Args:
         load_plugins: read the ``petriflow.actions`` entry points on first use.
@@ -89,6 +118,7 @@ class Registry:
     def __init__(self, load_plugins: bool = True) -> None:
         self._actions: dict[str, ActionSpec] = {}
         self._predicates: dict[str, Predicate] = {}
+        self._metrics: dict[str, MetricSpec] = {}
         self._plugins_pending = load_plugins
         #: ``{entry point: error}`` of the plugins that failed to load.
         self.broken: dict[str, str] = {}
@@ -126,6 +156,24 @@ class Registry:
             if name in self._predicates and not replace:
                 raise PetriflowError(f"guard {name!r} is already registered")
             self._predicates[name] = function
+            return function
+
+        return decorate
+
+    def register_metric(self, name: str, target: Callable[..., Any] | str, *, events: bool = False,
+                        doc: str = "", replace: bool = False) -> None:
+        """Register a metric ``f(record, **params)`` (or a lazy ``"module:function"``)."""
+        if name in self._metrics and not replace:
+            raise PetriflowError(f"metric {name!r} is already registered")
+        if not doc and not isinstance(target, str) and target.__doc__:
+            doc = target.__doc__.strip().splitlines()[0]
+        self._metrics[name] = MetricSpec(name, target, events, doc)
+
+    def metric(self, name: str, *, events: bool = False, replace: bool = False) -> Callable:
+        """Decorator registering a metric; ``events``: it reads the run's events."""
+
+        def decorate(function: Callable[..., Any]) -> Callable[..., Any]:
+            self.register_metric(name, function, events=events, replace=replace)
             return function
 
         return decorate
@@ -173,6 +221,18 @@ class Registry:
             raise self._unknown("action", name, self._actions)
         return spec.load()
 
+    def metric_spec(self, name: str) -> MetricSpec:
+        """The metric registered as ``name`` (UnknownActionError with hints if none)."""
+        self._load_plugins()
+        if name not in self._metrics:
+            raise self._unknown("metric", name, self._metrics)
+        return self._metrics[name]
+
+    def metric_specs(self) -> list[MetricSpec]:
+        """Registered metrics, sorted by name."""
+        self._load_plugins()
+        return [self._metrics[n] for n in sorted(self._metrics)]
+
     def guard(self, name: str) -> Predicate:
         """The predicate registered as ``name`` (UnknownActionError with hints if none)."""
         self._load_plugins()
@@ -192,9 +252,10 @@ default_registry = Registry()
 
 
 def _register_core(registry: Registry) -> None:
-    from petriflow.runtime import builtin
+    from petriflow.runtime import builtin, metrics
 
     builtin.register(registry)
+    metrics.register(registry)
 
 
 _register_core(default_registry)
@@ -242,3 +303,9 @@ def guard(name: str, *, replace: bool = False, registry: Registry | None = None)
     """Decorator registering a guard ``f(tokens, params) -> bool`` under ``name``
     (in the run registry by default); see :meth:`Registry.predicate`."""
     return (registry or default_registry).predicate(name, replace=replace)
+
+
+def metric(name: str, *, events: bool = False, replace: bool = False, registry: Registry | None = None) -> Callable:
+    """Decorator registering a metric ``f(record, **params)`` under ``name`` (in the run
+    registry by default); see :mod:`petriflow.runtime.metrics`."""
+    return (registry or default_registry).metric(name, events=events, replace=replace)

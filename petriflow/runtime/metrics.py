@@ -1,0 +1,244 @@
+"""Metrics: numbers computed from a finished run, registered by name like actions.
+
+A sweep file names the metrics it wants (``metrics: [core.end_time, core.messages]``);
+each is a function ``f(record, **params)`` of a :class:`RunRecord` (the run's result,
+its events, the final tokens, the world, the run configuration) that returns a number,
+a string, ``None`` (not measured in this run), or a flat ``{key: number}`` mapping
+(reported as ``name.key``). A metric depends only on what the run did, never on the
+wall clock, unless its name says so (``core.wall_s``), so the same (net, parameters,
+seed) gives the same value on every machine and backend.
+
+Register one with :func:`petriflow.metric` (or ``registry.metric``) in an action
+module or a plugin; ``events=True`` makes the run keep its events in memory for it::
+
+    from petriflow import metric
+
+    @metric("bidding.messages", events=True)
+    def messages(record):
+        return sum(1 for e in record.events if e.kind == "message")
+
+Core metrics:
+
+=========================  =============================================================
+``core.end_time``          simulated seconds at the end of the run
+``core.firings``           transitions fired
+``core.outcome``           why the run ended (``final``, ``until``, ``dead``, ...)
+``core.completed``         1 if the run reached the net's final marking, else 0
+``core.tokens``            tokens in ``place`` at the end
+``core.fired``             firings of ``transition`` (and ``outcome``, if given)
+``core.time_of``           simulated time ``transition`` first (``which: last``) ended
+``core.result``            a field of ``transition``'s result (first or last ok firing)
+``core.reported``          a value actions reported with ``ctx.emit(name, field=...)``
+``core.messages``          messages sent / delivered / lost / bytes (``channel``, ``agent``)
+``core.messages_per_channel``  the same per channel (``radio.sent``, ...)
+``core.messages_per_agent``    the same per sending agent (``robot1.sent``, ...)
+``core.wall_s``            wall-clock seconds of the run (the one metric that is not
+                           reproducible)
+=========================  =============================================================
+
+Examples:
+    >>> from petriflow.runtime.trace import Event
+    >>> record = RunRecord(events=[
+    ...     Event(0, 0.0, "message", None, "r1", {"fate": "sent", "channel": "radio", "size": 10}),
+    ...     Event(1, 0.0, "message", None, "r2", {"fate": "lost", "channel": "radio", "size": 4}),
+    ...     Event(2, 0.1, "message", None, "r1", {"fate": "delivered", "channel": "radio"})])
+    >>> messages(record)
+    {'sent': 2, 'delivered': 1, 'lost': 1, 'bytes': 14}
+    >>> messages_per_agent(record)["r2.lost"]
+    1
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any
+
+from petriflow.errors import PetriflowError
+
+__all__ = ["RunRecord", "register", "messages", "messages_per_agent", "messages_per_channel"]
+
+
+@dataclass
+class RunRecord:
+    """What a metric sees of a finished run.
+
+    Attributes:
+        result: how the run ended (:class:`~petriflow.runtime.scheduler.RunResult`).
+        events: the run's events (kept only when a metric asked for them).
+        world: the world at the end (still open), or ``None``.
+        config: the run configuration.
+        params: the sweep parameters of this trial.
+        seed: the run seed.
+        wall: wall-clock seconds the run took.
+        scheduler: the scheduler, for anything else (channels, faults, agents).
+    """
+
+    result: Any = None
+    events: list[Any] = field(default_factory=list)
+    world: Any = None
+    config: Any = None
+    params: dict[str, Any] = field(default_factory=dict)
+    seed: int | None = None
+    wall: float = 0.0
+    scheduler: Any = None
+
+    @property
+    def tokens(self) -> dict[str, list[Any]]:
+        """``{place: [data, ...]}`` at the end."""
+        return getattr(self.result, "tokens", {}) or {}
+
+
+def end_time(record: RunRecord) -> float:
+    """Simulated seconds at the end of the run."""
+    return record.result.time
+
+
+def firings(record: RunRecord) -> int:
+    """Transitions fired."""
+    return record.result.firings
+
+
+def outcome(record: RunRecord) -> str:
+    """Why the run ended: final, until, dead, firings, failed, stalled."""
+    return str(getattr(record.result.reason, "value", record.result.reason))
+
+
+def completed(record: RunRecord) -> int:
+    """1 if the run reached the net's final marking, else 0."""
+    return int(outcome(record) == "final")
+
+
+def tokens(record: RunRecord, place: str) -> int:
+    """Tokens in ``place`` at the end."""
+    return record.result.marking[place]
+
+
+def fired(record: RunRecord, transition: str, outcome: str | None = None) -> int:
+    """Firings of ``transition`` that ended (with ``outcome``, if given)."""
+    return sum(1 for e in record.events if e.kind == "end" and e.transition == transition
+               and (outcome is None or e.data.get("outcome") == outcome))
+
+
+def time_of(record: RunRecord, transition: str, which: str = "first") -> float | None:
+    """Simulated time at which ``transition`` first (``which: last``: last) ended ok."""
+    if which not in ("first", "last"):
+        raise PetriflowError(f"core.time_of: which must be 'first' or 'last', not {which!r}")
+    times = [e.time for e in record.events if e.kind == "end" and e.transition == transition
+             and e.data.get("outcome", "ok") == "ok"]
+    if not times:
+        return None
+    return times[0] if which == "first" else times[-1]
+
+
+def result(record: RunRecord, transition: str, field: str, which: str = "first") -> Any:
+    """``field`` of the result of ``transition``'s first (``which: last``: last) firing
+    that ended ok (a dotted ``field`` reaches into nested results)."""
+    if which not in ("first", "last"):
+        raise PetriflowError(f"core.result: which must be 'first' or 'last', not {which!r}")
+    ends = [e for e in record.events if e.kind == "end" and e.transition == transition
+            and e.data.get("outcome", "ok") == "ok"]
+    if not ends:
+        return None
+    value = (ends[0] if which == "first" else ends[-1]).data.get("result")
+    for key in field.split("."):
+        if not isinstance(value, dict) or key not in value:
+            return None
+        value = value[key]
+    return value
+
+
+_REDUCE = {
+    "first": lambda values: values[0],
+    "last": lambda values: values[-1],
+    "sum": sum,
+    "max": max,
+    "min": min,
+    "mean": lambda values: sum(values) / len(values),
+}
+
+
+def reported(record: RunRecord, name: str, field: str | None = None, reduce: str = "last") -> Any:
+    """A value actions reported with ``ctx.emit(name, field=value)``: ``reduce`` (first,
+    last, sum, max, min, mean, count) over every report; ``field`` omitted: the
+    simulated time of the report (``count``: how many there were)."""
+    if reduce != "count" and reduce not in _REDUCE:
+        raise PetriflowError(f"core.reported: reduce must be one of count, {', '.join(_REDUCE)}; not {reduce!r}")
+    values = []
+    for event in record.events:
+        if event.kind != "custom" or event.data.get("name") != name:
+            continue
+        if field is None:
+            values.append(event.time)
+            continue
+        data = event.data.get("data")
+        if isinstance(data, dict) and field in data:
+            values.append(data[field])
+    if reduce == "count":
+        return len(values)
+    return _REDUCE[reduce](values) if values else None
+
+
+def _count(record: RunRecord, key) -> dict[Any, Counter]:
+    counts: dict[Any, Counter] = {}
+    for event in record.events:
+        if event.kind != "message":
+            continue
+        group = key(event)
+        if group is None:
+            continue
+        counter = counts.setdefault(group, Counter(sent=0, delivered=0, lost=0, bytes=0))
+        fate = event.data.get("fate")
+        if fate in ("sent", "lost"):  # every message put into a channel: one or the other
+            counter["sent"] += 1
+            counter["bytes"] += event.data.get("size", 0)
+        if fate in ("delivered", "lost"):
+            counter[fate] += 1
+    return counts
+
+
+def messages(record: RunRecord, channel: str | None = None, agent: str | None = None) -> dict[str, int]:
+    """Messages put into channels (``sent``, lost ones included), ``delivered``,
+    ``lost`` and ``bytes`` sent; only ``channel``'s or ``agent``'s when given."""
+    counts = _count(record, lambda e: 0 if ((channel is None or e.data.get("channel") == channel)
+                                            and (agent is None or e.agent == agent)) else None)
+    return dict(counts.get(0, Counter(sent=0, delivered=0, lost=0, bytes=0)))
+
+
+def _flat(counts: dict[Any, Counter]) -> dict[str, int]:
+    return {f"{group}.{k}": v for group in sorted(counts, key=str) for k, v in counts[group].items()}
+
+
+def messages_per_channel(record: RunRecord) -> dict[str, int]:
+    """:func:`messages` per channel: ``{"radio.sent": n, ...}``."""
+    return _flat(_count(record, lambda e: e.data.get("channel")))
+
+
+def messages_per_agent(record: RunRecord) -> dict[str, int]:
+    """:func:`messages` per sending agent: ``{"robot1.sent": n, ...}``."""
+    return _flat(_count(record, lambda e: e.agent))
+
+
+def wall_s(record: RunRecord) -> float:
+    """Wall-clock seconds the run took (not reproducible: depends on the machine)."""
+    return record.wall
+
+
+def register(registry: Any) -> None:
+    """Register the core metrics in ``registry``."""
+    for name, function, events in (
+        ("core.end_time", end_time, False),
+        ("core.firings", firings, False),
+        ("core.outcome", outcome, False),
+        ("core.completed", completed, False),
+        ("core.tokens", tokens, False),
+        ("core.fired", fired, True),
+        ("core.time_of", time_of, True),
+        ("core.result", result, True),
+        ("core.reported", reported, True),
+        ("core.messages", messages, True),
+        ("core.messages_per_channel", messages_per_channel, True),
+        ("core.messages_per_agent", messages_per_agent, True),
+        ("core.wall_s", wall_s, False),
+    ):
+        registry.register_metric(name, function, events=events)

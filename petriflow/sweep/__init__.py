@@ -1,0 +1,135 @@
+"""Experiments as data: run a net over a grid of parameters and seeds, measure each run.
+
+``petriflow sweep SPEC.yaml`` and :func:`run_sweep` read a sweep file
+(:mod:`petriflow.sweep.spec`, ``docs/sweep-format.md``), run each trial (a row's
+parameters and a seed) on a backend (:mod:`petriflow.sweep.backends`: local worker
+processes or a Ray cluster), record one row per trial in SQLite
+(:mod:`petriflow.sweep.store`) and report each metric's mean and standard deviation per
+row beside the paper's value (:mod:`petriflow.sweep.report`).
+
+Examples:
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (folder / "net.yaml").write_text('''
+    ... petriflow: 1
+    ... places: [{id: i, tokens: 1}, o]
+    ... transitions: [{id: rest, action: core.wait, params: {seconds: 1}, in: [i], out: [o]}]
+    ... final: {o: 1}
+    ... ''')
+    >>> _ = (folder / "sweep.yaml").write_text('''
+    ... petriflow-sweep: 1
+    ... net: net.yaml
+    ... trials: 2
+    ... matrix: {wait: [1.5, 3]}
+    ... set: {net.transitions.rest.params.seconds: "${wait}"}
+    ... metrics: [core.end_time]
+    ... ''')
+    >>> result = run_sweep(load_sweep(folder / "sweep.yaml"), workers=1)
+    >>> [(row["params"], row["metrics"]["core.end_time"]["mean"]) for row in result.rows]
+    [({'wait': 1.5}, 1.5), ({'wait': 3}, 3.0)]
+"""
+
+from __future__ import annotations
+
+import sys
+import time as wallclock
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from petriflow.errors import PetriflowError
+from petriflow.sweep.backends import BACKENDS, BackendError, default_workers, run_local, run_ray
+from petriflow.sweep.report import metric_names, summary
+from petriflow.sweep.spec import Sweep, Trial, load_sweep
+from petriflow.sweep.store import Store, StoreError
+
+__all__ = ["Sweep", "SweepResult", "load_sweep", "run_sweep", "BACKENDS", "BackendError", "StoreError"]
+
+
+@dataclass
+class SweepResult:
+    """What a sweep produced.
+
+    Attributes:
+        sweep: the sweep.
+        rows: the report, a dict per row (:func:`petriflow.sweep.report.summary`).
+        trials: every trial recorded (this run's and, resumed, the earlier ones).
+        names: the metric names reported (a mapping metric's keys expanded).
+        ran: trials run by this call.
+        wall: wall seconds of this call.
+    """
+
+    sweep: Sweep
+    rows: list[dict[str, Any]]
+    trials: list[dict[str, Any]]
+    names: list[str]
+    ran: int = 0
+    wall: float = 0.0
+    failures: list[dict[str, Any]] = field(default_factory=list)
+
+    def to_json(self) -> dict[str, Any]:
+        """``{"spec": PATH, "rows": [...]}`` (the rows of :func:`~petriflow.sweep.report.summary`)."""
+        return {"spec": self.sweep.path, "rows": self.rows}
+
+
+def _progress(total: int, enabled: bool) -> Any:
+    if not enabled or total == 0:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, unit="trial", file=sys.stderr, dynamic_ncols=True, leave=False)
+
+
+def run_sweep(sweep: Sweep, *, backend: str = "local", workers: int | None = None, db: str | Path | None = None,
+              resume: bool = False, progress: bool = False, ray_address: str | None = None,
+              on_result: Callable[[Trial, dict[str, Any]], None] | None = None) -> SweepResult:
+    """Run every trial of ``sweep`` not yet in ``db``; record and summarise them.
+
+    Args:
+        backend: ``local`` (worker processes) or ``ray``.
+        workers: processes (local; default: every CPU) or tasks in flight (ray;
+            default: the cluster's CPUs).
+        db: the results database (default: in memory).
+        resume: ``db`` exists: run only the trials it lacks.
+        progress: show a progress bar (on a terminal).
+        ray_address: the Ray cluster (default ``RAY_ADDRESS``, else a local instance).
+        on_result: called with each trial's result as it arrives.
+
+    Raises:
+        StoreError: ``db`` exists without ``resume``, or holds another sweep.
+        BackendError: the backend cannot start.
+    """
+    if backend not in BACKENDS:
+        raise PetriflowError(f"unknown backend {backend!r} (one of {', '.join(BACKENDS)})")
+    if workers is not None and workers < 1:
+        raise PetriflowError(f"workers must be at least 1, not {workers}")
+    store = Store(db)
+    store.begin({"file": sweep.path, "digest": sweep.digest}, resume=resume)
+    started = wallclock.perf_counter()
+    try:
+        done = store.done()
+        todo = [t for t in sweep.trials() if (t.key, t.seed) not in done]
+        payloads = [sweep.payload(t) for t in todo]
+        if backend == "local":
+            results = run_local(payloads, workers or default_workers(), sweep.timeout)
+        else:
+            results = run_ray(payloads, workers, sweep.timeout, ray_address)
+        bar = _progress(len(todo), progress)
+        try:
+            for index, result in results:
+                trial = todo[index]
+                store.add(trial.row, trial.params, trial.seed, result)
+                if on_result is not None:
+                    on_result(trial, result)
+                if bar is not None:
+                    bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
+        trials = store.results()
+    finally:
+        store.close()
+    names = metric_names([m.name for m in sweep.metrics], trials)
+    rows = summary(sweep.rows, trials, names)
+    failures = [t for t in trials if t["status"] != "ok"]
+    return SweepResult(sweep, rows, trials, names, len(todo), wallclock.perf_counter() - started, failures)

@@ -1,0 +1,136 @@
+"""A sweep's results in SQLite: one row per trial, committed as it arrives.
+
+Tables: ``sweep`` (``key``, ``value``: the sweep file, its digest, the format) and
+``trials`` (``row``, ``params`` as canonical JSON, ``seed``, ``status`` ok / error /
+timeout / crashed, ``outcome``, ``metrics`` as JSON, ``wall`` seconds, ``error``), with
+one trial per (params, seed): a sweep resumed after a kill runs only what is missing,
+and never records a trial twice.
+
+Examples:
+    >>> store = Store(None)
+    >>> store.begin({"file": "s.yaml", "digest": "abc"}, resume=False)
+    >>> store.add(0, {"a": 1}, 1, {"status": "ok", "metrics": {"m": 2.0}, "outcome": "final",
+    ...                            "error": None, "wall": 0.1})
+    >>> store.done()
+    {('{"a":1}', 1)}
+    >>> store.results()[0]["metrics"]
+    {'m': 2.0}
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from pathlib import Path
+from typing import Any
+
+from petriflow.errors import NetFormatError, PetriflowError
+from petriflow.sweep.spec import canonical
+
+__all__ = ["Store", "StoreError"]
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS sweep (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS trials (
+    row INTEGER NOT NULL, params TEXT NOT NULL, seed INTEGER NOT NULL, status TEXT NOT NULL,
+    outcome TEXT, metrics TEXT NOT NULL, wall REAL, error TEXT,
+    PRIMARY KEY (params, seed)
+);
+"""
+#: What a results database says it is (``sweep.format``).
+FORMAT = "petriflow-sweep-results 1"
+
+
+class StoreError(PetriflowError):
+    """A results database cannot be used (exists without --resume, another sweep, damaged)."""
+
+
+class Store:
+    """Results of one sweep; ``path`` ``None`` keeps them in memory."""
+
+    def __init__(self, path: str | Path | None) -> None:
+        self.path = None if path is None else Path(path)
+        self.db: sqlite3.Connection | None = None
+
+    def begin(self, meta: dict[str, str], resume: bool) -> None:
+        """Open (``resume``: an existing database of the same sweep) or create the database.
+
+        Raises:
+            StoreError: it exists and ``resume`` is false; it holds another sweep; it is
+                not a results database.
+        """
+        if self.path is None:
+            self.db = sqlite3.connect(":memory:")
+            self.db.executescript(_SCHEMA)
+            self._meta({"format": FORMAT, **meta})
+            return
+        where = str(self.path)
+        exists = self.path.exists()
+        if exists and not resume:
+            raise StoreError(f"{where}: already exists; use --resume to finish that sweep, or another --db")
+        if not exists and resume:
+            raise StoreError(f"{where}: no such results database to resume")
+        if self.path.is_dir():
+            raise NetFormatError("--db names a folder, not a file", path=where)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.db = sqlite3.connect(where, timeout=5.0, isolation_level=None)
+            if exists:
+                known = dict(self.db.execute("SELECT key, value FROM sweep").fetchall())
+                if known.get("format") != FORMAT:
+                    raise StoreError(f"{where}: not a petriflow sweep results database")
+                if known.get("digest") != meta["digest"]:
+                    raise StoreError(f"{where}: holds the results of another sweep ({known.get('file')}, or this"
+                                     " file before it changed); use another --db")
+                self.db.execute("SELECT row, params, seed, status, outcome, metrics, wall, error FROM trials LIMIT 1")
+            else:
+                self.db.execute("PRAGMA journal_mode=WAL")
+                self.db.executescript(_SCHEMA)
+                self._meta({"format": FORMAT, **meta})
+        except sqlite3.Error as exc:
+            self.close()
+            raise StoreError(f"{where}: not a petriflow sweep results database ({exc})") from None
+        except OSError as exc:
+            self.close()
+            raise StoreError(f"{where}: {exc.strerror or exc}") from None
+        except StoreError:
+            self.close()
+            raise
+
+    def _meta(self, meta: dict[str, str]) -> None:
+        assert self.db is not None
+        with self.db:
+            self.db.executemany("INSERT OR REPLACE INTO sweep VALUES (?, ?)", sorted(meta.items()))
+
+    def done(self) -> set[tuple[str, int]]:
+        """``{(params, seed)}`` of the trials already recorded."""
+        assert self.db is not None
+        return set(self.db.execute("SELECT params, seed FROM trials").fetchall())
+
+    def add(self, row: int, params: dict[str, Any], seed: int, result: dict[str, Any]) -> None:
+        """Record one trial's result (committed at once)."""
+        assert self.db is not None
+        with self.db:
+            self.db.execute(
+                "INSERT OR IGNORE INTO trials VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
+                (row, canonical(params), seed, result["status"], result.get("outcome"),
+                 json.dumps(result.get("metrics", {}), sort_keys=True), result.get("wall"), result.get("error")),
+            )
+
+    def results(self) -> list[dict[str, Any]]:
+        """Every recorded trial, by row and seed."""
+        assert self.db is not None
+        out = []
+        try:
+            for row, params, seed, status, outcome, metrics, wall, error in self.db.execute(
+                    "SELECT row, params, seed, status, outcome, metrics, wall, error FROM trials ORDER BY row, seed"):
+                out.append({"row": row, "params": json.loads(params), "seed": seed, "status": status,
+                            "outcome": outcome, "metrics": json.loads(metrics), "wall": wall, "error": error})
+        except (sqlite3.Error, ValueError) as exc:
+            raise StoreError(f"{self.path}: damaged results ({exc})") from None
+        return out
+
+    def close(self) -> None:
+        if self.db is not None:
+            self.db.close()
+            self.db = None
