@@ -113,6 +113,14 @@ def test_huge_weights_are_refused_by_the_analysis_never_wrapped(tmp_path, capsys
     one_line_error(capsys, ["check", net, "--json"], "weight 4611686018427387904 is beyond what the analysis counts")
 
 
+def test_a_huge_final_marking_is_refused_by_the_analysis(tmp_path, capsys):
+    """Found by the nightly fuzz profile: a final marking of 10**21 was a traceback."""
+    net = tmp_path / "f.yaml"
+    net.write_text("petriflow: 1\nplaces: [{id: i, tokens: 1}, o]\ntransitions: [{id: t, in: [i], out: [o]}]\n"
+                   f"final: {{o: {10**21}}}\n")
+    one_line_error(capsys, ["check", net], "a final marking of 1000000000000000000000 tokens is beyond")
+
+
 @pytest.mark.parametrize("places, out, fragment", [
     (f"[{{id: p, tokens: {10**21}}}, q]", "[q]", ":2: 'p': starts with 1000000000000000000000 tokens"),
     ("[{id: p, tokens: 1}, q]", f"{{q: {10**11}}}", ":3: 't': arc 't' -> 'q' has weight 100000000000"),

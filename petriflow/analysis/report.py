@@ -381,7 +381,7 @@ MAX_EXACT = 2**60
 
 
 def _check_range(net: Net) -> None:
-    """Refuse weights and initial tokens beyond the analysis's exact range (exit 2).
+    """Refuse weights, initial and final tokens beyond the analysis's exact range (exit 2).
 
     Raises:
         PetriflowError: naming the arc or place.
@@ -394,6 +394,10 @@ def _check_range(net: Net) -> None:
         if count > MAX_EXACT:
             raise PetriflowError(f"place {place!r}: {count} initial tokens are beyond what the analysis"
                                  f" counts exactly (at most 2**60)")
+    for place, count in (net.final_marking or {}).items():
+        if count > MAX_EXACT:
+            raise PetriflowError(f"place {place!r}: a final marking of {count} tokens is beyond what the"
+                                 f" analysis counts exactly (at most 2**60)")
 
 
 def _count(number: int, noun: str) -> str:
