@@ -121,7 +121,8 @@ def run_local(payloads: list[dict[str, Any]], workers: int, timeout: float) -> I
                     result = None
                 worker.job = None
                 if result is None:
-                    code = worker.process.exitcode if not worker.process.is_alive() else None
+                    worker.process.join(2)  # the pipe closes a moment before the process is gone
+                    code = worker.process.exitcode
                     worker.kill()
                     pool[pool.index(worker)] = _Worker(context)
                     result = _failed("crashed", f"the worker process died (exit code {code})", wall)
