@@ -29,8 +29,10 @@ def did_you_mean(name: str, candidates: Iterable[str]) -> str:
         " (did you mean 'grab'?)"
         >>> did_you_mean("zzz", ["grab"])
         ''
+        >>> did_you_mean(-1, ["grab"])  # a name read from a file may be any YAML key
+        ''
     """
-    close = difflib.get_close_matches(name, list(candidates), n=3, cutoff=0.6)
+    close = difflib.get_close_matches(str(name), [str(c) for c in candidates], n=3, cutoff=0.6)
     if not close:
         return ""
     return " (did you mean " + " or ".join(repr(c) for c in close) + "?)"

@@ -337,3 +337,11 @@ def test_limits_are_raised_from_python(own_limits):
         loads_net(deep)
     own_limits.YAML_DEPTH = 100
     assert list(loads_net(deep).places) == ["a"]
+
+
+def test_a_parameter_named_by_a_number_is_one_line(tmp_path, capsys):
+    """Found by the nightly fuzz profile: params {seconds: 1, -1} made the hint a traceback."""
+    net = tmp_path / "k.yaml"
+    net.write_text("petriflow: 1\nplaces: [{id: i, tokens: 1}, o]\n"
+                   "transitions: [{id: t, action: core.wait, params: {seconds: 1, -1}, in: [i], out: [o]}]\n")
+    one_line_error(capsys, ["info", net], "k.yaml:3: 't': action has no parameter -1")

@@ -248,6 +248,13 @@ class PlanPath(_Instant):
         "scene": Port("place holding the latest scene, read when no input token has one"),
     }
 
+    def setup(self, world: Any) -> None:
+        """Compile (or load) the search before the run: the first plan of a process
+        would otherwise pay numba's compile, in its ``report_ms`` too."""
+        from petriflow.agents.planning.astar import warm_up
+
+        warm_up()
+
     def run(self, ctx: ActionContext) -> dict[str, Any]:
         params = self.params
         robot = params["robot"] if params["robot"] is not None else ctx.agent

@@ -185,13 +185,20 @@ def build_channel(name: str, spec: dict[str, Any], where: str = "channels") -> C
     """
     spec = dict(spec)
     model = spec.pop("model", "ideal")
-    if not isinstance(model, str) or model not in CHANNEL_MODELS:
+    cls = CHANNEL_MODELS.get(model) if isinstance(model, str) else None
+    if cls is None and isinstance(model, str):
+        from petriflow.runtime.registry import default_registry
+
+        cls = default_registry.channel_model(model)
+    if cls is None:
+        from petriflow.runtime.registry import default_registry
+
+        known = [*CHANNEL_MODELS, *default_registry.channel_names()]
         raise NetFormatError(
-            f"unknown channel model {model!r}{did_you_mean(str(model), CHANNEL_MODELS)}"
-            f" (one of {', '.join(CHANNEL_MODELS)})",
+            f"unknown channel model {model!r}{did_you_mean(str(model), known)}"
+            f" (one of {', '.join(known)})",
             element=f"{where}.{name}",
         )
-    cls = CHANNEL_MODELS[model]
     if is_dataclass(cls):
         _check_parameters(cls, model, spec, f"{where}.{name}")
     try:

@@ -119,6 +119,7 @@ class Registry:
         self._actions: dict[str, ActionSpec] = {}
         self._predicates: dict[str, Predicate] = {}
         self._metrics: dict[str, MetricSpec] = {}
+        self._channels: dict[str, Any] = {}
         self._plugins_pending = load_plugins
         #: ``{entry point: error}`` of the plugins that failed to load.
         self.broken: dict[str, str] = {}
@@ -168,6 +169,31 @@ class Registry:
         if not doc and not isinstance(target, str) and target.__doc__:
             doc = target.__doc__.strip().splitlines()[0]
         self._metrics[name] = MetricSpec(name, target, events, doc)
+
+    def register_channel(self, name: str, target: type | str, *, replace: bool = False) -> None:
+        """Register a channel model class (a :class:`~petriflow.runtime.channels.ChannelModel`
+        subclass, or a lazy ``"module:Class"``) that run configurations name as
+        ``channels: {bus: {model: NAME, ...}}``."""
+        if name in self._channels and not replace:
+            raise PetriflowError(f"channel model {name!r} is already registered")
+        self._channels[name] = target
+
+    def channel_model(self, name: str) -> type | None:
+        """The channel model class registered as ``name``, or ``None``."""
+        self._load_plugins()
+        target = self._channels.get(name)
+        if isinstance(target, str):
+            module_name, _, attribute = target.partition(":")
+            try:
+                target = self._channels[name] = getattr(importlib.import_module(module_name), attribute)
+            except (ImportError, AttributeError) as exc:
+                raise UnknownActionError(f"channel model {name!r}: cannot load {target!r}: {exc}") from exc
+        return target
+
+    def channel_names(self) -> list[str]:
+        """Registered channel model names, sorted."""
+        self._load_plugins()
+        return sorted(self._channels)
 
     def metric(self, name: str, *, events: bool = False, replace: bool = False) -> Callable:
         """Decorator registering a metric; ``events``: it reads the run's events."""

@@ -135,10 +135,11 @@ def test_two_processes_never_write_one_journal(tmp_path):
     gets one line and exit 2; the first finishes the journal alone, event for event."""
     net = tmp_path / "ticker.yaml"
     net.write_text(TICKER)
-    run_files(net, until=1.0, trace=tmp_path / "whole.jsonl")
+    # 4 s of real time: enough for the rival processes to start while it runs, on a busy machine too
+    run_files(net, until=4.0, trace=tmp_path / "whole.jsonl")
     whole = (tmp_path / "whole.jsonl").read_text().splitlines()
     db = tmp_path / "run.sqlite"
-    first = _petriflow("run", net, "--until", "1", "--db", db, "--realtime", "--trace", tmp_path / "a.jsonl")
+    first = _petriflow("run", net, "--until", "4", "--db", db, "--realtime", "--trace", tmp_path / "a.jsonl")
     try:
         _wait_for_events(db, 4, first)
         second = _petriflow("run", net, "--until", "1", "--db", db, "--trace", tmp_path / "b.jsonl")
