@@ -29,8 +29,12 @@ needs to run it (plain data, absolute paths), so a trial's result depends only o
 (sweep, parameters, seed), on any backend.
 
 Examples:
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (folder / "n.yaml").write_text("petriflow: 1\\nplaces: [p]\\n")
     >>> sweep = Sweep.from_dict({"petriflow-sweep": 1, "net": "n.yaml", "trials": 2,
-    ...                          "matrix": {"a": [1, 2], "b": ["x", "y"]}}, "/tmp/s.yaml")
+    ...                          "matrix": {"a": [1, 2], "b": ["x", "y"]},
+    ...                          "set": {"run.faults": [{"join": "${b}", "at": "${a}"}]}}, folder / "s.yaml")
     >>> [row.params for row in sweep.rows]
     [{'a': 1, 'b': 'x'}, {'a': 1, 'b': 'y'}, {'a': 2, 'b': 'x'}, {'a': 2, 'b': 'y'}]
     >>> len(sweep.trials()), sweep.trials()[1]

@@ -1,0 +1,96 @@
+"""Ray sensors over a pybullet world: distance sensors and a planar laser.
+
+:func:`cast` casts a fan of rays from one point in one ``rayTestBatch`` call and
+returns each ray's range (``max_range`` when it hits nothing), ignoring the bodies
+given (the robot itself, its teammates when asked). :func:`laser_angles` is the beam
+layout of a planar scanner (seed 004: 8 m, 180 degrees, 360 beams).
+
+Examples:
+    >>> [round(a, 4) for a in laser_angles(180.0, 3)]
+    [-1.5708, 0.0, 1.5708]
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+__all__ = ["cast", "laser_angles", "walls_between"]
+
+
+def laser_angles(fov_deg: float, beams: int) -> list[float]:
+    """Beam angles (rad, robot frame) spread evenly over ``fov_deg``, centred ahead."""
+    if beams < 1:
+        raise ValueError(f"a laser needs at least one beam, got {beams}")
+    if beams == 1:
+        return [0.0]
+    half = math.radians(fov_deg) / 2.0
+    return [-half + i * (2 * half) / (beams - 1) for i in range(beams)]
+
+
+def cast(world: Any, origin: tuple[float, float], heading: float, angles: Sequence[float], max_range: float,
+         *, z: float = 0.1, ignore: Iterable[int] = ()) -> list[float]:
+    """Ranges (m) of rays from ``origin`` at ``heading + angle`` for each angle.
+
+    A ray that hits only ignored bodies (or nothing) reads ``max_range``; one hitting an
+    ignored body is cast again from just past it, up to twice.
+    """
+    p = world.p
+    ignored = set(ignore)
+    x, y = origin
+    starts = [(x, y, z)] * len(angles)
+    ends = [(x + max_range * math.cos(heading + a), y + max_range * math.sin(heading + a), z) for a in angles]
+    ranges = [max_range] * len(angles)
+    pending = list(range(len(angles)))
+    offset = [0.0] * len(angles)
+    for _ in range(3):
+        if not pending:
+            break
+        hits = p.rayTestBatch([starts[i] for i in pending], [ends[i] for i in pending],
+                              physicsClientId=world.client)
+        again = []
+        for i, hit in zip(pending, hits):
+            body, fraction = hit[0], hit[2]
+            if body < 0:
+                continue
+            length = math.dist(starts[i], ends[i])
+            if body in ignored:
+                advance = fraction * length + 0.02
+                offset[i] += advance
+                sx, sy, _ = starts[i]
+                a = heading + angles[i]
+                starts[i] = (sx + advance * math.cos(a), sy + advance * math.sin(a), z)
+                if offset[i] < max_range:
+                    again.append(i)
+                continue
+            ranges[i] = min(max_range, offset[i] + fraction * length)
+        pending = again
+    return ranges
+
+
+def walls_between(world: Any, a: tuple[float, float], b: tuple[float, float], *, z: float = 0.1,
+                  ignore: Iterable[int] = (), most: int = 16) -> int:
+    """How many solid bodies (walls) a straight line from ``a`` to ``b`` crosses, not
+    counting the ``ignore`` bodies (the two robots), at most ``most``."""
+    p = world.p
+    ignored = set(ignore)
+    count = 0
+    start = (a[0], a[1], z)
+    end = (b[0], b[1], z)
+    total = math.dist(start, end)
+    travelled = 0.0
+    while count < most and travelled < total:
+        hit = p.rayTest(start, end, physicsClientId=world.client)[0]
+        if hit[0] < 0:
+            break
+        if hit[0] not in ignored:
+            count += 1
+        step = hit[2] * math.dist(start, end)
+        # continue from just beyond the body's far side: march until out of it
+        direction = ((end[0] - start[0]) / max(math.dist(start, end), 1e-9),
+                     (end[1] - start[1]) / max(math.dist(start, end), 1e-9))
+        advance = step + 0.05
+        travelled += advance
+        start = (start[0] + direction[0] * advance, start[1] + direction[1] * advance, z)
+    return count
