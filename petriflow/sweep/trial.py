@@ -206,7 +206,7 @@ def build(spec: dict[str, Any], params: dict[str, Any], seed: int) -> Built:
     return Built(net, net_path, config, binding, _world_data(config, sets["world"]), metrics)
 
 
-def _measure(spec: dict[str, Any], params: dict[str, Any], seed: int) -> tuple[dict[str, Any], str]:
+def _measure(spec: dict[str, Any], params: dict[str, Any], seed: int) -> tuple[dict[str, Any], str, str | None]:
     from petriflow.runtime.metrics import RunRecord
     from petriflow.runtime.scheduler import Scheduler
 
@@ -239,7 +239,7 @@ def _measure(spec: dict[str, Any], params: dict[str, Any], seed: int) -> tuple[d
     finally:
         if world is not None:
             world.close()
-    return measured, str(getattr(result.reason, "value", result.reason))
+    return measured, str(getattr(result.reason, "value", result.reason)), result.error
 
 
 def run_trial(payload: dict[str, Any]) -> dict[str, Any]:
@@ -247,12 +247,13 @@ def run_trial(payload: dict[str, Any]) -> dict[str, Any]:
 
     Returns:
         ``{"status": "ok" | "error", "metrics": {name: value}, "outcome": reason,
-        "error": one line or None, "wall": seconds}``.
+        "error": one line or None (the trial's error, or the run's unrouted failure),
+        "wall": seconds}``.
     """
     started = wallclock.perf_counter()
     try:
-        metrics, outcome = _measure(payload["sweep"], payload["params"], payload["seed"])
-        status, error = "ok", None
+        metrics, outcome, error = _measure(payload["sweep"], payload["params"], payload["seed"])
+        status = "ok"  # a run that ended failed is a measured run; its error is kept
     except PetriflowError as exc:
         metrics, outcome, status, error = {}, None, "error", str(exc)
     except (Exception, RecursionError) as exc:  # a trial's crash is its own row, the sweep goes on
