@@ -37,19 +37,22 @@ class Explorer:
 
     def __init__(self, start: Cell) -> None:
         self.stack: list[Cell] = [start]
+        self.here: Cell = start
         self.visited: set[Cell] = set()
         self.known: set[Cell] = set()
         self.open: dict[Cell, list[str]] = {}
 
     @property
     def cell(self) -> Cell:
-        return self.stack[-1] if self.stack else (0, 0)
+        """Where the robot is (the last cell it sensed, or its start)."""
+        return self.here
 
     def sense(self, cell: Cell, open_sides: Iterable[str]) -> None:
         """The robot is in ``cell`` and sees these sides open."""
         sides = [s for s in open_sides if s in _OFFSET]
         self.visited.add(cell)
         self.open[cell] = sides
+        self.here = cell
 
     def learn(self, cells: Iterable[Cell]) -> None:
         """Cells other agents have explored: not to be entered again."""
@@ -60,21 +63,55 @@ class Explorer:
         sides = set(self.open.get(cell, []))
         return sides not in STRAIGHT
 
+    def _new(self, cell: Cell) -> list[Cell]:
+        out = []
+        for side in self.open.get(cell, []):
+            dr, dc = _OFFSET[side]
+            there = (cell[0] + dr, cell[1] + dc)
+            if there not in self.visited and there not in self.known:
+                out.append(there)
+        return out
+
     def next_cell(self) -> Cell | None:
-        """Where to go next: a new cell, one cell back, or ``None`` when done."""
+        """Where to go next: a new cell, one cell back, or ``None`` when done. When the
+        way back is used up (after a detour, or cells forgotten), the robot goes to the
+        nearest visited cell that still opens onto an unexplored one."""
         while self.stack:
             here = self.stack[-1]
-            for side in self.open.get(here, []):
-                dr, dc = _OFFSET[side]
-                there = (here[0] + dr, here[1] + dc)
-                if there not in self.visited and there not in self.known and there not in self.stack:
+            for there in self._new(here):
+                if there not in self.stack:
                     self.stack.append(there)
                     return there
             self.stack.pop()
             if self.stack:
                 return self.stack[-1]
+        path = self._to_frontier()
+        if path is None:
+            return None
+        self.stack = path
+        return path[1] if len(path) > 1 else self.next_cell()
+
+    def _to_frontier(self) -> list[Cell] | None:
+        """Visited cells from here to the nearest one with an unexplored open side."""
+        from collections import deque
+
+        start = self.here
+        if start not in self.visited:
+            return None
+        parent: dict[Cell, Cell | None] = {start: None}
+        queue = deque([start])
+        while queue:
+            cell = queue.popleft()
+            if self._new(cell):
+                path = [cell]
+                while parent[path[-1]] is not None:
+                    path.append(parent[path[-1]])
+                return path[::-1]
+            for side in self.open.get(cell, []):
+                dr, dc = _OFFSET[side]
+                there = (cell[0] + dr, cell[1] + dc)
+                if there in self.visited and there not in parent:
+                    parent[there] = cell
+                    queue.append(there)
         return None
 
-    @property
-    def done(self) -> bool:
-        return not self.stack

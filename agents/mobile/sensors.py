@@ -34,7 +34,8 @@ def cast(world: Any, origin: tuple[float, float], heading: float, angles: Sequen
     """Ranges (m) of rays from ``origin`` at ``heading + angle`` for each angle.
 
     A ray that hits only ignored bodies (or nothing) reads ``max_range``; one hitting an
-    ignored body is cast again from just past it, up to twice.
+    ignored body (each link of a robot: chassis, wheels, caster) is cast again from just
+    past the hit, as often as it takes to leave them behind.
     """
     p = world.p
     ignored = set(ignore)
@@ -44,7 +45,7 @@ def cast(world: Any, origin: tuple[float, float], heading: float, angles: Sequen
     ranges = [max_range] * len(angles)
     pending = list(range(len(angles)))
     offset = [0.0] * len(angles)
-    for _ in range(3):
+    for _ in range(64):
         if not pending:
             break
         hits = p.rayTestBatch([starts[i] for i in pending], [ends[i] for i in pending],

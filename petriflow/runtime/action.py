@@ -193,6 +193,7 @@ class ActionContext:
     emitted: list[tuple[str, dict[str, Any]]] | None = None
     _rng: random.Random | None = field(default=None, repr=False)
     _reader: Callable[[str], list[Any]] | None = field(default=None, repr=False)
+    _links: Callable[[str], tuple[Any, str | None]] | None = field(default=None, repr=False)
 
     @property
     def rng(self) -> random.Random:
@@ -234,6 +235,17 @@ class ActionContext:
         """The data of the newest token in the port's place, or ``default``."""
         tokens = self.read(port)
         return tokens[-1] if tokens else default
+
+    def link(self, place: str) -> tuple[Any, str | None]:
+        """The channel model that carries the channel place ``place`` and the agent that
+        receives from it, to judge a link before sending (a radio's RSSI, a bus).
+
+        Raises:
+            PetriflowError: no run, or ``place`` is not a channel place.
+        """
+        if self._links is None:
+            raise PetriflowError(f"{self.transition!r}: no run to look up channel place {place!r} in")
+        return self._links(place)
 
     def put(self, place: str, data: Any) -> None:
         """Give the tokens this firing produces in ``place`` the data ``data`` instead

@@ -307,15 +307,31 @@ class Channels:
         self.rng = random.Random(f"{seed}:channels")
         self.receiver = receivers(run.net)
         self.channel = {p.id: p.channel for p in run.net.places.values() if p.channel is not None}
+        for model in self.models.values():
+            bind = getattr(model, "bind", None)
+            if callable(bind):  # a model that measures the world (walls between agents...)
+                bind(getattr(run, "world", None))
+
+    def model_for(self, place: str) -> tuple[ChannelModel, str | None]:
+        """The model carrying the channel place ``place`` and the agent receiving from it.
+
+        Raises:
+            PetriflowError: ``place`` is not a channel place.
+        """
+        channel = self.channel.get(place)
+        if channel is None:
+            raise PetriflowError(f"{place!r} is not a channel place")
+        model = self.models.get(channel)
+        if model is None:
+            model = self.models[channel] = IdealChannel()
+        return model, self.receiver[place]
 
     def send(self, place: str, data: Any, sender: str | None) -> None:
         """Put a message into ``place``: record it and schedule its delivery, or its loss."""
         run = self.run
         channel = self.channel[place]
         receiver = self.receiver[place]
-        model = self.models.get(channel)
-        if model is None:
-            model = self.models[channel] = IdealChannel()
+        model, _ = self.model_for(place)
         distance = None
         world = run.world
         if sender and receiver and hasattr(world, "distance"):

@@ -1,0 +1,473 @@
+"""The framework's processes and the mapping task as actions nets bind by name.
+
+Start-up, in order (seed 000 §3.2), each a transition of every agent's subnet:
+
+* ``comm.characterise`` (process 1): the robot's wheels and encoders give ``dpp``
+  (eq. 2); its start on the odometry grid ``pg`` (eq. 3) is reported. Makes the
+  agent's state (:class:`~petriflow.agents.comm.agent.CommAgent`), the token data of
+  its subnet from then on.
+* ``comm.analyse`` (process 2): the Fig. 5 sweep on the radio model of one of its
+  channel places: the distance up to which nothing is lost behind a wall, and the RSSI
+  threshold it will use.
+* ``comm.initialise`` (process 3): its address by eq. 4 (or, for a late joiner, the
+  first free address of a peer's DHCP pool, eq. 5).
+* ``comm.history`` (process 4): empty ``Ad`` and ``Ah``; puts the state into the
+  agent's work loop and its listening place.
+
+Then the task, as a loop per agent: ``comm.explore`` (a robot moves to the next cell,
+senses its walls with four distance rays, adds a vertex, and plans what to send with
+Algorithm 1 for each peer it hears above the threshold) or ``comm.listen`` (a static
+agent: a monitor or the central unit, waits ``period`` s and plans); ``comm.send`` puts
+one waiting message into the channel place towards a peer (process 5: a token sized in
+bytes); ``comm.receive`` takes one from a channel place into the agent's history.
+Guards route the loop: ``comm.has_message`` (for the transition's ``peer``),
+``comm.going_on`` and ``comm.finished``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from petriflow.agents.comm.agent import CommAgent, Peer
+from petriflow.agents.comm.framework import History, addresses, dhcp_pools, dpp, grid_position, grid_size
+from petriflow.agents.comm.radio import RadioChannel, pick_threshold, threshold_sweep
+
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+
+__all__ = [
+    "GUARDS",
+    "Analyse",
+    "Characterise",
+    "Explore",
+    "Initialise",
+    "Listen",
+    "MakeHistory",
+    "Receive",
+    "Send",
+]
+
+
+def _state(ctx: ActionContext) -> CommAgent:
+    state = ctx.token()
+    if not isinstance(state, CommAgent):
+        raise ActionFailure(f"{ctx.transition!r}: the input token carries no agent state (got {type(state).__name__})")
+    return state
+
+
+class _Instant(Action):
+    """Does its work in ``start``; ends ok at the first poll."""
+
+    def start(self, ctx: ActionContext) -> None:
+        ctx.result = self.run(ctx)
+
+    def poll(self, ctx: ActionContext) -> Status:
+        return Status.OK
+
+    def run(self, ctx: ActionContext) -> Any:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+
+class Characterise(_Instant):
+    """Process 1: make the agent's state; a robot's dpp (eq. 2) and start on the grid (eq. 3)."""
+
+    params = {
+        "kind": Param(str, "robot", "robot, monitor or central", choices=("robot", "monitor", "central")),
+        "wheel_radius": Param(float, 0.025, "wheel radius r (m)"),
+        "ppr": Param(int, 200, "encoder pulses per wheel revolution"),
+        "track": Param(float, 0.2, "distance between the wheels (m)"),
+        "area": Param(list, [5.0, 5.0], "the environment's size D = [Dx, Dy] (m)"),
+        "cell": Param(float, 0.5, "the maze's cell size (m): where the robot stops to sense"),
+        "cols": Param(int, 10, "cells per maze row (a vertex id is row * cols + col)"),
+        "origin": Param(list, [0.0, 0.0], "world (x, y) of the maze's south-west corner"),
+    }
+
+    def run(self, ctx: ActionContext) -> CommAgent:
+        p = self.params
+        agent = ctx.agent or ctx.transition
+        state = CommAgent(agent, p["kind"], cell=p["cell"], origin=tuple(p["origin"]), cols=p["cols"])
+        report: dict[str, Any] = {"agent": agent, "role": p["kind"]}
+        if p["kind"] == "robot":
+            if ctx.world is None:
+                raise ActionFailure("comm.characterise: a robot needs a world")
+            from petriflow.agents.mobile.explore import Explorer
+            from petriflow.agents.mobile.kinematic import KinematicRobot
+
+            step = dpp(p["wheel_radius"], p["ppr"])
+            state.robot = KinematicRobot(ctx.world, agent, radius=p["wheel_radius"], ppr=p["ppr"], track=p["track"])
+            x, y, _ = state.robot.pose
+            state.explorer = Explorer(self._cell(state, x, y))
+            report.update(dpp_mm=round(step * 1000, 4), grid=list(grid_size(tuple(p["area"]), [step])),
+                          pg=list(grid_position((x - state.origin[0], y - state.origin[1]), step)))
+        ctx.emit("comm.characterised", **report)
+        return state
+
+    @staticmethod
+    def _cell(state: CommAgent, x: float, y: float) -> tuple[int, int]:
+        return (int((y - state.origin[1]) // state.cell), int((x - state.origin[0]) // state.cell))
+
+
+class Analyse(_Instant):
+    """Process 2: sweep the link of a channel place behind a wall (Fig. 5); keep the threshold."""
+
+    params = {
+        "channel_place": Param(str, doc="a channel place of this agent whose radio to analyse"),
+        "distances": Param(int, 10, "distances 1..N m"),
+        "trials": Param(int, 100, "frames per distance"),
+    }
+
+    def run(self, ctx: ActionContext) -> CommAgent:
+        state = _state(ctx)
+        model, _ = ctx.link(self.params["channel_place"])
+        if isinstance(model, RadioChannel):
+            rows = threshold_sweep(model, range(1, self.params["distances"] + 1), walls=1,
+                                   trials=self.params["trials"], seed=ctx.seed)
+            distance, level = pick_threshold(rows)
+            ctx.emit("comm.analysed", lossless_behind_wall_m=distance, rssi_there_dbm=level,
+                     threshold_dbm=model.threshold_dbm, range_m=round(model.range(), 3))
+        return state
+
+
+class Initialise(_Instant):
+    """Process 3: the agent's address (eq. 4), or one from a peer's DHCP pool (eq. 5)."""
+
+    params = {
+        "index": Param(int, 0, "this agent's index i among the initial agents"),
+        "agents": Param(int, 1, "N, the initial agents (the robots)"),
+        "available": Param(int, 253, "A, the addresses available"),
+        "pool_of": Param((int, type(None)), None, "a late joiner: take the first free address of agent i's pool"),
+        "address": Param((int, type(None)), None, "a fixed address instead (the central unit)"),
+        "peers": Param(dict, {}, "peer agent -> {address: A, box: channel place towards it}"),
+    }
+
+    def run(self, ctx: ActionContext) -> CommAgent:
+        state = _state(ctx)
+        p = self.params
+        team = addresses(p["agents"], p["available"])
+        if p["address"] is not None:
+            state.address = p["address"]
+        elif p["pool_of"] is not None:
+            state.address = dhcp_pools(p["agents"], p["available"])[p["pool_of"]][0]
+        else:
+            if not 0 <= p["index"] < p["agents"]:
+                raise ActionFailure(f"comm.initialise: index {p['index']} is not one of {p['agents']} agents")
+            state.address = team[p["index"]]
+        state.team = set(team)
+        for name, peer in p["peers"].items():
+            state.peers[name] = Peer(name, int(peer["address"]), str(peer["box"]))
+        ctx.emit("comm.initialised", address=f"192.168.1.{state.address}")
+        return state
+
+
+class MakeHistory(_Instant):
+    """Process 4: the empty data and history arrays."""
+
+    def run(self, ctx: ActionContext) -> CommAgent:
+        state = _state(ctx)
+        state.history = History(state.address)
+        return state
+
+
+def _plan(ctx: ActionContext, state: CommAgent) -> None:
+    """Algorithm 1 towards every peer heard above the threshold now."""
+    state.in_range = set()
+    for peer in state.peers.values():
+        model, _ = ctx.link(peer.box)
+        usable = model.usable(state.name, peer.name) if isinstance(model, RadioChannel) else True
+        if usable:
+            state.in_range.add(peer.name)
+            state.plan_for(peer)
+
+
+class Explore(Action):
+    """A robot goes to its next cell, senses its walls, maps a vertex, plans what to send.
+
+    After its own exploration it heads for the place it last heard from a robot whose
+    data it lacks (a rendezvous), and waits there; a decentralised robot that has waited
+    ``give_up`` s re-explores what the silent robots had claimed.
+    """
+
+    params = {
+        "speed": Param(float, 0.15, "cruise speed (m/s)"),
+        "turn_rate": Param(float, 1.5, "turn rate on the spot (rad/s)"),
+        "sensor_z": Param(float, 0.1, "height of the distance sensors (m)"),
+        "give_up": Param(float, 240.0, "seconds after its exploration to wait for silent robots"),
+        "reexplore": Param(bool, True, "re-explore silent robots' cells after give_up (decentralised)"),
+        "wait": Param(float, 1.0, "seconds between plans while waiting"),
+        "jitter": Param(float, 0.1, "each move's speed is the cruise speed times U(1 - j, 1 + j) (seeded)"),
+        "stop_at": Param((float, int, type(None)), None, "a mechanical failure at this time: the robot stops"
+                         " moving for good, its radio goes on"),
+    }
+    needs_world = True
+
+    def start(self, ctx: ActionContext) -> None:
+        self.state = state = _state(ctx)
+        if state.robot is None:
+            raise ActionFailure("comm.explore: the agent has no robot (use comm.listen for static agents)")
+        self.goal = None
+        self.waiting = 0.0
+        jitter = min(max(self.params["jitter"], 0.0), 0.9)
+        self.speed = self.params["speed"] * (1.0 + jitter * (2.0 * ctx.rng.random() - 1.0))
+        explorer = state.explorer
+        stop_at = self.params["stop_at"]
+        if stop_at is not None and ctx.now >= stop_at:
+            if not state.broken:
+                state.broken = True
+                ctx.emit("comm.broken", distance_m=round(state.robot.travelled, 3))
+            self.waiting = self.params["wait"]
+            ctx.result = state
+            return
+        if not state.explored:
+            if not explorer.visited:
+                self.goal = explorer.cell
+            else:
+                self.goal = explorer.next_cell()
+                if self.goal is None:
+                    self._explored(ctx)
+        if state.explored:
+            self._route(ctx)
+        ctx.result = state
+
+    def _explored(self, ctx: ActionContext) -> None:
+        state = self.state
+        state.explored = True
+        state.explored_at = ctx.now
+        state.final[state.address] = len(state.history.items(state.address))
+        ctx.emit("comm.explored", vertices=state.final[state.address], distance_m=round(state.robot.travelled, 3))
+
+    def _route(self, ctx: ActionContext) -> None:
+        """After exploring: go towards a robot whose data is missing, else wait."""
+        state = self.state
+        missing = state.missing()
+        if missing and ctx.now - max(state.explored_at or 0.0, state.last_news) > self.params["give_up"]:
+            if self.params["reexplore"] and not state.reexplored:
+                state.reexplored = True
+                cells = {(v // state.cols, v % state.cols) for s in missing for v in
+                         [item[0] for item in state.history.items(s)]}
+                state.explorer.known -= cells
+                state.explorer.stack = []
+                state.explored = False
+                state.parked = False
+                state.route = []
+                del state.final[state.address]
+                self.goal = state.explorer.next_cell()
+                ctx.emit("comm.reexplore", silent=sorted(missing), cells=len(cells))
+                return
+            if not state.gave_up >= set(missing):
+                state.gave_up |= set(missing)
+                ctx.emit("comm.gave_up", silent=sorted(missing))
+        waiting_for = [s for s in missing if s not in state.gave_up]
+        waiting_for += [state.peers[name].address for name in state.untold()
+                        if state.peers[name].address not in waiting_for]
+        if waiting_for and not state.route and not state.parked:
+            state.route = self._meeting_route(waiting_for)
+            state.parked = not state.route
+        if state.route:
+            self.goal = state.route.pop(0)
+        else:
+            self.goal = None
+            self.waiting = self.params["wait"]
+
+    def _meeting_route(self, sources: list[int]) -> list[tuple[int, int]]:
+        """Cells to a place to meet a robot whose data is missing: the nearest visited
+        cell with an open side into a cell that robot mapped (the border between the two
+        explored regions), else the visited cell nearest where it was last heard of."""
+        import networkx as nx
+
+        state = self.state
+        explorer = state.explorer
+        graph = self._graph()
+        here = explorer.cell
+        if here not in graph:
+            return []
+        lengths = nx.single_source_shortest_path_length(graph, here)
+        offsets = {"north": (1, 0), "south": (-1, 0), "east": (0, 1), "west": (0, -1)}
+        for source in sources:
+            theirs = {(item[0] // state.cols, item[0] % state.cols) for item in state.history.items(source)}
+            border = [cell for cell in lengths if any(
+                (cell[0] + offsets[side][0], cell[1] + offsets[side][1]) in theirs
+                for side in explorer.open.get(cell, []))]
+            if border:
+                goal = min(border, key=lambda c: (lengths[c], c))
+                return nx.shortest_path(graph, here, goal)[1:]
+        for source in sources:
+            if source in state.last_seen:
+                return self._path_to(state.last_seen[source])
+        return []
+
+    def _graph(self):
+        import networkx as nx
+
+        explorer = self.state.explorer
+        graph = nx.Graph()
+        graph.add_node(explorer.cell)
+        offsets = {"north": (1, 0), "south": (-1, 0), "east": (0, 1), "west": (0, -1)}
+        for cell, sides in explorer.open.items():
+            graph.add_node(cell)
+            for side in sides:
+                other = (cell[0] + offsets[side][0], cell[1] + offsets[side][1])
+                if other in explorer.visited:
+                    graph.add_edge(cell, other)
+        return graph
+
+    def _path_to(self, target: tuple[float, float]) -> list[tuple[int, int]]:
+        """Cells from here to the visited cell nearest ``target``, through visited cells."""
+        import networkx as nx
+
+        state = self.state
+        explorer = state.explorer
+        graph = nx.Graph()
+        offsets = {"north": (1, 0), "south": (-1, 0), "east": (0, 1), "west": (0, -1)}
+        for cell, sides in explorer.open.items():
+            for side in sides:
+                other = (cell[0] + offsets[side][0], cell[1] + offsets[side][1])
+                if other in explorer.visited:
+                    graph.add_edge(cell, other)
+        here = explorer.cell
+        if here not in graph:
+            return []
+        centre = lambda c: (state.origin[0] + (c[1] + 0.5) * state.cell, state.origin[1] + (c[0] + 0.5) * state.cell)
+        nearest = min(graph.nodes, key=lambda c: math.dist(centre(c), target))
+        if nearest == here:
+            return []
+        return nx.shortest_path(graph, here, nearest)[1:]
+
+    def poll(self, ctx: ActionContext) -> Status:
+        state = self.state
+        robot = state.robot
+        dt = ctx.world.dt
+        if self.goal is None:
+            self.waiting -= dt
+            if self.waiting > 0:
+                return Status.RUNNING
+            _plan(ctx, state)
+            return Status.OK
+        cell = self.goal
+        target = (state.origin[0] + (cell[1] + 0.5) * state.cell, state.origin[1] + (cell[0] + 0.5) * state.cell)
+        if not robot.step_towards(target, self.speed, self.params["turn_rate"], dt):
+            return Status.RUNNING
+        self._sense(ctx, cell)
+        ctx.emit("comm.step", cell=list(cell), distance_m=round(robot.travelled, 3))
+        if state.explorer.stack and state.explorer.stack[-1] != cell and not state.explored:
+            state.explorer.stack.append(cell)  # arrived by a route, not by the explorer
+        _plan(ctx, state)
+        return Status.OK
+
+    def _sense(self, ctx: ActionContext, cell: tuple[int, int]) -> None:
+        from petriflow.agents.mobile.sensors import cast
+
+        state = self.state
+        world = ctx.world
+        x, y, _ = state.robot.pose
+        robots = [world.body(name) for name in world.agents]
+        angles = [math.pi / 2, -math.pi / 2, 0.0, math.pi]  # north, south, east, west (world frame)
+        ranges = cast(world, (x, y), 0.0, angles, state.cell, z=self.params["sensor_z"], ignore=robots)
+        sides = [side for side, reach in zip(("north", "south", "east", "west"), ranges) if reach > 0.75 * state.cell]
+        state.explorer.sense(cell, sides)
+        if state.explorer.is_vertex(cell):
+            ox, oy, _ = state.robot.odometry
+            vertex_id = cell[0] * state.cols + cell[1]
+            vertex = (vertex_id, round(ox, 2), round(oy, 2))
+            if vertex_id not in state.vertices and state.history.add_own(vertex):
+                ctx.emit("comm.learnt", ids=[vertex_id], distance_m=round(state.robot.travelled, 3))
+
+
+class Listen(_Instant):
+    """A static agent (monitor, central unit): wait ``period`` s, then plan what to send."""
+
+    params = {"period": Param(float, 1.0, "seconds between plans"),
+              "give_up": Param(float, 240.0, "seconds without news after which missing robots are given up")}
+
+    def start(self, ctx: ActionContext) -> None:
+        self.state = _state(ctx)
+        self.left = self.params["period"]
+        ctx.result = self.state
+
+    def poll(self, ctx: ActionContext) -> Status:
+        self.left -= ctx.world.dt if ctx.world is not None else self.left
+        if self.left > 1e-9:
+            return Status.RUNNING
+        state = self.state
+        missing = state.missing()
+        if missing and ctx.now - state.last_news > self.params["give_up"] and not state.gave_up >= set(missing):
+            if not state.gave_up >= set(missing):
+                state.gave_up |= set(missing)
+                ctx.emit("comm.gave_up", silent=sorted(missing))
+        _plan(ctx, state)
+        return Status.OK
+
+    needs_world = True
+
+
+class Send(_Instant):
+    """Process 5: the next message waiting for ``peer`` into the channel place towards it."""
+
+    params = {"peer": Param(str, doc="the peer agent"), "box": Param(str, doc="the channel place towards it"),
+              "loop": Param(str, doc="the place the state goes back to")}
+
+    def run(self, ctx: ActionContext) -> CommAgent:
+        state = _state(ctx)
+        message = state.take(self.params["peer"])
+        if message is None:
+            raise ActionFailure(f"comm.send: nothing waiting for {self.params['peer']!r}")
+        ctx.put(self.params["box"], {"size": message.size, "payload": message.payload, "code": message.code,
+                                     "message": message})
+        ctx.put(self.params["loop"], state)
+        ctx.emit("comm.sent", to=self.params["peer"], code=message.code, bytes=message.size,
+                 payload=message.payload, source=message.source)
+        return state
+
+
+class Receive(_Instant):
+    """Take one message from a channel place into this agent's history and map."""
+
+    params = {"box": Param(str, doc="the channel place"), "state": Param(str, doc="the listening place")}
+
+    def run(self, ctx: ActionContext) -> CommAgent:
+        state = ctx.inputs[self.params["state"]][0]
+        packet = ctx.inputs[self.params["box"]][0]
+        message = packet["message"] if isinstance(packet, dict) else None
+        if not isinstance(state, CommAgent) or message is None:
+            raise ActionFailure("comm.receive: needs the agent's state and a message")
+        new = state.receive(message)
+        if new or message.final:
+            state.last_news = ctx.now
+        if new:
+            if state.explorer is not None:
+                state.explorer.learn((v // state.cols, v % state.cols) for v in new)
+            ctx.emit("comm.learnt", ids=new)
+        ctx.put(self.params["state"], state)
+        return None
+
+
+def has_message(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+    """Guard: the agent has a message waiting for ``params['peer']`` and hears it."""
+    state = next((d for ts in tokens.values() for d in ts if isinstance(d, CommAgent)), None)
+    return state is not None and state.has_for(params["peer"])
+
+
+def _done(state: CommAgent) -> bool:
+    if state.kind == "robot" and not state.explored:
+        return False
+    silent = {name for name, peer in state.peers.items() if peer.address in state.gave_up}
+    waiting = any(box for name, box in state.outbox.items() if name not in silent)
+    return state.complete_sources(state.gave_up) and not waiting and not state.untold()
+
+
+def finished(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+    """Guard: the agent holds the whole map and has nothing left to send (or gave up)."""
+    state = next((d for ts in tokens.values() for d in ts if isinstance(d, CommAgent)), None)
+    if state is None:
+        return False
+    if state.finished or _done(state):
+        state.finished = True
+        return True
+    return False
+
+
+def going_on(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+    """Guard: the agent is not finished."""
+    return not finished(tokens, params)
+
+
+GUARDS = {"comm.has_message": has_message, "comm.finished": finished, "comm.going_on": going_on}

@@ -1,0 +1,197 @@
+"""One agent of seed 000's framework: what it knows, what it has to send, its robot.
+
+A :class:`CommAgent` travels as the data of its subnet's tokens (the same object in
+its work loop and in its listening place), so every transition of the agent sees and
+updates one state: the history (:class:`~petriflow.agents.comm.framework.History`),
+the topological map, the messages waiting for each peer, and, for a robot, its body,
+odometry and exploration.
+
+Map data is the history's data: an item is a vertex ``(id, x, y)`` whose id is the
+maze cell the robot's odometry puts it in (one byte). A source's data is final when
+its robot has explored all it will: the header then says so (the top bit of the
+code byte; the paper's codes 0-3 need two bits), so other agents know when they hold
+all of it.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any
+
+from petriflow.agents.comm.framework import History, Message, plan
+
+__all__ = ["CommAgent", "Peer"]
+
+
+@dataclass
+class Peer:
+    """Another agent this one can talk to: its address and the channel place to it."""
+
+    name: str
+    address: int
+    box: str
+
+
+@dataclass
+class CommAgent:
+    """The state of one agent (see the module)."""
+
+    name: str
+    kind: str                      # robot, monitor or central
+    address: int = 0
+    peers: dict[str, Peer] = field(default_factory=dict)
+    team: set = field(default_factory=set)                   # addresses of every robot of the mission
+    history: History | None = None
+    robot: Any = None              # KinematicRobot
+    explorer: Any = None           # Explorer
+    cell: float = 0.5
+    origin: tuple[float, float] = (0.0, 0.0)
+    cols: int = 1
+    explored: bool = False
+    explored_at: float | None = None
+    final: dict[int, int] = field(default_factory=dict)      # source -> items it has in all
+    outbox: dict[str, deque] = field(default_factory=dict)  # peer -> messages waiting
+    asked: set = field(default_factory=set)                  # (peer, source) queries answered by no reply yet
+    in_range: set = field(default_factory=set)
+    last_seen: dict[int, tuple[float, float]] = field(default_factory=dict)  # source -> last vertex position
+    route: list = field(default_factory=list)
+    finished: bool = False
+    reexplored: bool = False
+    broken: bool = False                         # a mechanical failure: it cannot move
+    parked: bool = False                         # waiting at its meeting place
+    gave_up: set = field(default_factory=set)   # robots given up on (silent too long)
+    last_news: float = 0.0                       # simulated time new map data last arrived
+    sent_bytes: int = 0
+    payload_bytes: int = 0
+
+    # Map -------------------------------------------------------------------------------
+    @property
+    def vertices(self) -> dict[int, tuple[float, float]]:
+        """The topological map: vertex id -> (x, y)."""
+        if self.history is None:
+            return {}
+        return {item[0]: (item[1], item[2]) for _, item, _ in self.history.data}
+
+    def by_address(self, address: int) -> Peer | None:
+        for peer in self.peers.values():
+            if peer.address == address:
+                return peer
+        return None
+
+    def complete_sources(self, ignore: set[int] = frozenset()) -> bool:
+        """Whether this agent holds the whole map: its own exploration ended (a robot),
+        and every other team robot's data is known final and held in full (``ignore``:
+        sources given up on)."""
+        if self.history is None:
+            return False
+        for source in self.team:
+            if source in ignore:
+                continue
+            if source == self.address:
+                if not self.explored:
+                    return False
+                continue
+            if source not in self.final or len(self.history.items(source)) < self.final[source]:
+                return False
+        return True
+
+    def missing(self) -> list[int]:
+        """Team robots (not this one) whose data is not known final and complete here."""
+        return sorted(s for s in self.team if s != self.address and
+                      (s not in self.final or len(self.history.items(s)) < self.final[s]))
+
+    def untold(self) -> list[str]:
+        """Peers (not given up on) this agent has not yet told that a source it holds in
+        full is final: it must meet them once more before it may stop."""
+        out = []
+        for name, peer in self.peers.items():
+            if peer.address in self.gave_up:
+                continue
+            for source, total in self.final.items():
+                if source == peer.address or len(self.history.items(source)) < total:
+                    continue
+                if ("final", name, source) not in self.asked:
+                    out.append(name)
+                    break
+        return out
+
+    # Messages --------------------------------------------------------------------------
+    def queue(self, message: Message) -> None:
+        peer = self.by_address(message.receiver)
+        if peer is not None:
+            self.outbox.setdefault(peer.name, deque()).append(message)
+
+    def plan_for(self, peer: Peer) -> None:
+        """Algorithm 1 towards ``peer`` (in range): queue what it should get, unless a
+        conversation about that source is under way; and, for every final source,
+        a query with its count and the final flag when the peer may lack it."""
+        waiting = {(m.source, m.code) for m in self.outbox.get(peer.name, ())}
+        for message in plan(self.history, peer.address):
+            message.final = message.source in self.final
+            if message.code == 0:
+                if (peer.name, message.source) in self.asked or (message.source, 0) in waiting:
+                    continue
+                self.asked.add((peer.name, message.source))
+            else:
+                if (message.source, 3) in waiting:
+                    continue
+                self.history.sent(peer.address, message.source, len(message.vertices))
+            self.queue(message)
+        for source, total in self.final.items():
+            key = ("final", peer.name, source)
+            if source == peer.address or key in self.asked:
+                continue
+            if len(self.history.items(source)) >= total:
+                self.asked.add(key)
+                note = Message(0, source, total, self.address, peer.address)
+                note.final = True
+                self.queue(note)
+
+    def take(self, peer: str) -> Message | None:
+        box = self.outbox.get(peer)
+        if not box:
+            return None
+        message = box.popleft()
+        self.sent_bytes += message.size
+        self.payload_bytes += message.payload
+        return message
+
+    def has_for(self, peer: str) -> bool:
+        return bool(self.outbox.get(peer)) and peer in self.in_range
+
+    def receive(self, message: Message) -> list[int]:
+        """Handle one message; returns the ids of vertices new to this agent."""
+        sender = self.by_address(message.sender)
+        new: list[int] = []
+        final = message.final
+        if message.code == 0:
+            if final:
+                self.final[message.source] = max(self.final.get(message.source, 0), message.count)
+            have = len(self.history.items(message.source))
+            wanted = max(0, message.count - have)
+            if wanted and sender is not None:
+                self.queue(Message(1, message.source, wanted, self.address, message.sender))
+        elif message.code == 1:
+            if sender is not None:
+                self.asked.discard((sender.name, message.source))
+                # the items not yet sent to the requester, by the history's count, oldest first
+                items = self.history.items(message.source, excluding_via=message.sender)
+                already = self.history.sent_count(message.sender, message.source)
+                if already >= len(items):
+                    already = max(0, len(items) - message.count)
+                chosen = items[already:already + message.count]
+                self.history.sent(message.sender, message.source, len(chosen))
+                if chosen:
+                    reply = Message(2, message.source, len(self.history.items(message.source)), self.address,
+                                    message.sender, list(chosen))
+                    reply.final = message.source in self.final
+                    self.queue(reply)
+        else:
+            if final:
+                self.final[message.source] = max(self.final.get(message.source, 0), message.count)
+            fresh = self.history.receive(message.sender, message.source, list(message.vertices))
+            new = [v[0] for v in fresh]
+            if message.vertices:
+                self.last_seen[message.source] = tuple(message.vertices[-1][1:3])
+        return new

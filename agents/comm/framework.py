@@ -1,0 +1,263 @@
+"""Seed 000's communication framework as plain functions and data: processes 1, 3, 4, 5.
+
+Process 1, characterisation: the travel per encoder pulse ``dpp = 2 pi r / ppr``
+(eq. 2) and the odometry grid ``pg`` whose upper corner is ``D / max(dpp)`` (eq. 3).
+Process 2 (transmission analysis) is in :mod:`petriflow.agents.comm.radio`.
+
+Process 3, initialisation: the address of agent ``i`` of ``N`` initial agents out of
+``A`` available addresses (eq. 4) and its DHCP pool (eq. 5). The pools the paper
+prints (§4.1-4.2: N = 2 gives .3-.127 and .129-.254) end one below the next agent's
+address, not at ``round((A+2)(i+1)/N) + 1`` as eq. 5 is printed; the pools here follow
+the paper's numbers (each pool ends where the next address begins, the last at
+``A + 1``).
+
+Process 4, history: :class:`History` is one agent's data array ``Ad`` (source id, data)
+and history array ``Ah`` (from = the data's source, to = the agent it went to, sent,
+pending), updated by the three rules of §3.2.4 when data goes to a peer: (1) the source
+is in no row, (2) it is, but not towards that peer, (3) the row towards the peer has
+pending data. New data of a source (made, or received) adds to the pending count of
+the rows that already sent that source elsewhere.
+
+Process 5, the packet header: code 0 asks how many packets are pending, 1 requests a
+number of packets, 2 begins a transmission, 3 transfers a packet at once
+(:data:`CODES`). :func:`plan` is Algorithm 1: towards one peer in range, a source with
+a row of pending data goes by request (codes 0, 1, 2), one never sent to that peer
+goes at once (code 3). A message is a header of three bytes (code, source id, count)
+and, for codes 2 and 3, five bytes per map vertex (a 1-byte id and two 16-bit floats,
+§4.1).
+
+Examples:
+    >>> round(dpp(0.025, 200) * 1000, 4), grid_position((0.25, 4.75), 0.0007853)
+    (0.7854, (318, 6048))
+    >>> addresses(3), dhcp_pools(3)
+    ([2, 85, 170], [(3, 84), (86, 169), (171, 254)])
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = [
+    "CODES",
+    "HEADER_BYTES",
+    "VERTEX_BYTES",
+    "History",
+    "Message",
+    "addresses",
+    "decode_vertex",
+    "dhcp_pools",
+    "dpp",
+    "encode_vertex",
+    "grid_position",
+    "grid_size",
+    "plan",
+]
+
+#: The header codes of §3.2.5.
+CODES = {0: "query pending", 1: "request packets", 2: "begin transmission", 3: "immediate transfer"}
+#: Bytes of a header: code, source id, count.
+HEADER_BYTES = 3
+#: Bytes of one map vertex: a 1-byte id and two 16-bit floats (x, y).
+VERTEX_BYTES = 5
+
+
+# Process 1 ---------------------------------------------------------------------------
+def dpp(radius: float, ppr: int) -> float:
+    """Travel per encoder pulse (m), eq. 2."""
+    if not radius > 0 or ppr < 1:
+        raise ValueError(f"a wheel needs a radius > 0 and at least one pulse per turn, got {radius}, {ppr}")
+    return 2.0 * math.pi * radius / ppr
+
+
+def grid_size(area: tuple[float, float], dpps: list[float]) -> tuple[int, int]:
+    """The odometry grid's upper corner ``pg(sup)`` for an area ``(Dx, Dy)`` (m), eq. 3."""
+    step = max(dpps)
+    return (math.floor(area[0] / step), math.floor(area[1] / step))
+
+
+def grid_position(point: tuple[float, float], step: float) -> tuple[int, int]:
+    """The grid point ``pg`` of a position (m) on a grid of ``step`` m."""
+    return (math.floor(point[0] / step + 1e-9), math.floor(point[1] / step + 1e-9))
+
+
+# Process 3 ---------------------------------------------------------------------------
+def addresses(agents: int, available: int = 253) -> list[int]:
+    """The last byte of each initial agent's address, eq. 4 (``A`` = ``available``)."""
+    if agents < 1:
+        raise ValueError(f"the network needs at least one initial agent, got {agents}")
+    if agents > available // 2:
+        raise ValueError(f"{agents} agents leave no DHCP pool in {available} addresses")
+    span = (available + 2) / agents
+    return [2 if i == 0 else _round(span * i) for i in range(agents)]
+
+
+def dhcp_pools(agents: int, available: int = 253) -> list[tuple[int, int]]:
+    """Each initial agent's DHCP pool ``(first, last)`` (eq. 5, as the paper's pools)."""
+    starts = addresses(agents, available)
+    ends = [s - 1 for s in starts[1:]] + [available + 1]
+    return [(start + 1, end) for start, end in zip(starts, ends)]
+
+
+def _round(value: float) -> int:
+    return math.floor(value + 0.5)
+
+
+# Process 4 ---------------------------------------------------------------------------
+@dataclass
+class History:
+    """One agent's data array ``Ad`` and history array ``Ah`` (see the module).
+
+    ``data`` holds ``(source, item, via)``: ``via`` is the agent it came from (the
+    agent itself for its own data), so nothing goes back where it came from.
+    ``rows`` holds ``[from, to, sent, pending]`` in the order they were made.
+    """
+
+    me: int
+    data: list[tuple[int, Any, int]] = field(default_factory=list)
+    rows: list[list[int]] = field(default_factory=list)
+
+    def _row(self, source: int, to: int) -> list[int] | None:
+        for row in self.rows:
+            if row[0] == source and row[1] == to:
+                return row
+        return None
+
+    def items(self, source: int, excluding_via: int | None = None) -> list[Any]:
+        return [item for s, item, via in self.data if s == source and via != excluding_via]
+
+    def sources(self) -> list[int]:
+        seen: list[int] = []
+        for source, _, _ in self.data:
+            if source not in seen:
+                seen.append(source)
+        return seen
+
+    def has(self, source: int, item: Any) -> bool:
+        return any(s == source and i == item for s, i, _ in self.data)
+
+    def _more(self, source: int, count: int, sender: int) -> None:
+        for row in self.rows:
+            if row[0] == source and row[1] not in (self.me, sender):
+                row[3] += count
+
+    def add_own(self, item: Any) -> bool:
+        """Data this agent made (a vertex it found); False if it had it already."""
+        if self.has(self.me, item):
+            return False
+        self.data.append((self.me, item, self.me))
+        self._more(self.me, 1, self.me)
+        return True
+
+    def receive(self, sender: int, source: int, items: list[Any]) -> list[Any]:
+        """Items of ``source`` arrived from ``sender``: keep the new ones; returns them."""
+        new = [item for item in items if not self.has(source, item)]
+        for item in new:
+            self.data.append((source, item, sender))
+        row = self._row(source, self.me)
+        if row is None:
+            self.rows.append([source, self.me, len(items), 0])
+        else:
+            row[2] += len(items)
+        if new:
+            self._more(source, len(new), sender)
+        return new
+
+    def outgoing(self, peer: int) -> list[tuple[int, list[Any], str]]:
+        """What the rules send ``peer``: ``(source, items, rule)`` per source, rule
+        ``"new"`` (rules 1 and 2: never sent that source to this peer: all of it) or
+        ``"pending"`` (rule 3: the items made or received since)."""
+        out = []
+        for source in self.sources():
+            if source == peer:
+                continue
+            items = self.items(source, excluding_via=peer)
+            if not items:
+                continue
+            row = self._row(source, peer)
+            if row is None:
+                out.append((source, items, "new"))
+            elif row[3] > 0:
+                out.append((source, items[-row[3]:], "pending"))
+        return out
+
+    def sent(self, peer: int, source: int, count: int) -> None:
+        """``count`` items of ``source`` went to ``peer``: the row records them, nothing pending."""
+        row = self._row(source, peer)
+        if row is None:
+            self.rows.append([source, peer, count, 0])
+        else:
+            row[2] += count
+            row[3] = 0
+
+    def sent_count(self, peer: int, source: int) -> int:
+        """Items of ``source`` sent to ``peer`` so far (the row's ``sent``)."""
+        row = self._row(source, peer)
+        return 0 if row is None else row[2]
+
+    def pending(self, peer: int, source: int) -> int:
+        row = self._row(source, peer)
+        return 0 if row is None else row[3]
+
+
+# Process 5 ---------------------------------------------------------------------------
+@dataclass
+class Message:
+    """One packet: header ``code``, ``source`` id, ``count`` (codes 0, 2, 3: the items of
+    that source the sender holds; code 1: the items requested); vertices for codes 2
+    and 3; ``final``: the source's data is complete (the code byte's top bit)."""
+
+    code: int
+    source: int
+    count: int
+    sender: int
+    receiver: int
+    vertices: list[tuple[int, float, float]] = field(default_factory=list)
+    final: bool = False
+
+    @property
+    def size(self) -> int:
+        """Bytes on the air (header and vertices)."""
+        return HEADER_BYTES + VERTEX_BYTES * len(self.vertices)
+
+    @property
+    def payload(self) -> int:
+        """Bytes of map data (what the paper's tables count)."""
+        return VERTEX_BYTES * len(self.vertices)
+
+    def encode(self) -> bytes:
+        head = bytes([self.code | (0x80 if self.final else 0), self.source & 0xFF, min(self.count, 255)])
+        return head + b"".join(encode_vertex(*v) for v in self.vertices)
+
+
+def encode_vertex(vertex_id: int, x: float, y: float) -> bytes:
+    """A vertex as five bytes: id, then x and y as IEEE 754 half floats.
+
+    Examples:
+        >>> decode_vertex(encode_vertex(7, 1.25, 4.75))
+        (7, 1.25, 4.75)
+    """
+    if not 0 <= vertex_id <= 255:
+        raise ValueError(f"a vertex id is one byte (0..255), got {vertex_id}")
+    return bytes([vertex_id]) + struct.pack("<ee", x, y)
+
+
+def decode_vertex(data: bytes) -> tuple[int, float, float]:
+    x, y = struct.unpack("<ee", data[1:5])
+    return (data[0], x, y)
+
+
+def plan(history: History, peer: int) -> list[Message]:
+    """Algorithm 1 towards one peer in range: a message per source to send, code 0
+    (query, then the peer requests and code 2 follows) for a source with pending data
+    in a row towards the peer, code 3 (immediate) for a source never sent to it."""
+    messages = []
+    for source, items, rule in history.outgoing(peer):
+        total = len(history.items(source))
+        if rule == "pending":
+            messages.append(Message(0, source, total, history.me, peer))
+        else:
+            messages.append(Message(3, source, total, history.me, peer, list(items)))
+    return messages

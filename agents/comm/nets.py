@@ -1,0 +1,208 @@
+"""The mapping mission of seed 000 as a workflow net, generated for any team.
+
+:func:`build` writes the net (petriflow YAML) for ``robots`` robots, an optional
+monitor agent and, in the ``centralised`` mode, a central unit that relays everything.
+Each agent is a subnet: the four start-up processes in order, then its work loop
+(``step``: a robot explores one cell, a static agent listens; one ``send`` transition
+per peer, guarded by ``comm.has_message``; back to the loop, or ``finish`` when the agent
+holds the whole map); and a ``receive`` transition per peer taking that peer's messages
+from the channel place between them. A channel place holds at most one message: the
+sender takes a slot token, the receiver gives it back, so the net is bounded and its
+analysis finite, and ``end`` collects every slot (``begin`` hands them out), so no
+message is left in flight.
+
+Used directly by sweep files (``net: {builder: petriflow.agents.comm.nets:build}``);
+``python -m petriflow.agents.comm.nets`` writes the shipped nets of ``nets/comm/``.
+
+Examples:
+    >>> from petriflow.io.yaml import loads_net
+    >>> net = loads_net(build(robots=2))
+    >>> len(net.subnets), len([p for p in net.places.values() if p.channel])
+    (2, 2)
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from petriflow.agents.comm.framework import addresses, dhcp_pools
+
+__all__ = ["build", "ROBOT_STARTS", "MONITOR", "CENTRAL"]
+
+#: Robot starts of the paper (§4.1-4.2): robot1, robot2, robot3.
+ROBOT_STARTS = [(0.25, 0.25), (4.75, 4.75), (0.25, 4.75)]
+#: The monitor agent's place (§4.3, Table 9).
+MONITOR = (1.75, 3.25)
+#: Where the central unit stands in the centralised mode (the maze's centre; the paper does not say).
+CENTRAL = (2.5, 2.5)
+#: The central unit's address (Table 6).
+CENTRAL_ADDRESS = 129
+
+
+def _agents(robots: int, monitor: bool, mode: str) -> list[dict[str, Any]]:
+    team = addresses(robots)
+    agents = [{"name": f"robot{i + 1}", "kind": "robot", "address": team[i], "index": i} for i in range(robots)]
+    if monitor:
+        agents.append({"name": "monitor1", "kind": "monitor", "address": dhcp_pools(robots)[0][0], "index": 0,
+                       "pool_of": 0})
+    if mode == "centralised":
+        agents.append({"name": "central", "kind": "central", "address": CENTRAL_ADDRESS, "index": 0})
+    return agents
+
+
+def _peers(agent: dict[str, Any], agents: list[dict[str, Any]], mode: str) -> list[dict[str, Any]]:
+    others = [a for a in agents if a["name"] != agent["name"]]
+    if mode == "decentralised":
+        return others
+    if agent["kind"] == "central":
+        return others
+    return [a for a in others if a["kind"] == "central"]
+
+
+def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *, cell: float = 5 / 6,
+          cols: int = 6, area: float = 5.0, speed: float = 0.15, give_up: float = 240.0,
+          **ignored: Any) -> str:
+    """The mission's net as petriflow YAML (see the module).
+
+    Args:
+        robots: robots in the team (1..126).
+        mode: ``decentralised`` (every agent talks to every agent it hears) or
+            ``centralised`` (robots talk only to the central unit, which relays).
+        monitor: add the monitor agent (it joins when the run configuration says).
+        cell, cols, area: the maze's cell size (m), cells per row, side (m).
+        speed: the robots' cruise speed (m/s).
+        give_up: seconds an agent waits for silent robots (see ``comm.explore``).
+        ignored: other sweep parameters (they go elsewhere).
+    """
+    if mode not in ("decentralised", "centralised"):
+        raise ValueError(f"mode is decentralised or centralised, not {mode!r}")
+    if not 1 <= robots <= 126:
+        raise ValueError(f"robots must be from 1 to 126, got {robots}")
+    agents = _agents(robots, monitor, mode)
+    subnets = []
+    end_in = []
+    for agent in agents:
+        name = agent["name"]
+        peers = _peers(agent, agents, mode)
+        places: list[Any] = [f"{name}_start", f"{name}_c1", f"{name}_c2", f"{name}_c3", f"{name}_idle",
+                             f"{name}_out", f"{name}_listen", f"{name}_done"]
+        kind = agent["kind"]
+        characterise = {"kind": kind, "cell": round(cell, 6), "cols": cols, "area": [area, area]}
+        initialise: dict[str, Any] = {"agents": robots, "peers": {
+            p["name"]: {"address": p["address"], "box": f"box_{name}_{p['name']}"} for p in peers}}
+        if kind == "robot":
+            initialise["index"] = agent["index"]
+        elif kind == "monitor":
+            initialise["pool_of"] = agent["pool_of"]
+        else:
+            initialise["address"] = agent["address"]
+        first_box = f"box_{peers[0]['name']}_{name}" if peers else None
+        transitions: list[dict[str, Any]] = [
+            {"id": f"{name}_characterise", "label": "process 1: characterisation", "action": "comm.characterise",
+             "params": characterise, "in": [f"{name}_start"], "out": [f"{name}_c1"]},
+            {"id": f"{name}_analyse", "label": "process 2: transmission analysis",
+             **({"action": "comm.analyse", "params": {"channel_place": first_box}} if first_box else {}),
+             "in": [f"{name}_c1"], "out": [f"{name}_c2"]},
+            {"id": f"{name}_initialise", "label": "process 3: initialisation", "action": "comm.initialise",
+             "params": initialise, "in": [f"{name}_c2"], "out": [f"{name}_c3"]},
+            {"id": f"{name}_history", "label": "process 4: history", "action": "comm.history",
+             "in": [f"{name}_c3"], "out": [f"{name}_idle", f"{name}_listen"]},
+            {"id": f"{name}_step", "label": "explore a cell" if kind == "robot" else "listen",
+             "action": "comm.explore" if kind == "robot" else "comm.listen",
+             "params": ({"speed": speed, "give_up": give_up, "reexplore": mode == "decentralised"}
+                        if kind == "robot" else {"give_up": give_up}),
+             "in": [f"{name}_idle"], "out": [f"{name}_out"]},
+            {"id": f"{name}_loop", "label": "go on", "guard": "comm.going_on", "priority": 1,
+             "in": [f"{name}_out"], "out": [f"{name}_idle"]},
+            {"id": f"{name}_finish", "label": "map complete", "guard": "comm.finished", "priority": 1,
+             "in": [f"{name}_out"], "out": [f"{name}_done"]},
+        ]
+        for peer in peers:
+            other = peer["name"]
+            box, slot = f"box_{name}_{other}", f"slot_{name}_{other}"
+            places.append({"id": slot, "label": f"{name} may send to {other}"})
+            transitions.append({
+                "id": f"{name}_send_{other}", "label": f"process 5: send to {other}", "action": "comm.send",
+                "params": {"peer": other, "box": box, "loop": f"{name}_out"}, "guard": "comm.has_message",
+                "priority": 2, "in": [f"{name}_out", slot], "out": [f"{name}_out", box]})
+            end_in.append(slot)
+        for peer in peers:
+            other = peer["name"]
+            box, slot = f"box_{other}_{name}", f"slot_{other}_{name}"
+            places.append({"id": box, "channel": "radio", "label": f"{other} to {name}"})
+            transitions.append({
+                "id": f"{name}_receive_{other}", "label": f"receive from {other}", "action": "comm.receive",
+                "params": {"box": box, "state": f"{name}_listen"}, "priority": 3,
+                "in": [box, f"{name}_listen"], "out": [f"{name}_listen", slot]})
+        subnets.append({"id": name, "agent": name, "label": f"{kind} {name} (192.168.1.{agent['address']})",
+                        "places": places, "transitions": transitions})
+        end_in += [f"{name}_done", f"{name}_listen"]
+    net = {
+        "petriflow": 1,
+        "net": f"comm-{mode}-{robots}{'-monitor' if monitor else ''}",
+        "label": f"seed 000 mapping mission: {robots} robots, {mode}{', a monitor' if monitor else ''}",
+        "subnets": subnets,
+        "places": [{"id": "i", "tokens": 1}, "o"],
+        "transitions": [
+            {"id": "begin", "label": "start-up", "in": ["i"],
+             "out": [f"{a['name']}_start" for a in agents] + [p for p in end_in if p.startswith("slot_")]},
+            {"id": "end", "label": "every agent holds the map", "in": end_in, "out": ["o"]},
+        ],
+        "final": {"o": 1},
+    }
+    return yaml.safe_dump(net, sort_keys=False, width=120)
+
+
+#: The maze of the shipped world: 6 x 6 cells of 5/6 m in 5 m x 5 m (24 map vertices,
+#: as many as the paper's tables imply: 120 bytes = 24 vertices of 5 bytes).
+MAZE_SEED = 10
+
+
+def world(maze_seed: int = MAZE_SEED, robots: int = 3, cols: int = 6, area: float = 5.0) -> dict[str, Any]:
+    """The mission's world description: the maze, the paper's robots, the monitor and
+    the central unit (kinematic bodies: gravity is off, nothing falls or slides)."""
+    from petriflow.agents.mobile.maze import generate
+
+    maze = generate(cols, cols, seed=maze_seed, cell=area / cols, loops=0.1)
+    colours = ["red", "blue", "green", "orange", "purple", "cyan"]
+    bodies = []
+    for i in range(robots):
+        x, y = ROBOT_STARTS[i] if i < len(ROBOT_STARTS) else maze.centre((i % cols, (i * 7) % cols))
+        bodies.append({"id": f"robot{i + 1}", "agent": f"robot{i + 1}", "urdf": "petriflow.agents:robots/diffdrive.urdf",
+                       "position": [x, y], "z": 0.05, "colour": colours[i % len(colours)]})
+    bodies.append({"id": "monitor1", "agent": "monitor1", "urdf": "petriflow.agents:robots/diffdrive.urdf",
+                   "position": list(MONITOR), "z": 0.05, "colour": "yellow"})
+    bodies.append({"id": "central", "agent": "central", "urdf": "petriflow.agents:robots/diffdrive.urdf",
+                   "position": list(CENTRAL), "z": 0.6, "colour": "white"})
+    description = maze.world(bodies, dt=0.05)
+    description["gravity"] = 0.0
+    return description
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Write the shipped world and nets (``nets/comm/``)."""
+    parser = argparse.ArgumentParser(description="write seed 000's world and nets")
+    parser.add_argument("--out", default="nets/comm")
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    head = ("# The 5 m x 5 m maze of seed 000's experiments (generated: python -m petriflow.agents.comm.nets;\n"
+            f"# generate(6, 6, seed={MAZE_SEED}, cell=5/6, loops=0.1)), the paper's robot starts, the monitor\n"
+            "# at (1.75, 3.25) and the central unit above the centre. meta.maze is the maze itself: the\n"
+            "# comm metrics take the ground-truth map from it; the robots only sense the walls.\n")
+    (out / "world.yaml").write_text(head + yaml.safe_dump(world(), sort_keys=False, width=120))
+    print(f"wrote {out / 'world.yaml'}")
+    for robots, mode, monitor in ((2, "decentralised", False), (2, "centralised", False), (3, "decentralised", False),
+                                  (3, "centralised", False), (3, "decentralised", True)):
+        name = f"comm-{mode}-{robots}{'-monitor' if monitor else ''}.yaml"
+        text = build(robots, mode, monitor)
+        (out / name).write_text("# Generated by python -m petriflow.agents.comm.nets; the run configuration is"
+                                f" run.yaml.\nrun: run.yaml\n{text}")
+        print(f"wrote {out / name}")
+
+
+if __name__ == "__main__":
+    main()
