@@ -61,6 +61,7 @@ def fire_one(
     registry: Registry | None = None,
     seed: int = 0,
     timeout: float = 60.0,
+    config: Any = None,
 ) -> FiredTransition:
     """Fire ``transition`` of ``net`` once, with its bound action, and wait for it.
 
@@ -74,11 +75,13 @@ def fire_one(
         registry: where actions are looked up (default: the run registry).
         seed: the run seed (the firing's random generator derives from it).
         timeout: simulated seconds to wait for the action.
+        config: a run configuration (:class:`~petriflow.runtime.config.RunConfig`):
+            its channel models carry the channel places (a radio the action judges).
 
     Raises:
         NotEnabledError: the transition is not enabled in the given marking.
     """
-    scheduler = Scheduler(net, world=world, seed=seed, registry=registry)
+    scheduler = Scheduler(net, world=world, seed=seed, registry=registry, config=config)
     if tokens is not None:
         scheduler.set_tokens({p: list(v) for p, v in tokens.items()})
     elif marking is not None:

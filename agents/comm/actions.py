@@ -165,13 +165,17 @@ class MakeHistory(_Instant):
     def run(self, ctx: ActionContext) -> CommAgent:
         state = _state(ctx)
         state.history = History(state.address)
+        state.last_news = ctx.now  # a late joiner waits for news from when it joined
         return state
 
 
 def _plan(ctx: ActionContext, state: CommAgent) -> None:
     """Algorithm 1 towards every peer heard above the threshold now."""
+    state.now = ctx.now
     state.in_range = set()
     for peer in state.peers.values():
+        if not ctx.running(peer.name):  # no beacon: switched off, not joined yet, or dead
+            continue
         model, _ = ctx.link(peer.box)
         usable = model.usable(state.name, peer.name) if isinstance(model, RadioChannel) else True
         if usable:
@@ -202,6 +206,8 @@ class Explore(Action):
 
     def start(self, ctx: ActionContext) -> None:
         self.state = state = _state(ctx)
+        state.now = ctx.now
+        state.patience = self.params["give_up"]
         if state.robot is None:
             raise ActionFailure("comm.explore: the agent has no robot (use comm.listen for static agents)")
         self.goal = None
@@ -380,6 +386,8 @@ class Listen(_Instant):
 
     def start(self, ctx: ActionContext) -> None:
         self.state = _state(ctx)
+        self.state.now = ctx.now
+        self.state.patience = self.params["give_up"]
         self.left = self.params["period"]
         ctx.result = self.state
 
@@ -429,6 +437,7 @@ class Receive(_Instant):
         message = packet["message"] if isinstance(packet, dict) else None
         if not isinstance(state, CommAgent) or message is None:
             raise ActionFailure("comm.receive: needs the agent's state and a message")
+        state.now = ctx.now
         new = state.receive(message)
         if new or message.final:
             state.last_news = ctx.now

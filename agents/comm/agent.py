@@ -62,6 +62,9 @@ class CommAgent:
     parked: bool = False                         # waiting at its meeting place
     gave_up: set = field(default_factory=set)   # robots given up on (silent too long)
     last_news: float = 0.0                       # simulated time new map data last arrived
+    heard: dict = field(default_factory=dict)    # peer -> simulated time of its last message
+    now: float = 0.0                             # simulated time of the agent's last action
+    patience: float = 240.0                      # seconds of silence after which a peer counts as gone
     sent_bytes: int = 0
     payload_bytes: int = 0
 
@@ -102,11 +105,13 @@ class CommAgent:
                       (s not in self.final or len(self.history.items(s)) < self.final[s]))
 
     def untold(self) -> list[str]:
-        """Peers (not given up on) this agent has not yet told that a source it holds in
-        full is final: it must meet them once more before it may stop."""
+        """Peers this agent has not yet told that a source it holds in full is final: it
+        must meet them once more before it may stop. A peer given up on and not heard
+        from for ``patience`` s (dead, as far as anyone can tell) is not waited for; one
+        that still talks (a robot broken down, its radio on) is."""
         out = []
         for name, peer in self.peers.items():
-            if peer.address in self.gave_up:
+            if peer.address in self.gave_up and self.now - self.heard.get(name, -1e9) > self.patience:
                 continue
             for source, total in self.final.items():
                 if source == peer.address or len(self.history.items(source)) < total:
@@ -136,7 +141,7 @@ class CommAgent:
             else:
                 if (message.source, 3) in waiting:
                     continue
-                self.history.sent(peer.address, message.source, len(message.vertices))
+                self.history.sent(peer.address, message.source, list(message.vertices))
             self.queue(message)
         for source, total in self.final.items():
             key = ("final", peer.name, source)
@@ -147,6 +152,12 @@ class CommAgent:
                 note = Message(0, source, total, self.address, peer.address)
                 note.final = True
                 self.queue(note)
+                # the final push: what the peer may still lack goes with the note, so no
+                # request has to be answered after this agent has finished
+                unsent = self.history.unsent(peer.address, source)
+                if unsent:
+                    self.history.sent(peer.address, source, unsent)
+                    self.queue(Message(2, source, total, self.address, peer.address, unsent, final=True))
 
     def take(self, peer: str) -> Message | None:
         box = self.outbox.get(peer)
@@ -163,6 +174,8 @@ class CommAgent:
     def receive(self, message: Message) -> list[int]:
         """Handle one message; returns the ids of vertices new to this agent."""
         sender = self.by_address(message.sender)
+        if sender is not None:
+            self.heard[sender.name] = self.now
         new: list[int] = []
         final = message.final
         if message.code == 0:
@@ -175,13 +188,9 @@ class CommAgent:
         elif message.code == 1:
             if sender is not None:
                 self.asked.discard((sender.name, message.source))
-                # the items not yet sent to the requester, by the history's count, oldest first
-                items = self.history.items(message.source, excluding_via=message.sender)
-                already = self.history.sent_count(message.sender, message.source)
-                if already >= len(items):
-                    already = max(0, len(items) - message.count)
-                chosen = items[already:already + message.count]
-                self.history.sent(message.sender, message.source, len(chosen))
+                # the items never sent to the requester, oldest first
+                chosen = self.history.unsent(message.sender, message.source)[:message.count]
+                self.history.sent(message.sender, message.source, chosen)
                 if chosen:
                     reply = Message(2, message.source, len(self.history.items(message.source)), self.address,
                                     message.sender, list(chosen))

@@ -118,6 +118,7 @@ class History:
     me: int
     data: list[tuple[int, Any, int]] = field(default_factory=list)
     rows: list[list[int]] = field(default_factory=list)
+    given: dict[tuple[int, int], list[Any]] = field(default_factory=dict)  # (peer, source) -> items sent
 
     def _row(self, source: int, to: int) -> list[int] | None:
         for row in self.rows:
@@ -183,14 +184,20 @@ class History:
                 out.append((source, items[-row[3]:], "pending"))
         return out
 
-    def sent(self, peer: int, source: int, count: int) -> None:
-        """``count`` items of ``source`` went to ``peer``: the row records them, nothing pending."""
+    def sent(self, peer: int, source: int, items: list[Any]) -> None:
+        """``items`` of ``source`` went to ``peer``: the row counts them, nothing pending."""
         row = self._row(source, peer)
         if row is None:
-            self.rows.append([source, peer, count, 0])
+            self.rows.append([source, peer, len(items), 0])
         else:
-            row[2] += count
+            row[2] += len(items)
             row[3] = 0
+        self.given.setdefault((peer, source), []).extend(items)
+
+    def unsent(self, peer: int, source: int) -> list[Any]:
+        """Items of ``source`` this agent holds, did not get from ``peer`` and never sent it."""
+        given = self.given.get((peer, source), [])
+        return [item for item in self.items(source, excluding_via=peer) if item not in given]
 
     def sent_count(self, peer: int, source: int) -> int:
         """Items of ``source`` sent to ``peer`` so far (the row's ``sent``)."""

@@ -194,6 +194,7 @@ class ActionContext:
     _rng: random.Random | None = field(default=None, repr=False)
     _reader: Callable[[str], list[Any]] | None = field(default=None, repr=False)
     _links: Callable[[str], tuple[Any, str | None]] | None = field(default=None, repr=False)
+    _alive: Callable[[str | None], bool] | None = field(default=None, repr=False)
 
     @property
     def rng(self) -> random.Random:
@@ -246,6 +247,11 @@ class ActionContext:
         if self._links is None:
             raise PetriflowError(f"{self.transition!r}: no run to look up channel place {place!r} in")
         return self._links(place)
+
+    def running(self, agent: str | None) -> bool:
+        """Whether ``agent`` runs now: not killed, not waiting to join (what a radio
+        learns from an agent's beacon). ``True`` outside a run."""
+        return True if self._alive is None else self._alive(agent)
 
     def put(self, place: str, data: Any) -> None:
         """Give the tokens this firing produces in ``place`` the data ``data`` instead

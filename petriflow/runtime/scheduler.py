@@ -387,7 +387,8 @@ class Scheduler:
             self._cancel_region(t, number, withdrawn)
         now = self.kernel.now
         ctx = ActionContext(tid, agent, self._params[t], inputs, self.world, self._seed_prefix + str(number),
-                            now, now, _reader=self.tokens.read, _links=self.channels.model_for)
+                            now, now, _reader=self.tokens.read, _links=self.channels.model_for,
+                            _alive=self.faults.alive)
         action = self._actions[t]
         if action is None:
             ctx.result = ctx.token()
