@@ -85,7 +85,8 @@ class Characterise(_Instant):
     def run(self, ctx: ActionContext) -> CommAgent:
         p = self.params
         agent = ctx.agent or ctx.transition
-        state = CommAgent(agent, p["kind"], cell=p["cell"], origin=tuple(p["origin"]), cols=p["cols"])
+        state = CommAgent(agent, p["kind"], cell=p["cell"], origin=tuple(p["origin"]), cols=p["cols"],
+                          cells=p["cols"] * max(1, round(p["area"][1] / p["cell"])))
         report: dict[str, Any] = {"agent": agent, "role": p["kind"]}
         if p["kind"] == "robot":
             if ctx.world is None:

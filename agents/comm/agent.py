@@ -48,6 +48,7 @@ class CommAgent:
     cell: float = 0.5
     origin: tuple[float, float] = (0.0, 0.0)
     cols: int = 1
+    cells: int = 1
     explored: bool = False
     explored_at: float | None = None
     final: dict[int, int] = field(default_factory=dict)      # source -> items it has in all
@@ -122,7 +123,13 @@ class CommAgent:
         return out
 
     # Messages --------------------------------------------------------------------------
+    @property
+    def id_bytes(self) -> int:
+        """Bytes of a vertex id: one (the paper's) up to 256 cells, else two."""
+        return 1 if self.cells <= 256 else 2
+
     def queue(self, message: Message) -> None:
+        message.id_bytes = self.id_bytes
         peer = self.by_address(message.receiver)
         if peer is not None:
             self.outbox.setdefault(peer.name, deque()).append(message)

@@ -223,37 +223,42 @@ class Message:
     receiver: int
     vertices: list[tuple[int, float, float]] = field(default_factory=list)
     final: bool = False
+    id_bytes: int = 1
 
     @property
     def size(self) -> int:
         """Bytes on the air (header and vertices)."""
-        return HEADER_BYTES + VERTEX_BYTES * len(self.vertices)
+        return HEADER_BYTES + self.payload
 
     @property
     def payload(self) -> int:
-        """Bytes of map data (what the paper's tables count)."""
-        return VERTEX_BYTES * len(self.vertices)
+        """Bytes of map data (what the paper's tables count): 5 per vertex, 6 when a
+        maze has more than 256 cells and a vertex id takes two bytes."""
+        return (VERTEX_BYTES - 1 + self.id_bytes) * len(self.vertices)
 
     def encode(self) -> bytes:
         head = bytes([self.code | (0x80 if self.final else 0), self.source & 0xFF, min(self.count, 255)])
-        return head + b"".join(encode_vertex(*v) for v in self.vertices)
+        return head + b"".join(encode_vertex(*v, id_bytes=self.id_bytes) for v in self.vertices)
 
 
-def encode_vertex(vertex_id: int, x: float, y: float) -> bytes:
-    """A vertex as five bytes: id, then x and y as IEEE 754 half floats.
+def encode_vertex(vertex_id: int, x: float, y: float, *, id_bytes: int = 1) -> bytes:
+    """A vertex as an id of ``id_bytes`` bytes (the paper's one byte), then x and y as
+    IEEE 754 half floats.
 
     Examples:
         >>> decode_vertex(encode_vertex(7, 1.25, 4.75))
         (7, 1.25, 4.75)
+        >>> decode_vertex(encode_vertex(300, 0.5, 0.5, id_bytes=2), id_bytes=2)
+        (300, 0.5, 0.5)
     """
-    if not 0 <= vertex_id <= 255:
-        raise ValueError(f"a vertex id is one byte (0..255), got {vertex_id}")
-    return bytes([vertex_id]) + struct.pack("<ee", x, y)
+    if not 0 <= vertex_id < 256 ** id_bytes:
+        raise ValueError(f"a vertex id of {id_bytes} byte(s) is 0..{256 ** id_bytes - 1}, got {vertex_id}")
+    return vertex_id.to_bytes(id_bytes, "little") + struct.pack("<ee", x, y)
 
 
-def decode_vertex(data: bytes) -> tuple[int, float, float]:
-    x, y = struct.unpack("<ee", data[1:5])
-    return (data[0], x, y)
+def decode_vertex(data: bytes, *, id_bytes: int = 1) -> tuple[int, float, float]:
+    x, y = struct.unpack("<ee", data[id_bytes:id_bytes + 4])
+    return (int.from_bytes(data[:id_bytes], "little"), x, y)
 
 
 def plan(history: History, peer: int) -> list[Message]:

@@ -166,22 +166,34 @@ MAZE_SEED = 4
 MAZE_LOOPS = 0.0
 
 
+def starts(robots: int, cols: int, area: float) -> list[tuple[float, float]]:
+    """Robot starts: the paper's three in its 5 m maze, else spread over a k x k lattice
+    of cells (k = ceil(sqrt(robots)))."""
+    if robots <= len(ROBOT_STARTS) and cols == 6 and area == 5.0:
+        return ROBOT_STARTS[:robots]
+    import math
+
+    cell = area / cols
+    k = math.ceil(math.sqrt(robots))
+    spots = [(round((a + 0.5) * cols / k - 0.5), round((b + 0.5) * cols / k - 0.5)) for a in range(k) for b in range(k)]
+    return [((c + 0.5) * cell, (r + 0.5) * cell) for r, c in spots[:robots]]
+
+
 def world(maze_seed: int = MAZE_SEED, robots: int = 3, cols: int = 6, area: float = 5.0) -> dict[str, Any]:
-    """The mission's world description: the maze, the paper's robots, the monitor and
-    the central unit (kinematic bodies: gravity is off, nothing falls or slides)."""
+    """The mission's world description: the maze, the robots, the monitor and the central
+    unit (kinematic bodies: gravity is off, nothing falls or slides)."""
     from petriflow.agents.mobile.maze import generate
 
     maze = generate(cols, cols, seed=maze_seed, cell=area / cols, loops=MAZE_LOOPS)
-    colours = ["red", "blue", "green", "orange", "purple", "cyan"]
+    colours = ["red", "blue", "green", "orange"]
     bodies = []
-    for i in range(robots):
-        x, y = ROBOT_STARTS[i] if i < len(ROBOT_STARTS) else maze.centre((i % cols, (i * 7) % cols))
+    for i, (x, y) in enumerate(starts(robots, cols, area)):
         bodies.append({"id": f"robot{i + 1}", "agent": f"robot{i + 1}", "urdf": "petriflow.agents:robots/diffdrive.urdf",
                        "position": [x, y], "z": 0.05, "colour": colours[i % len(colours)]})
     bodies.append({"id": "monitor1", "agent": "monitor1", "urdf": "petriflow.agents:robots/diffdrive.urdf",
-                   "position": list(MONITOR), "z": 0.05, "colour": "yellow"})
+                   "position": [MONITOR[0] * area / 5.0, MONITOR[1] * area / 5.0], "z": 0.05, "colour": "yellow"})
     bodies.append({"id": "central", "agent": "central", "urdf": "petriflow.agents:robots/diffdrive.urdf",
-                   "position": list(CENTRAL), "z": 0.6, "colour": "white"})
+                   "position": [area / 2, area / 2], "z": 0.6, "colour": "white"})
     description = maze.world(bodies, dt=0.05)
     description["gravity"] = 0.0
     return description
