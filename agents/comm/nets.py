@@ -199,6 +199,46 @@ def world(maze_seed: int = MAZE_SEED, robots: int = 3, cols: int = 6, area: floa
     return description
 
 
+def draw_world(description: dict[str, Any], path: str | Path) -> None:
+    """A top view of a mission world: walls, the maze's topological map (vertices and
+    corridors, the ground truth), the robots' starts, the monitor and the central unit."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from petriflow.agents.mobile.maze import from_meta
+
+    maze = from_meta(description["meta"]["maze"])
+    figure, axis = plt.subplots(figsize=(6, 6))
+    for box in description["boxes"]:
+        (x, y, _), (w, d, _) = box["position"], box["size"]
+        axis.add_patch(plt.Rectangle((x - w / 2, y - d / 2), w, d, color="0.25"))
+    graph = maze.graph()
+    for a, b in graph.edges:
+        (xa, ya), (xb, yb) = maze.centre(a), maze.centre(b)
+        axis.plot([xa, xb], [ya, yb], color="tab:green", linewidth=1, alpha=0.6)
+    xs, ys = zip(*(maze.centre(v) for v in graph.nodes))
+    axis.scatter(xs, ys, s=14, color="tab:green", zorder=3, label=f"map vertices ({graph.number_of_nodes()})")
+    for body in description["robots"]:
+        x, y = body["position"]
+        role = "robot" if body["id"].startswith("robot") else body["id"]
+        marker = {"robot": "o", "monitor1": "s", "central": "^"}[role]
+        axis.scatter([x], [y], s=90, marker=marker, color=body["colour"] if role == "robot" else "k", zorder=4,
+                     edgecolors="k")
+        axis.annotate(body["id"], (x, y), textcoords="offset points", xytext=(6, 6), fontsize=8)
+    axis.set_aspect("equal")
+    axis.set_xlim(-0.2, maze.size[0] + 0.2)
+    axis.set_ylim(-0.2, maze.size[1] + 0.2)
+    axis.set_xlabel("x (m)")
+    axis.set_ylabel("y (m)")
+    axis.set_title("seed 000 maze: walls, topological map, agents")
+    axis.legend(loc="upper right", fontsize=7)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Write the shipped world and nets (``nets/comm/``)."""
     parser = argparse.ArgumentParser(description="write seed 000's world and nets")
@@ -209,8 +249,10 @@ def main(argv: list[str] | None = None) -> None:
             f"# generate(6, 6, seed={MAZE_SEED}, cell=5/6, loops={MAZE_LOOPS})), the paper's robot starts, the monitor\n"
             "# at (1.75, 3.25) and the central unit above the centre. meta.maze is the maze itself: the\n"
             "# comm metrics take the ground-truth map from it; the robots only sense the walls.\n")
-    (out / "world.yaml").write_text(head + yaml.safe_dump(world(), sort_keys=False, width=120))
-    print(f"wrote {out / 'world.yaml'}")
+    description = world()
+    (out / "world.yaml").write_text(head + yaml.safe_dump(description, sort_keys=False, width=120))
+    draw_world(description, out / "world.png")
+    print(f"wrote {out / 'world.yaml'} and {out / 'world.png'}")
     for robots, mode, monitor in ((2, "decentralised", False), (2, "centralised", False), (3, "decentralised", False),
                                   (3, "centralised", False), (3, "decentralised", True)):
         name = f"comm-{mode}-{robots}{'-monitor' if monitor else ''}.yaml"
