@@ -156,3 +156,39 @@ def pick_threshold(rows: list[tuple[float, float, float]]) -> tuple[float, float
     if best is None:
         raise ValueError("no distance of the sweep delivered every frame")
     return best
+
+
+def plot_analysis(model: RadioChannel, path: str, *, distances: Iterable[float] = range(1, 11), trials: int = 500,
+                  seed: int = 0) -> tuple[float, float]:
+    """Fig. 5 on the model: delivered share and RSSI against distance behind one
+    concrete wall, with the picked threshold marked; returns it ``(m, dBm)``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = threshold_sweep(model, list(distances), walls=1, trials=trials, seed=seed)
+    picked = pick_threshold(rows)
+    figure, (share, level) = plt.subplots(1, 2, figsize=(9, 3.6))
+    share.plot([r[0] for r in rows], [r[1] for r in rows], marker="o")
+    share.axvline(picked[0], color="tab:red", linestyle="--", label=f"last lossless: {picked[0]:g} m")
+    share.set_xlabel("distance behind a concrete wall (m)")
+    share.set_ylabel("frames delivered")
+    share.legend(fontsize=8)
+    level.plot([r[0] for r in rows], [r[2] for r in rows], marker="o", color="tab:orange")
+    level.axhline(model.sensitivity_dbm, color="tab:red", linestyle="--", label="adapter sensitivity")
+    level.axhline(model.threshold_dbm, color="tab:green", linestyle=":", label="framework threshold (2 m, free space)")
+    level.set_xlabel("distance behind a concrete wall (m)")
+    level.set_ylabel("RSSI (dBm)")
+    level.legend(fontsize=8)
+    figure.suptitle("process 2: transmission analysis of the comm.radio model (seed 000 Fig. 5)")
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+    return picked
+
+
+if __name__ == "__main__":  # python -m petriflow.agents.comm.radio OUT.png
+    import sys
+
+    print(plot_analysis(RadioChannel(), sys.argv[1] if len(sys.argv) > 1 else "fig5.png"))
