@@ -68,3 +68,53 @@ def test_decentralised_mission_maps_the_whole_maze():
         assert set(sent) == {"robot1", "robot2"} and all(v % 5 == 0 and v > 0 for v in sent.values())
     finally:
         world.close()
+
+
+def trial_metrics(table: str, row: int) -> tuple[dict, dict]:
+    from petriflow.sweep import load_sweep
+    from petriflow.sweep.trial import run_trial
+
+    sweep = load_sweep(examples.path("comm", f"experiments/{table}.yaml"))
+    trial = [t for t in sweep.trials() if t.row == row][0]
+    result = run_trial(sweep.payload(trial))
+    assert result["status"] == "ok", result["error"]
+    return result["metrics"], trial.params
+
+
+def test_a_failed_robot_leaves_the_decentralised_survivors_with_the_whole_map():
+    metrics, params = trial_metrics("table8", 1)
+    assert params["failed"] == "robot3"
+    assert metrics["maps_complete"] == 1.0            # survivors only: they re-explored robot3's cells
+
+
+def test_a_failed_central_unit_leaves_partial_maps():
+    metrics, params = trial_metrics("table8", 0)
+    assert params["failed"] == "central"
+    assert metrics["maps_complete"] < 1.0
+
+
+def test_a_late_monitor_relays_to_the_broken_down_robot():
+    metrics, params = trial_metrics("table9", 0)
+    assert params["monitor"] is True
+    assert metrics["bytes_per_agent.monitor1"] > 0     # it joined, got data and passed it on
+    assert metrics["maps_complete"] == 1.0             # robot3, which cannot move, holds the whole map
+
+
+def test_each_agents_map_is_drawn_with_its_missing_vertices(tmp_path):
+    from petriflow.agents.comm.maps import draw_maps
+    from petriflow.agents.comm.nets import world
+    from petriflow.runtime.trace import Event
+
+    maze = world()["meta"]["maze"]
+    events = [Event(0, 1.0, "custom", None, "robot1", {"name": "comm.learnt", "data": {"ids": [0, 1]}}),
+              Event(1, 2.0, "custom", None, "robot2", {"name": "comm.learnt", "data": {"ids": list(range(36))}})]
+    lacking = draw_maps(events, maze, tmp_path / "maps.png")
+    assert lacking["robot2"] == 0 and lacking["robot1"] == 24 - len({0, 1} & set(range(36)) & _vertex_ids(maze))
+    assert (tmp_path / "maps.png").stat().st_size > 10_000
+
+
+def _vertex_ids(maze_meta) -> set[int]:
+    from petriflow.agents.mobile.maze import from_meta
+
+    maze = from_meta(maze_meta)
+    return {r * maze.cols + c for r, c in maze.vertices()}
