@@ -48,7 +48,7 @@ def payload_of(message: Message) -> bytes:
         >>> payload_of(Message("p", "a", "b", b"hi", 0.0, 2))
         b'hi'
         >>> payload_of(Message("p", "a", "b", {"size": 3}, 0.0, 3)).hex()
-        '0b3057'
+        '0b3055'
     """
     if isinstance(message.data, (bytes, bytearray)):
         return bytes(message.data)

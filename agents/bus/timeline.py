@@ -116,7 +116,7 @@ class Timeline:
         to ``until``), or until none is left, or until ``stop()`` is true after a step.
         """
         limit = math.inf if until is None else until
-        while self.peek() <= limit:
+        while (next_time := self.peek()) <= limit and next_time < math.inf:
             self.step()
             if stop is not None and stop():
                 return

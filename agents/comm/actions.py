@@ -166,7 +166,7 @@ class MakeHistory(_Instant):
     def run(self, ctx: ActionContext) -> CommAgent:
         state = _state(ctx)
         state.history = History(state.address)
-        state.last_news = ctx.now  # a late joiner waits for news from when it joined
+        state.last_news = state.since = ctx.now  # a late joiner waits for news from when it joined
         return state
 
 
@@ -264,8 +264,8 @@ class Explore(Action):
                 state.gave_up |= set(missing)
                 ctx.emit("comm.gave_up", silent=sorted(missing))
         waiting_for = [s for s in missing if s not in state.gave_up]
-        waiting_for += [state.peers[name].address for name in state.untold()
-                        if state.peers[name].address not in waiting_for]
+        owed = state.untold() + [name for name, box in state.outbox.items() if box]
+        waiting_for += [state.peers[name].address for name in owed if state.peers[name].address not in waiting_for]
         if waiting_for and not state.route and not state.parked:
             state.route = self._meeting_route(waiting_for)
             state.parked = not state.route
@@ -459,7 +459,8 @@ def has_message(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
 def _done(state: CommAgent) -> bool:
     if state.kind == "robot" and not state.explored:
         return False
-    silent = {name for name, peer in state.peers.items() if peer.address in state.gave_up}
+    silent = {name for name, peer in state.peers.items()
+              if peer.address in state.gave_up or state.now - state.heard.get(name, state.since) > state.patience}
     waiting = any(box for name, box in state.outbox.items() if name not in silent)
     return state.complete_sources(state.gave_up) and not waiting and not state.untold()
 

@@ -66,6 +66,7 @@ class CommAgent:
     heard: dict = field(default_factory=dict)    # peer -> simulated time of its last message
     now: float = 0.0                             # simulated time of the agent's last action
     patience: float = 240.0                      # seconds of silence after which a peer counts as gone
+    since: float = 0.0                           # simulated time the agent started its task
     sent_bytes: int = 0
     payload_bytes: int = 0
 
@@ -107,12 +108,12 @@ class CommAgent:
 
     def untold(self) -> list[str]:
         """Peers this agent has not yet told that a source it holds in full is final: it
-        must meet them once more before it may stop. A peer given up on and not heard
-        from for ``patience`` s (dead, as far as anyone can tell) is not waited for; one
-        that still talks (a robot broken down, its radio on) is."""
+        must meet them once more before it may stop. A peer not heard from for
+        ``patience`` s (gone, as far as anyone can tell) is not waited for; one that still
+        talks (a robot broken down, its radio on) is."""
         out = []
         for name, peer in self.peers.items():
-            if peer.address in self.gave_up and self.now - self.heard.get(name, -1e9) > self.patience:
+            if self.now - self.heard.get(name, self.since) > self.patience:
                 continue
             for source, total in self.final.items():
                 if source == peer.address or len(self.history.items(source)) < total:
