@@ -118,3 +118,49 @@ def _vertex_ids(maze_meta) -> set[int]:
 
     maze = from_meta(maze_meta)
     return {r * maze.cols + c for r, c in maze.vertices()}
+
+
+def test_send_and_receive_move_one_message_through_the_channel_place():
+    from petriflow.agents.comm.agent import CommAgent, Peer
+    from petriflow.agents.comm.framework import History, Message
+
+    net = load_net(examples.path("comm", "comm-decentralised-2.yaml"))
+    config = load_config(examples.path("comm", "run.yaml"))
+    sender = CommAgent("robot1", "robot", address=2, history=History(2))
+    sender.peers["robot2"] = Peer("robot2", 128, "box_robot1_robot2")
+    sender.in_range = {"robot2"}
+    sender.queue(Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))
+    sent = fire_one(net, "robot1_send_robot2", config=config,
+                    tokens={"robot1_out": [sender], "slot_robot1_robot2": [None]})
+    assert sent.outcome == "ok" and sent.marking["robot1_out"] == 1
+    on_air = [e.data for e in sent.events if e.kind == "message"]
+    assert on_air[0]["fate"] == "sent" and on_air[0]["size"] == 8 and on_air[0]["receiver"] == "robot2"
+    assert not sender.outbox["robot2"]
+    packet = {"size": 8, "payload": 5, "code": 3, "message": Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)])}
+    receiver = CommAgent("robot2", "robot", address=128, history=History(128))
+    receiver.peers["robot1"] = Peer("robot1", 2, "box_robot2_robot1")
+    got = fire_one(net, "robot2_receive_robot1", config=config,
+                   tokens={"box_robot1_robot2": [packet], "robot2_listen": [receiver]})
+    assert got.outcome == "ok" and got.marking["slot_robot1_robot2"] == 1   # the slot goes back to the sender
+    assert receiver.vertices == {0: (0.4, 0.4)}
+
+
+def test_walls_between_two_agents_are_counted_by_ray_tests():
+    from petriflow.agents.comm.radio import RadioChannel
+    from petriflow.world import World
+
+    world = World({"plane": True, "gravity": 0.0,
+                   "boxes": [{"id": "w1", "size": [0.04, 2, 0.3], "position": [1, 0, 0.15]},
+                             {"id": "w2", "size": [0.04, 2, 0.3], "position": [2, 0, 0.15]}],
+                   "robots": [{"id": "a", "urdf": "petriflow.agents:robots/diffdrive.urdf", "position": [0.5, 0]},
+                              {"id": "b", "urdf": "petriflow.agents:robots/diffdrive.urdf", "position": [1.5, 0]},
+                              {"id": "c", "urdf": "petriflow.agents:robots/diffdrive.urdf", "position": [2.5, 0]}]})
+    try:
+        radio = RadioChannel()
+        radio.bind(world)
+        assert radio.between("a", "b")[1] == 1 and radio.between("a", "c")[1] == 2
+        assert radio.link_rssi("a", "b") == pytest.approx(radio.rssi(1.0) - 3.0, abs=0.05)
+        radio.gains_db = {"c": 20}
+        assert radio.link_rssi("a", "c") == pytest.approx(radio.rssi(2.0) - 6.0 + 20, abs=0.05)
+    finally:
+        world.close()
