@@ -34,16 +34,12 @@ from collections import deque
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
 
-from petriflow.errors import PetriflowError
+from petriflow.agents.bus.errors import AddressingError
 
 __all__ = ["MAX_MODULES", "AddressNotice", "AddressingError", "AddressingModule", "auto_address"]
 
 #: Modules the addressing supports.
 MAX_MODULES = 254
-
-
-class AddressingError(PetriflowError):
-    """The chain cannot address itself (no head, two heads, too long, a module not reached)."""
 
 
 @dataclass(frozen=True)
@@ -113,7 +109,7 @@ def auto_address(behind: Mapping[Hashable, Hashable | None],
         >>> auto_address({"a": "b", "b": "a"}, {"a": False, "b": False})
         Traceback (most recent call last):
         ...
-        petriflow.agents.bus.addressing.AddressingError: no module has a free front sensor: nobody takes address 0
+        petriflow.agents.bus.errors.AddressingError: no module has a free front sensor: nobody takes address 0
     """
     modules = {name: AddressingModule(name, front_free.get(name, False)) for name in behind}
     heads = [name for name, module in modules.items() if module.front_free]

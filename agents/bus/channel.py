@@ -29,6 +29,7 @@ import random
 from typing import TYPE_CHECKING, Any
 
 from petriflow.agents.bus.timeline import MODULE, Timeline
+
 from petriflow.runtime.channels import Message
 
 if TYPE_CHECKING:
@@ -106,7 +107,8 @@ class ChannelState:
         """The delay until the receiver reads the whole message, or ``None`` if it is lost."""
         self.timeline.run(until=message.time)
         frames = self.frames(message)
-        ahead = copy.deepcopy((self.timeline, self.medium))
+        # The bus parameters are shared, not copied (they hold this state object).
+        ahead = copy.deepcopy((self.timeline, self.medium), memo={id(self.bus): self.bus})
         arrival = _look_ahead(ahead[0], ahead[1], frames)
         for frame in frames:  # the same requests on the kept state: the same draws follow
             self.medium.request(frame)

@@ -64,7 +64,7 @@ class CpgParameters:
         lag: the phase by which each module trails the one in front (rad).
         offset: ``xi`` (rad).
         amplitude: ``ri`` (rad).
-        dt: integration step (s).
+        dt: integration step (s); 20 ms, the modules' control step.
         extrapolate: advance stored neighbour phases by ``frequency × age``.
     """
 
@@ -73,7 +73,7 @@ class CpgParameters:
     lag: float = 2.0 * math.pi / 3.0
     offset: float = 0.0
     amplitude: float = 0.5
-    dt: float = 0.01
+    dt: float = 0.02
     extrapolate: bool = False
 
 
@@ -133,62 +133,74 @@ class CpgChain:
             raise ValueError(f"{n} modules need {n} phases, got {self.phases.shape}")
         self.time = 0.0
         self.listen_continuously = False
-        index = np.arange(n)
-        self._neighbour = np.abs(index[:, None] - index[None, :]) == 1
-        self._bias = (index[:, None] - index[None, :]) * self.parameters.lag
-        self._heard = np.zeros((n, n))
-        self._heard_at = np.full((n, n), np.nan)
+        # Each module's two couplings, towards the module in front (j = i − 1, desired
+        # φj − φi = +lag) and behind (j = i + 1, −lag): columns 0 and 1 of these arrays.
+        self._exists = np.ones((n, 2), dtype=bool)
+        self._exists[0, 0] = self._exists[n - 1, 1] = False
+        self._bias = np.array([self.parameters.lag, -self.parameters.lag])
+        self._heard = np.zeros((n, 2))
+        self._heard_at = np.full((n, 2), np.nan)
+
+    @staticmethod
+    def _side(module: int, neighbour: int) -> int | None:
+        """Column of ``neighbour`` in ``module``'s coupling arrays (None: not a neighbour)."""
+        return {-1: 0, 1: 1}.get(neighbour - module)
 
     def hear(self, module: int, neighbour: int, phase: float) -> None:
         """``module`` read a message carrying ``neighbour``'s phase (ignored unless they
         are neighbours)."""
-        if self._neighbour[module, neighbour]:
-            self._heard[module, neighbour] = phase
-            self._heard_at[module, neighbour] = self.time
+        side = self._side(module, neighbour)
+        if side is not None and 0 <= neighbour < self.n:
+            self._heard[module, side] = phase
+            self._heard_at[module, side] = self.time
 
     def knows(self, module: int, neighbour: int) -> bool:
         """Whether ``module`` has heard from ``neighbour``."""
-        return not math.isnan(self._heard_at[module, neighbour])
+        side = self._side(module, neighbour)
+        return side is not None and not math.isnan(self._heard_at[module, side])
 
     def angles(self) -> np.ndarray:
         """Equation (1) for every module: the motor angles ``θ``."""
         p = self.parameters
         return p.offset + p.amplitude * np.cos(self.phases)
 
-    def _targets(self) -> tuple[np.ndarray, np.ndarray]:
-        """Neighbour phases each module uses now, and the mask of those it has."""
-        if self.listen_continuously:
-            return np.broadcast_to(self.phases, (self.n, self.n)), self._neighbour
-        known = self._neighbour & ~np.isnan(self._heard_at)
-        heard = self._heard
-        if self.parameters.extrapolate:
-            age = np.nan_to_num(self.time - self._heard_at)
-            heard = heard + self.parameters.frequency * age
-        return heard, known
-
     def _rate(self, phases: np.ndarray, targets: np.ndarray, mask: np.ndarray) -> np.ndarray:
         p = self.parameters
-        pull = np.where(mask, np.sin(targets - phases[:, None] - self._bias), 0.0)
-        return p.frequency + p.coupling * pull.sum(axis=1)
+        pull = np.sin(targets - phases[:, None] - self._bias)
+        return p.frequency + p.coupling * (pull * mask).sum(axis=1)
+
+    @staticmethod
+    def _neighbours_of(phases: np.ndarray) -> np.ndarray:
+        """Each module's front and back neighbours' current phases (0 where none)."""
+        around = np.zeros((phases.size, 2))
+        around[1:, 0] = phases[:-1]
+        around[:-1, 1] = phases[1:]
+        return around
 
     def step(self, dt: float | None = None) -> None:
         """One Runge–Kutta step of ``dt`` (default the parameters' step)."""
         h = self.parameters.dt if dt is None else dt
-        if self.listen_continuously:
-            # Everyone sees everyone's current phase: the neighbours move within the step.
-            def rate(phases: np.ndarray) -> np.ndarray:
-                return self._rate(phases, np.broadcast_to(phases, (self.n, self.n)), self._neighbour)
+        continuous = self.listen_continuously
+        if continuous:
+            mask = self._exists
+            targets = self._heard  # unused
         else:
-            targets, mask = self._targets()
+            mask = self._exists & ~np.isnan(self._heard_at)
+            targets = self._heard
+            if self.parameters.extrapolate:
+                targets = targets + self.parameters.frequency * np.nan_to_num(self.time - self._heard_at)
+        drift = self.parameters.frequency if self.parameters.extrapolate and not continuous else 0.0
 
-            def rate(phases: np.ndarray) -> np.ndarray:
-                return self._rate(phases, targets, mask)
+        def rate(phases: np.ndarray, tau: float) -> np.ndarray:
+            if continuous:  # everyone sees everyone's current phase: neighbours move within the step
+                return self._rate(phases, self._neighbours_of(phases), mask)
+            return self._rate(phases, targets + drift * tau, mask)
 
         phi = self.phases
-        k1 = rate(phi)
-        k2 = rate(phi + 0.5 * h * k1)
-        k3 = rate(phi + 0.5 * h * k2)
-        k4 = rate(phi + h * k3)
+        k1 = rate(phi, 0.0)
+        k2 = rate(phi + 0.5 * h * k1, 0.5 * h)
+        k3 = rate(phi + 0.5 * h * k2, 0.5 * h)
+        k4 = rate(phi + h * k3, h)
         self.phases = phi + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
         self.time += h
 

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from petriflow.errors import PetriflowError
+from petriflow.agents.bus.errors import FrameError
 
 __all__ = [
     "CAN_FIXED_BITS",
@@ -77,10 +77,6 @@ IEEE802154_MAX_FRAME_BYTES = 127
 IEEE802154_ACK_BITS = 8 * (IEEE802154_PHY_BYTES + 5)
 
 _CRC15_POLY = 0x4599  # x^15 + x^14 + x^10 + x^8 + x^7 + x^4 + x^3 + 1
-
-
-class FrameError(PetriflowError, ValueError):
-    """A frame that its bus cannot carry (too long, a bad identifier, a bad setting)."""
 
 
 def uart_frame_bits(n_bytes: int, data_bits: int = 8, parity: bool = False, stop_bits: int = 1) -> int:
@@ -208,7 +204,7 @@ def ieee802154_frame_bits(payload_bytes: int, network_bytes: int = 0,
         >>> ieee802154_frame_bits(200)
         Traceback (most recent call last):
         ...
-        petriflow.agents.bus.frames.FrameError: an 802.15.4 MAC frame carries at most 127 bytes, this one needs 211
+        petriflow.agents.bus.errors.FrameError: an 802.15.4 MAC frame carries at most 127 bytes, this one needs 211
     """
     mac_frame = mac_header_bytes + network_bytes + payload_bytes + 2
     if payload_bytes < 0 or mac_frame > IEEE802154_MAX_FRAME_BYTES:

@@ -55,7 +55,11 @@ Losses common to all three (real modules' limits):
   overwrite one for this module; ``acceptance_filter=True`` models a hardware filter
   (CAN acceptance masks, XBee unicast addressing) that keeps them out.
 * **Transmit queue** (``tx_queue`` frames waiting besides the one on the wire): a
-  request finding it full is dropped (:attr:`Loss.QUEUE_FULL`).
+  request finding it full is dropped (:attr:`Loss.QUEUE_FULL`). Defaults (assumed):
+  3 frames for a UART driver's ring buffer and for the XBee's serial buffer, 2 on CAN
+  (a controller such as the MCP2515 has three transmit buffers, one of which holds
+  the frame being sent). At the paper's rates (about one message a second per
+  module) no queue fills; the limit matters for heavier traffic.
 
 Each bus class is also a petriflow
 :class:`~petriflow.runtime.channels.ChannelModel`: ``channels: {bus: {model: ...}}``
@@ -112,6 +116,7 @@ from petriflow.agents.bus.frames import (
 )
 from petriflow.agents.bus.radio import RadioLink
 from petriflow.agents.bus.timeline import MEDIUM, Timeline, Timer
+
 from petriflow.outcome import Name
 from petriflow.runtime.channels import ChannelModel, Message
 
@@ -269,7 +274,8 @@ class SerialBus(BusModel):
 
 @dataclass
 class CanBus(BusModel):
-    """CAN 2.0A at ``bitrate``; frames are stuffed as their bits require.
+    """CAN 2.0A at ``bitrate``; frames are stuffed as their bits require. ``tx_queue``
+    defaults to 2: three transmit buffers, one holding the frame on the bus.
 
     Examples:
         >>> CanBus().frame_bits(Frame(0, (1,), bytes(8), identifier=0x100)) >= 44 + 64
@@ -579,7 +585,6 @@ class ZigbeeMedium(Medium):
 
     def __init__(self, bus: ZigbeeBus, timeline: Timeline, rng: random.Random, modules: Iterable[int] = (),
                  positions: dict[int, float] | None = None) -> None:
-        super().__init__(bus, timeline, rng, modules)
         self.positions = dict(positions or {})
         self._link = bus.link()
         self._active: list[Transmission] = []
@@ -587,6 +592,7 @@ class ZigbeeMedium(Medium):
         self._serving: dict[int, bool] = {}
         self._ready: dict[int, deque[float]] = {}
         self._attempt: dict[int, tuple[int, int]] = {}  # module -> (NB, BE)
+        super().__init__(bus, timeline, rng, modules)
 
     def add_module(self, module: int) -> None:
         super().add_module(module)

@@ -31,7 +31,8 @@ from __future__ import annotations
 
 import heapq
 import math
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 __all__ = ["MEDIUM", "MODULE", "Timeline", "Timer"]
 
@@ -49,7 +50,7 @@ class Timer:
         cancelled: whether :meth:`cancel` was called.
     """
 
-    __slots__ = ("time", "callback", "args", "cancelled")
+    __slots__ = ("args", "callback", "cancelled", "time")
 
     def __init__(self, time: float, callback: Callable[..., Any], args: tuple[Any, ...]) -> None:
         self.time = time
