@@ -64,6 +64,7 @@ class RadioChannel(ChannelModel):
 
     def __post_init__(self) -> None:
         self.world: Any = None
+        self._walls: dict[tuple, int] = {}
 
     @property
     def sensitivity_dbm(self) -> float:
@@ -71,8 +72,10 @@ class RadioChannel(ChannelModel):
         return self.rssi(8.0) - self.concrete_db
 
     def bind(self, world: Any) -> None:
-        """The run's world: positions and walls between agents come from it."""
+        """The run's world: positions and walls between agents come from it (walls do
+        not move, so each pair of places, to the centimetre, is ray-tested once)."""
         self.world = world
+        self._walls = {}
 
     def rssi(self, distance: float, walls: int = 0) -> float:
         """Received signal strength (dBm) at ``distance`` m through ``walls`` walls."""
@@ -93,8 +96,12 @@ class RadioChannel(ChannelModel):
             return None
         from petriflow.agents.mobile.sensors import walls_between
 
-        ignore = [world.body(a), world.body(b)]
-        return math.dist(pa, pb), walls_between(world, pa, pb, z=self.antenna_z, ignore=ignore)
+        key = tuple(sorted(((round(pa[0], 2), round(pa[1], 2)), (round(pb[0], 2), round(pb[1], 2)))))
+        walls = self._walls.get(key)
+        if walls is None:
+            ignore = [world.body(name) for name in getattr(world, "agents", {})] or [world.body(a), world.body(b)]
+            walls = self._walls[key] = walls_between(world, pa, pb, z=self.antenna_z, ignore=ignore)
+        return math.dist(pa, pb), walls
 
     def link_rssi(self, a: str, b: str) -> float | None:
         """The RSSI between two agents now, their antennas' gains included (``None``
