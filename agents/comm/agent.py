@@ -97,14 +97,14 @@ class CommAgent:
                 if not self.explored:
                     return False
                 continue
-            if source not in self.final or len(self.history.items(source)) < self.final[source]:
+            if source not in self.final or self.history.count(source) < self.final[source]:
                 return False
         return True
 
     def missing(self) -> list[int]:
         """Team robots (not this one) whose data is not known final and complete here."""
         return sorted(s for s in self.team if s != self.address and
-                      (s not in self.final or len(self.history.items(s)) < self.final[s]))
+                      (s not in self.final or self.history.count(s) < self.final[s]))
 
     def untold(self) -> list[str]:
         """Peers this agent has not yet told that a source it holds in full is final: it
@@ -116,7 +116,7 @@ class CommAgent:
             if self.now - self.heard.get(name, self.since) > self.patience:
                 continue
             for source, total in self.final.items():
-                if source == peer.address or len(self.history.items(source)) < total:
+                if source == peer.address or self.history.count(source) < total:
                     continue
                 if ("final", name, source) not in self.asked:
                     out.append(name)
@@ -155,7 +155,7 @@ class CommAgent:
             key = ("final", peer.name, source)
             if source == peer.address or key in self.asked:
                 continue
-            if len(self.history.items(source)) >= total:
+            if self.history.count(source) >= total:
                 self.asked.add(key)
                 note = Message(0, source, total, self.address, peer.address)
                 note.final = True
@@ -189,7 +189,7 @@ class CommAgent:
         if message.code == 0:
             if final:
                 self.final[message.source] = max(self.final.get(message.source, 0), message.count)
-            have = len(self.history.items(message.source))
+            have = self.history.count(message.source)
             wanted = max(0, message.count - have)
             if wanted and sender is not None:
                 self.queue(Message(1, message.source, wanted, self.address, message.sender))
@@ -200,7 +200,7 @@ class CommAgent:
                 chosen = self.history.unsent(message.sender, message.source)[:message.count]
                 self.history.sent(message.sender, message.source, chosen)
                 if chosen:
-                    reply = Message(2, message.source, len(self.history.items(message.source)), self.address,
+                    reply = Message(2, message.source, self.history.count(message.source), self.address,
                                     message.sender, list(chosen))
                     reply.final = message.source in self.final
                     self.queue(reply)

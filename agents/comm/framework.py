@@ -112,54 +112,67 @@ class History:
 
     ``data`` holds ``(source, item, via)``: ``via`` is the agent it came from (the
     agent itself for its own data), so nothing goes back where it came from.
-    ``rows`` holds ``[from, to, sent, pending]`` in the order they were made.
+    ``rows`` holds ``[from, to, sent, pending]`` in the order they were made. Both are
+    indexed (by source, by row key) so a large team's history stays fast.
     """
 
     me: int
     data: list[tuple[int, Any, int]] = field(default_factory=list)
     rows: list[list[int]] = field(default_factory=list)
     given: dict[tuple[int, int], list[Any]] = field(default_factory=dict)  # (peer, source) -> items sent
+    _by_source: dict[int, list[tuple[Any, int]]] = field(default_factory=dict, repr=False)
+    _held: set = field(default_factory=set, repr=False)
+    _rows: dict[tuple[int, int], list[int]] = field(default_factory=dict, repr=False)
+    _given_sets: dict[tuple[int, int], set] = field(default_factory=dict, repr=False)
 
     def _row(self, source: int, to: int) -> list[int] | None:
-        for row in self.rows:
-            if row[0] == source and row[1] == to:
-                return row
-        return None
+        return self._rows.get((source, to))
+
+    def _add_row(self, row: list[int]) -> None:
+        self.rows.append(row)
+        self._rows[(row[0], row[1])] = row
+
+    def _keep(self, source: int, item: Any, via: int) -> None:
+        self.data.append((source, item, via))
+        self._by_source.setdefault(source, []).append((item, via))
+        self._held.add((source, _key(item)))
 
     def items(self, source: int, excluding_via: int | None = None) -> list[Any]:
-        return [item for s, item, via in self.data if s == source and via != excluding_via]
+        return [item for item, via in self._by_source.get(source, ()) if via != excluding_via]
+
+    def count(self, source: int) -> int:
+        """Items of ``source`` held."""
+        return len(self._by_source.get(source, ()))
 
     def sources(self) -> list[int]:
-        seen: list[int] = []
-        for source, _, _ in self.data:
-            if source not in seen:
-                seen.append(source)
-        return seen
+        return list(self._by_source)
 
     def has(self, source: int, item: Any) -> bool:
-        return any(s == source and i == item for s, i, _ in self.data)
+        return (source, _key(item)) in self._held
 
     def _more(self, source: int, count: int, sender: int) -> None:
-        for row in self.rows:
-            if row[0] == source and row[1] not in (self.me, sender):
+        for (row_source, to), row in self._rows.items():
+            if row_source == source and to not in (self.me, sender):
                 row[3] += count
 
     def add_own(self, item: Any) -> bool:
         """Data this agent made (a vertex it found); False if it had it already."""
         if self.has(self.me, item):
             return False
-        self.data.append((self.me, item, self.me))
+        self._keep(self.me, item, self.me)
         self._more(self.me, 1, self.me)
         return True
 
     def receive(self, sender: int, source: int, items: list[Any]) -> list[Any]:
         """Items of ``source`` arrived from ``sender``: keep the new ones; returns them."""
-        new = [item for item in items if not self.has(source, item)]
-        for item in new:
-            self.data.append((source, item, sender))
+        new = []
+        for item in items:
+            if not self.has(source, item):
+                self._keep(source, item, sender)
+                new.append(item)
         row = self._row(source, self.me)
         if row is None:
-            self.rows.append([source, self.me, len(items), 0])
+            self._add_row([source, self.me, len(items), 0])
         else:
             row[2] += len(items)
         if new:
@@ -174,13 +187,15 @@ class History:
         for source in self.sources():
             if source == peer:
                 continue
+            row = self._row(source, peer)
+            if row is not None and row[3] <= 0:
+                continue
             items = self.items(source, excluding_via=peer)
             if not items:
                 continue
-            row = self._row(source, peer)
             if row is None:
                 out.append((source, items, "new"))
-            elif row[3] > 0:
+            else:
                 out.append((source, items[-row[3]:], "pending"))
         return out
 
@@ -188,16 +203,17 @@ class History:
         """``items`` of ``source`` went to ``peer``: the row counts them, nothing pending."""
         row = self._row(source, peer)
         if row is None:
-            self.rows.append([source, peer, len(items), 0])
+            self._add_row([source, peer, len(items), 0])
         else:
             row[2] += len(items)
             row[3] = 0
         self.given.setdefault((peer, source), []).extend(items)
+        self._given_sets.setdefault((peer, source), set()).update(_key(i) for i in items)
 
     def unsent(self, peer: int, source: int) -> list[Any]:
         """Items of ``source`` this agent holds, did not get from ``peer`` and never sent it."""
-        given = self.given.get((peer, source), [])
-        return [item for item in self.items(source, excluding_via=peer) if item not in given]
+        given = self._given_sets.get((peer, source), set())
+        return [item for item in self.items(source, excluding_via=peer) if _key(item) not in given]
 
     def sent_count(self, peer: int, source: int) -> int:
         """Items of ``source`` sent to ``peer`` so far (the row's ``sent``)."""
@@ -207,6 +223,11 @@ class History:
     def pending(self, peer: int, source: int) -> int:
         row = self._row(source, peer)
         return 0 if row is None else row[3]
+
+
+def _key(item: Any) -> Any:
+    """A hashable stand-in for an item (lists become tuples)."""
+    return tuple(item) if isinstance(item, list) else item
 
 
 # Process 5 ---------------------------------------------------------------------------
