@@ -26,7 +26,7 @@ def maze_side(robots: int) -> int:
     return 6 if robots <= 3 else math.ceil(math.sqrt(12 * robots))
 
 
-def run(robots: int, mode: str, folder: Path) -> dict:
+def run(robots: int, mode: str, folder: Path, until: float = 6000.0) -> dict:
     from petriflow.agents.comm import metrics
     from petriflow.agents.comm.nets import build, world
     from petriflow.runtime.metrics import RunRecord
@@ -36,7 +36,7 @@ def run(robots: int, mode: str, folder: Path) -> dict:
     cols = maze_side(robots)
     area = round(cols * 5 / 6, 6)
     (folder / "world.yaml").write_text(yaml.safe_dump(world(robots=robots, cols=cols, area=area), sort_keys=False))
-    (folder / "run.yaml").write_text("seed: 1\nuntil: 6000\nstall: 1200\nworld: world.yaml\n"
+    (folder / "run.yaml").write_text(f"seed: 1\nuntil: {until}\nstall: 1200\nworld: world.yaml\n"
                                      "channels: {radio: {model: comm.radio, gains_db: {central: 20}}}\n")
     net = folder / f"{mode}-{robots}.yaml"
     net.write_text("run: run.yaml\n" + build(robots, mode, cols=cols, area=area, cell=area / cols))
@@ -59,6 +59,8 @@ def main(argv: list[str] | None = None) -> list[dict]:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robots", type=int, nargs="+", default=[3, 5, 10, 25, 50])
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--modes", nargs="+", default=["centralised", "decentralised"])
+    parser.add_argument("--until", type=float, default=6000.0, help="simulated-time limit of each run (s)")
     args = parser.parse_args(argv)
     sys.path.insert(0, str(ROOT))
     teams = [3, 5] if args.quick else args.robots
@@ -67,9 +69,9 @@ def main(argv: list[str] | None = None) -> list[dict]:
           "| maps complete | distance / robot (m) | run ends (s) | wall (s) | x real time |")
     print("|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for robots in teams:
-        for mode in ("centralised", "decentralised"):
+        for mode in args.modes:
             with tempfile.TemporaryDirectory() as tmp:
-                row = run(robots, mode, Path(tmp))
+                row = run(robots, mode, Path(tmp), args.until)
             rows.append(row)
             print(f"| {row['robots']} | {row['mode']} | {row['maze']} | {row['vertices']} | {row['bytes']:,} |"
                   f" {row['bytes'] / row['vertices']:.1f} | {row['time_s']:.0f} | {row['complete']:.2f} |"
