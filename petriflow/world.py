@@ -296,6 +296,16 @@ class World:
             return None
         return math.hypot(pa[0] - pb[0], pa[1] - pb[1])
 
+    def remove(self, name: str) -> None:
+        """Take a body (or an agent's robot) out of the scene, e.g. a robot a scenario
+        does not deploy; the agent then has no body (:meth:`position` is ``None``)."""
+        body = self.body(name)
+        name = self.agents.get(name, name)
+        self.p.removeBody(body, physicsClientId=self.client)
+        del self.bodies[name]
+        for agent in [a for a, b in self.agents.items() if b == name]:
+            del self.agents[agent]
+
     def camera(self, name: str = "camera") -> Camera:
         """A camera by id."""
         if name not in self.cameras:

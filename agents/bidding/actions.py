@@ -1,0 +1,787 @@
+"""Seed 004's agents as actions nets bind by name, and the guards that route them.
+
+Every agent's subnet has a work loop (its state token in ``<agent>_work``) and a
+listening place (the same state in ``<agent>_listen``). ``bidding.receive`` takes one
+message from the agent's mailbox (a channel place) into its state; the work loop's
+transitions act on what arrived, each guarded by the state:
+
+========================  ===========================================================
+``bidding.operator``      the operator: the mission (REQUEST, then INFORM)
+``bidding.interface``     creates the HMIA's state and its global map
+``bidding.robot``         creates an RA's state
+``bidding.team``          HMIA, on REQUEST + INFORM: INITIALIZE to every RA
+``bidding.ready``         RA, on INITIALIZE: its laser and pose; INITIALIZED back
+``bidding.inform``        HMIA, random deployment: each RA's zone list (INFORM)
+``bidding.cfp``           HMIA, autonomous deployment: the next zone to the RAs (CFP)
+``bidding.bid``           RA, on CFP: its eq. 6 cost to the other bidders (PROPOSE)
+``bidding.decide``        RA, all proposals in: lowest cost (ties: smallest rank)
+                          wins; the winner tells the HMIA (ALLOCATED)
+``bidding.map``           HMIA, every zone owned: MAP to every RA
+``bidding.explore``       RA: drive its zones nearest first, laser scans, MAPPED
+``bidding.end``           HMIA, every zone mapped: END to every RA
+``bidding.send``          any agent: the next message for one peer into its mailbox
+``bidding.wait``          any agent with nothing to do: wait for news
+========================  ===========================================================
+
+A robot that stops (a ``kill`` fault) stops answering; the HMIA notices (as a missing
+heartbeat: ``ctx.running``), and offers its unmapped zones again to the survivors (a
+re-auction, in both deployments).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+
+from petriflow.agents.bidding.agent import Auction, Interface, Operator, RobotAgent
+from petriflow.agents.bidding.auction import best, random_deployment, tour
+from petriflow.agents.bidding.cost import AREA_M2, SPEED_M_S, Weights, bid_costs
+from petriflow.agents.bidding.protocol import Message
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+
+__all__ = ["GUARDS"]
+
+
+def _state(ctx: ActionContext, kind: type) -> Any:
+    for tokens in ctx.inputs.values():
+        for data in tokens:
+            if isinstance(data, kind):
+                return data
+    raise ActionFailure(f"{ctx.transition!r}: no {kind.__name__} state among the input tokens")
+
+
+def _office(world: Any) -> Any:
+    meta = getattr(world, "meta", None) or {}
+    if "office" not in meta:
+        return None
+    return _office_of(_frozen(meta["office"]))
+
+
+def _frozen(value: Any) -> Any:
+    if isinstance(value, dict):
+        return tuple(sorted((k, _frozen(v)) for k, v in value.items()))
+    if isinstance(value, (list, tuple)):
+        return tuple(_frozen(v) for v in value)
+    return value
+
+
+def _thawed(value: Any) -> Any:
+    if isinstance(value, tuple) and value and all(isinstance(v, tuple) and len(v) == 2 and isinstance(v[0], str)
+                                                   for v in value):
+        return {k: _thawed(v) for k, v in value}
+    if isinstance(value, tuple):
+        return [_thawed(v) for v in value]
+    return value
+
+
+@lru_cache(maxsize=8)
+def _office_of(frozen: Any) -> Any:
+    from petriflow.agents.bidding.office import from_meta
+
+    return from_meta(_thawed(frozen))
+
+
+@lru_cache(maxsize=8)
+def _navigator(frozen: Any, resolution: float, inflate: float) -> Any:
+    from petriflow.agents.mobile.navigate import Navigator
+
+    free, frame = _office_of(frozen).free_grid(resolution, inflate)
+    return Navigator(free, frame.origin, frame.resolution)
+
+
+class _Instant(Action):
+    """Does its work in ``start``; ends ok at the first poll."""
+
+    def start(self, ctx: ActionContext) -> None:
+        ctx.result = self.run(ctx)
+
+    def poll(self, ctx: ActionContext) -> Status:
+        return Status.OK
+
+    def run(self, ctx: ActionContext) -> Any:  # pragma: no cover - overridden
+        raise NotImplementedError
+
+
+# Creating the agents ---------------------------------------------------------------------
+
+class MakeOperator(_Instant):
+    """The operator's mission: REQUEST, then INFORM (deployment, team, zones, lists)."""
+
+    params = {
+        "hmia": Param(str, "hmia", "the interface agent"),
+        "robots": Param(list, doc="the robot agents, in rank order"),
+        "deployment": Param(str, "autonomous", "autonomous (bidding) or random (the operator's lists)",
+                            choices=("autonomous", "random")),
+        "zones": Param((list, type(None)), None, "zone positions [[x, y], ...] in rank order (default: the"
+                       " world's office)"),
+        "lists": Param((list, type(None)), None, "random deployment: each robot's zone numbers (1-based), in"
+                       " visiting order (default: drawn at random with the run's seed)"),
+    }
+
+    def run(self, ctx: ActionContext) -> Operator:
+        p = self.params
+        zones = p["zones"]
+        if zones is None:
+            office = _office(ctx.world)
+            if office is None:
+                raise ActionFailure("bidding.operator: no zones given and the world has no meta.office")
+            zones = [list(z) for z in office.zones]
+        zones = [[float(v) for v in z[:2]] for z in zones]
+        robots = [str(r) for r in p["robots"]]
+        if not robots:
+            raise ActionFailure("bidding.operator: the team has no robot")
+        lists = p["lists"]
+        if p["deployment"] == "random":
+            if lists is None:
+                lists = random_deployment(len(robots), len(zones), ctx.rng)
+            else:
+                if len(lists) != len(robots):
+                    raise ActionFailure(f"bidding.operator: {len(lists)} zone lists for {len(robots)} robots")
+                lists = [[int(z) - 1 for z in zs] for zs in lists]
+                flat = sorted(z for zs in lists for z in zs)
+                if flat != list(range(len(zones))):
+                    raise ActionFailure("bidding.operator: the zone lists must hold every zone number from 1 to"
+                                        f" {len(zones)} once, got {[[z + 1 for z in zs] for zs in lists]}")
+        mission = {"deployment": p["deployment"], "robots": robots, "zones": zones, "lists": lists}
+        operator = Operator(ctx.agent or ctx.transition, p["hmia"], mission)
+        operator.queue(Message("REQUEST", operator.name, p["hmia"], body={"task": "map"}))
+        operator.queue(Message("INFORM", operator.name, p["hmia"], body={
+            "deployment": p["deployment"], "zones": [tuple(z) for z in zones],
+            "lists": None if lists is None else [list(zs) for zs in lists], "robots": list(robots)}))
+        ctx.emit("bidding.mission", deployment=p["deployment"], robots=len(robots), zones=len(zones),
+                 lists=None if lists is None else [[z + 1 for z in zs] for zs in lists])
+        return operator
+
+
+class MakeInterface(_Instant):
+    """The HMIA's state, with an empty global map over the world's office."""
+
+    params = {"resolution": Param(float, 0.1, "global map cell (m)")}
+
+    def run(self, ctx: ActionContext) -> Interface:
+        hmia = Interface(ctx.agent or ctx.transition)
+        office = _office(ctx.world)
+        if office is not None:
+            from petriflow.agents.bidding.grid import GlobalMap
+
+            truth = office.truth(self.params["resolution"])
+            hmia.truth = truth
+            hmia.global_map = GlobalMap(truth)
+        return hmia
+
+
+class MakeRobot(_Instant):
+    """An RA's state (it waits for INITIALIZE)."""
+
+    params = {"rank": Param(int, 0, "the robot's rank in the team (ties go to the smallest)"),
+              "hmia": Param(str, "hmia", "the interface agent")}
+
+    def run(self, ctx: ActionContext) -> RobotAgent:
+        return RobotAgent(ctx.agent or ctx.transition, self.params["rank"], self.params["hmia"])
+
+
+# Receiving -------------------------------------------------------------------------------
+
+class Receive(_Instant):
+    """One message from the agent's mailbox into its state."""
+
+    params = {"box": Param(str, doc="the mailbox (channel place)"), "state": Param(str, doc="the listening place")}
+
+    def run(self, ctx: ActionContext) -> None:
+        state = ctx.inputs[self.params["state"]][0]
+        packet = ctx.inputs[self.params["box"]][0]
+        message = packet.get("message") if isinstance(packet, dict) else None
+        if not isinstance(message, Message):
+            raise ActionFailure(f"bidding.receive: {self.params['box']!r} held no protocol message")
+        state.now = ctx.now
+        state.received[message.kind] = state.received.get(message.kind, 0) + 1
+        if isinstance(state, Interface):
+            _hmia_receive(ctx, state, message)
+        elif isinstance(state, RobotAgent):
+            _robot_receive(ctx, state, message)
+        ctx.put(self.params["state"], state)
+        return None
+
+
+def _hmia_receive(ctx: ActionContext, hmia: Interface, message: Message) -> None:
+    kind = message.kind
+    if kind == "REQUEST":
+        hmia.request = message
+    elif kind == "INFORM":
+        body = message.body
+        hmia.mode = body["deployment"]
+        hmia.robots = list(body["robots"])
+        hmia.zones = [tuple(z) for z in body["zones"]]
+        hmia.lists = body["lists"]
+        hmia.alive = {r for r in hmia.robots if ctx.running(r)}
+        hmia.requested = True
+    elif kind == "INITIALIZED":
+        hmia.initialised.add(message.sender)
+    elif kind == "ALLOCATED":
+        zone = message.zone
+        hmia.owner[zone] = message.sender
+        if hmia.auction == zone:
+            hmia.auction = None
+        ctx.emit("bidding.allocated", zone=zone + 1, robot=message.sender, cost=message.body.get("cost"))
+    elif kind == "MAPPED":
+        points = message.body.get("points")
+        if points is not None and len(points) and hmia.global_map is not None:
+            hmia.points += len(points)
+            hmia.global_map.add(int(message.body.get("rank", 0)), np.asarray(points, dtype=float))
+        for zone in message.body.get("finished", ()):
+            if zone not in hmia.finished:
+                hmia.finished.add(zone)
+                ctx.emit("bidding.zone_mapped", zone=zone + 1, robot=message.sender)
+
+
+def _robot_receive(ctx: ActionContext, ra: RobotAgent, message: Message) -> None:
+    kind = message.kind
+    body = message.body
+    if kind == "INITIALIZE":
+        ra.initialise = message
+    elif kind == "INFORM":  # random deployment: the operator's list for this robot
+        for zone, position in zip(body["zones"], body["positions"]):
+            ra.zones[zone] = tuple(position)
+            if zone not in ra.mine:
+                ra.mine.append(zone)
+            ra.order.append(zone)  # the operator's order is the visiting order
+    elif kind == "CFP":
+        ra.auctions = type(ra.auctions)(a for a in ra.auctions if a.zone != message.zone)
+        ra.auctions.append(Auction(message.zone, tuple(body["position"]), list(body["bidders"])))
+        ra.zones[message.zone] = tuple(body["position"])
+    elif kind == "PROPOSE":
+        for auction in ra.auctions:
+            if auction.zone == message.zone:
+                auction.proposals[message.sender] = float(body["cost"])
+                ra.ranks[message.sender] = int(body["rank"])
+    elif kind == "MAP":
+        ra.mapping = True
+    elif kind == "END":
+        ra.ended = True
+        ra.mapping = False
+
+
+# The interface agent --------------------------------------------------------------------
+
+def _hmia_alive(ctx: ActionContext, hmia: Interface) -> None:
+    """Robots that stopped: drop what waits for them, re-offer their unmapped zones."""
+    hmia.now = ctx.now
+    for robot in sorted(hmia.alive):
+        if ctx.running(robot):
+            continue
+        hmia.alive.discard(robot)
+        hmia.drop(robot)
+        lost = sorted(z for z, owner in hmia.owner.items() if owner == robot and z not in hmia.finished)
+        for zone in lost:
+            del hmia.owner[zone]
+            if zone not in hmia.to_offer:
+                hmia.to_offer.append(zone)
+        if hmia.auction is not None and hmia.auction not in hmia.owner:
+            hmia.to_offer.appendleft(hmia.auction)
+            hmia.auction = None
+        ctx.emit("bidding.breakdown", robot=robot, reoffered=[z + 1 for z in lost])
+
+
+class Team(_Instant):
+    """HMIA: create the team: INITIALIZE (with its start pose) to every RA."""
+
+    def run(self, ctx: ActionContext) -> Interface:
+        hmia = _state(ctx, Interface)
+        world = ctx.world
+        if world is not None:  # robots of the world that are not in the team are not deployed
+            for agent in [a for a in world.agents if a.startswith("robot") and a not in hmia.robots]:
+                world.remove(agent)
+        _hmia_alive(ctx, hmia)
+        for rank, robot in enumerate(hmia.robots):
+            if robot in hmia.alive:
+                hmia.queue(Message("INITIALIZE", hmia.name, robot, body={"rank": rank, "team": list(hmia.robots)}))
+        hmia.initialise_sent = True
+        if hmia.mode == "autonomous":
+            hmia.to_offer.extend(range(len(hmia.zones)))
+        return hmia
+
+
+class Inform(_Instant):
+    """HMIA, random deployment: every RA's zone list (INFORM)."""
+
+    def run(self, ctx: ActionContext) -> Interface:
+        hmia = _state(ctx, Interface)
+        _hmia_alive(ctx, hmia)
+        for robot, zones in zip(hmia.robots, hmia.lists or []):
+            for zone in zones:
+                hmia.owner[zone] = robot
+            if robot in hmia.alive:
+                hmia.queue(Message("INFORM", hmia.name, robot, body={
+                    "zones": list(zones), "positions": [hmia.zones[z] for z in zones]}))
+        hmia.informed = True
+        for zone in range(len(hmia.zones)):
+            if hmia.owner.get(zone) not in hmia.alive and zone not in hmia.to_offer:
+                hmia.owner.pop(zone, None)
+                hmia.to_offer.append(zone)
+        return hmia
+
+
+class Offer(_Instant):
+    """HMIA: a call for proposals for the next zone to every living RA (CFP)."""
+
+    def run(self, ctx: ActionContext) -> Interface:
+        hmia = _state(ctx, Interface)
+        _hmia_alive(ctx, hmia)
+        if not hmia.to_offer or not hmia.alive:
+            return hmia
+        zone = hmia.to_offer.popleft()
+        hmia.auction = zone
+        hmia.auction_at = ctx.now
+        bidders = [r for r in hmia.robots if r in hmia.alive]
+        hmia.broadcast("CFP", hmia.name, bidders, zone, {"position": hmia.zones[zone], "bidders": bidders})
+        ctx.emit("bidding.cfp", zone=zone + 1, bidders=len(bidders))
+        return hmia
+
+
+class StartMapping(_Instant):
+    """HMIA: every zone has an owner: MAP to every living RA (mapping starts)."""
+
+    def run(self, ctx: ActionContext) -> Interface:
+        hmia = _state(ctx, Interface)
+        hmia.broadcast("MAP", hmia.name, [r for r in hmia.robots if r in hmia.alive])
+        hmia.map_sent = ctx.now
+        ctx.emit("bidding.map", owners={str(z + 1): r for z, r in sorted(hmia.owner.items())})
+        return hmia
+
+
+class End(_Instant):
+    """HMIA: every zone is mapped: END to every living RA; the map's accuracy (eq. 10)."""
+
+    params = {"tolerance": Param(int, 1, "cells between a mapped point and a real obstacle that still count"
+                                 " as real (eq. 10's sigma)")}
+
+    def run(self, ctx: ActionContext) -> Interface:
+        hmia = _state(ctx, Interface)
+        _hmia_alive(ctx, hmia)
+        hmia.broadcast("END", hmia.name, [r for r in hmia.robots if r in hmia.alive])
+        hmia.end_sent = ctx.now
+        report: dict[str, Any] = {"time_s": round(ctx.now - (hmia.map_sent or 0.0), 6), "points": hmia.points}
+        if hmia.global_map is not None:
+            from petriflow.agents.bidding.grid import accuracy
+
+            score = accuracy(hmia.global_map.occupied, hmia.truth.occupied, self.params["tolerance"])
+            report.update(accuracy_pct=round(score.percent, 4), sigma=int(score.sigma), xi=int(score.xi),
+                          coverage=round(score.coverage, 4))
+        ctx.emit("bidding.end", **report)
+        return hmia
+
+
+# Robot agents ----------------------------------------------------------------------------
+
+class Ready(_Instant):
+    """RA, on INITIALIZE: take its pose and laser; INITIALIZED back."""
+
+    params = {"radius": Param(float, 0.1, "wheel radius (m)"), "ppr": Param(int, 500, "encoder pulses per turn"),
+              "track": Param(float, 0.33, "wheel track (m)")}
+
+    def run(self, ctx: ActionContext) -> RobotAgent:
+        ra = _state(ctx, RobotAgent)
+        if ctx.world is None:
+            raise ActionFailure("bidding.ready: a robot agent needs a world")
+        from petriflow.agents.mobile.kinematic import KinematicRobot
+
+        ra.robot = KinematicRobot(ctx.world, ra.name, radius=self.params["radius"], ppr=self.params["ppr"],
+                                  track=self.params["track"])
+        if ra.initialise is not None:
+            ra.rank = int(ra.initialise.body.get("rank", ra.rank))
+            ra.team = list(ra.initialise.body.get("team", [ra.name]))
+        ra.ranks.update({name: rank for rank, name in enumerate(ra.team)})
+        _robot_alive(ctx, ra)
+        ra.initialised = True
+        x, y, yaw = ra.robot.pose
+        ra.queue(Message("INITIALIZED", ra.name, ra.hmia, body={"pose": (x, y, yaw)}))
+        ctx.emit("bidding.ready", pose=[round(x, 3), round(y, 3), round(yaw, 4)])
+        return ra
+
+
+class Bid(_Instant):
+    """RA, on CFP: its cost for the zone by eq. 6, to every other bidder (PROPOSE)."""
+
+    params = {
+        "speed": Param(float, SPEED_M_S, "the speed turning distance into travel time P_ij (m/s)"),
+        "accuracy": Param(float, 1.0, "E_i, the laser's accuracy (0..1)"),
+        "alpha": Param(float, 1 / 3, "eq. 6 weight of travel time"),
+        "beta": Param(float, 1 / 3, "eq. 6 weight of the zones held"),
+        "gamma": Param(float, 1 / 3, "eq. 6 weight of sensor inaccuracy"),
+        "area": Param(float, AREA_M2, "L x W (m^2)"),
+    }
+
+    def run(self, ctx: ActionContext) -> RobotAgent:
+        ra = _state(ctx, RobotAgent)
+        auction = ra.auction()
+        if auction is None:
+            raise ActionFailure("bidding.bid: no call for proposals")
+        p = self.params
+        x, y, _ = ra.robot.pose
+        travel = math.dist((x, y), auction.position) / p["speed"]
+        held = len(ra.mine)  # the zones this robot already holds (eq. 6's sum over k < j)
+        weights = Weights(p["alpha"], p["beta"], p["gamma"])
+        cost = float(bid_costs([[travel]], [held], [p["accuracy"]], area=p["area"], weights=weights)[0, 0])
+        auction.own = cost
+        others = [b for b in auction.bidders if b != ra.name]
+        if others:
+            ra.broadcast("PROPOSE", ra.name, others, auction.zone, {"cost": cost, "rank": ra.rank})
+        ctx.emit("bidding.bid", zone=auction.zone + 1, cost=round(cost, 6), held=held)
+        return ra
+
+
+class Decide(_Instant):
+    """RA, every proposal in: the lowest cost wins (ties: smallest rank); the winner
+    takes the zone and tells the HMIA (ALLOCATED)."""
+
+    def run(self, ctx: ActionContext) -> RobotAgent:
+        ra = _state(ctx, RobotAgent)
+        auction = ra.auctions.popleft()
+        names = [ra.name] + [b for b in auction.proposals if b in ra.alive or not ra.alive]
+        costs = [auction.own] + [auction.proposals[b] for b in names[1:]]
+        ranks = [ra.rank] + [ra.ranks.get(b, 1 << 30) for b in names[1:]]
+        winner_rank = best(costs, ranks)
+        if winner_rank == ra.rank:
+            if auction.zone not in ra.mine:
+                ra.mine.append(auction.zone)
+            ra.queue(Message("ALLOCATED", ra.name, ra.hmia, zone=auction.zone, body={"cost": auction.own}))
+        ctx.emit("bidding.decided", zone=auction.zone + 1, won=winner_rank == ra.rank)
+        return ra
+
+
+def _robot_alive(ctx: ActionContext, ra: RobotAgent) -> None:
+    ra.alive = {r for r in ra.team if ctx.running(r)}
+
+
+class Explore(Action):
+    """RA: drive to its zones nearest first, visiting each zone's waypoints and turning
+    a full circle at each, scanning the laser every ``scan_period`` s; each scan's new
+    world points (eq. 7-8) go to the HMIA (MAPPED), with the zones finished.
+
+    Ends after ``step`` s, or as soon as a message waits to be sent, so the work loop
+    sends it and answers calls for proposals while mapping.
+    """
+
+    params = {
+        "speed": Param(float, SPEED_M_S, "cruise speed (m/s)"),
+        "turn_rate": Param(float, 1.0, "turn rate (rad/s)"),
+        "step": Param(float, 1.0, "longest run of one firing (s)"),
+        "scan_period": Param(float, 1.0, "seconds between laser scans"),
+        "range": Param(float, 8.0, "laser range (m)"),
+        "fov": Param(float, 180.0, "laser field of view (degrees)"),
+        "beams": Param(int, 360, "laser beams"),
+        "z": Param(float, 0.13, "laser height (m): at the robots' body height, so teammates are seen"),
+        "filter_teammates": Param(bool, False, "drop laser returns on teammates (the paper's drawback, fixed)"),
+        "cell": Param(float, 0.1, "a point is new when its cell (m) was not sent before"),
+        "send": Param(str, "every", "MAPPED after every scan (every, the paper's: its message counts follow"
+                      " the mapping time) or only after scans that saw new cells (new)", choices=("every", "new")),
+        "spin": Param(bool, True, "turn a full circle at every waypoint"),
+        "visit": Param(str, "centre", "what mapping a zone means: drive to its position (centre, the paper's)"
+                       " or through waypoints spread over its room (room)", choices=("centre", "room")),
+        "clearance": Param(float, 0.8, "hold while a robot of smaller rank is this close ahead (m)"),
+        "patience": Param(float, 3.0, "seconds held before planning a detour around the robot in the way"),
+        "inflate": Param(float, 0.35, "obstacle margin for path planning (m)"),
+    }
+    needs_world = True
+
+    def start(self, ctx: ActionContext) -> None:
+        self.ra = ra = _state(ctx, RobotAgent)
+        ra.now = ctx.now
+        self.left = self.params["step"]
+        self.at = ctx.now
+        ctx.result = ra
+        if ra.robot is None:
+            raise ActionFailure("bidding.explore: the robot agent is not initialised")
+        _robot_alive(ctx, ra)
+
+    def poll(self, ctx: ActionContext) -> Status:
+        ra = self.ra
+        world = ctx.world
+        dt = ctx.now - self.at  # the first poll comes at the start: no time has passed yet
+        self.at = ra.now = ctx.now
+        if dt <= 1e-12:
+            return Status.RUNNING
+        self.dt = dt
+        self.left -= dt
+        if not ra.route and ra.spin_left <= 0:
+            if not self._next(ctx):
+                return Status.OK
+        if ra.spin_left > 0:
+            w = self.params["turn_rate"]
+            half = ra.robot.encoders.track / 2.0
+            ra.robot.drive(-w * half, w * half, dt)
+            ra.spin_left -= w * dt
+        elif not self._held(ctx):
+            target = ra.route[0]
+            if ra.robot.step_towards(target, self.params["speed"], self.params["turn_rate"], dt, tolerance=0.05):
+                ra.route.pop(0)
+                if not ra.route:
+                    ra.passing = None
+                    ra.spin_left = 2 * math.pi if self.params["spin"] else 0.0
+        ra.waiting += dt
+        if ra.waiting >= self.params["scan_period"] - 1e-9:
+            ra.waiting = 0.0
+            self._scan(ctx)
+        if not ra.route and ra.spin_left <= 0 and not ra.waypoints and ra.plan:
+            self._zone_done(ctx)
+        if ra.pending() or self.left <= 1e-9:
+            return Status.OK
+        return Status.RUNNING
+
+    def _next(self, ctx: ActionContext) -> bool:
+        """Route to the next waypoint (of this zone, or of the nearest zone left)."""
+        ra = self.ra
+        if not ra.waypoints:
+            left = ra.left()
+            if not left:
+                return False
+            x, y, _ = ra.robot.pose
+            listed = [z for z in ra.order if z in left]
+            zone = listed[0] if listed else left[tour((x, y), [ra.zones[z] for z in left])[0]]
+            ra.plan = [zone]
+            office = _office(ctx.world)
+            if office is not None and self.params["visit"] == "room":
+                points = [tuple(p) for p in office.waypoints(zone)]
+            else:
+                points = [ra.zones[zone]]
+            ra.waypoints = [points[k] for k in tour((x, y), points)]
+        goal = ra.waypoints.pop(0)
+        office = _office(ctx.world)
+        if office is None:
+            ra.route = [goal]
+            return True
+        meta = _frozen(ctx.world.meta["office"])
+        route = _navigator(meta, 0.1, self.params["inflate"]).route(ra.robot.pose[:2], goal)
+        if route is None:
+            ctx.emit("bidding.unreachable", goal=[round(goal[0], 3), round(goal[1], 3)])
+            return bool(ra.waypoints) or self._finish_zone(ctx)
+        ra.route = route
+        return True
+
+    def _finish_zone(self, ctx: ActionContext) -> bool:
+        self._zone_done(ctx)
+        return False
+
+    def _zone_done(self, ctx: ActionContext) -> None:
+        ra = self.ra
+        zone = ra.plan.pop(0)
+        ra.done.add(zone)
+        ra.queue(Message("MAPPED", ra.name, ra.hmia, zone=zone, body={"points": None, "finished": [zone],
+                                                                      "rank": ra.rank}))
+        ctx.emit("bidding.zone_done", zone=zone + 1, distance_m=round(ra.robot.travelled, 3))
+
+    def _held(self, ctx: ActionContext) -> bool:
+        """Hold while a robot of smaller rank is close ahead (no two robots wait for
+        each other: ranks order them); after ``patience`` s, drive around it."""
+        ra = self.ra
+        blocker = self._blocker(ctx.world)
+        if blocker is None:
+            ra.held = 0.0
+            return False
+        ra.held += self.dt
+        if ra.held < self.params["patience"]:
+            return True
+        ra.held = 0.0
+        office = _office(ctx.world)
+        if office is None or not ra.route:
+            return False
+        where = ctx.world.position(blocker)
+        navigator = _navigator(_frozen(ctx.world.meta["office"]), 0.1, self.params["inflate"])
+        detour = navigator.around([(where[0], where[1], self.params["clearance"])]).route(ra.robot.pose[:2],
+                                                                                           ra.route[-1])
+        ctx.emit("bidding.detour", around=blocker, found=detour is not None)
+        if detour is not None:
+            ra.route = detour
+            ra.passing = blocker
+        return False
+
+    def _blocker(self, world: Any) -> str | None:
+        ra = self.ra
+        x, y, yaw = ra.robot.pose
+        for other in ra.alive:
+            if other == ra.name or other == ra.passing or ra.ranks.get(other, ra.rank) >= ra.rank:
+                continue
+            where = world.position(other)
+            if where is None:
+                continue
+            dx, dy = where[0] - x, where[1] - y
+            distance = math.hypot(dx, dy)
+            if distance < self.params["clearance"]:
+                bearing = math.atan2(dy, dx) - yaw
+                if math.cos(bearing) > 0.3:
+                    return other
+        return None
+
+    def _scan(self, ctx: ActionContext) -> None:
+        from petriflow.agents.bidding.laser import scan, world_points
+
+        ra = self.ra
+        p = self.params
+        pose = ra.robot.pose
+        ranges, angles = scan(ctx.world, ra.name, pose, max_range=p["range"], fov_deg=p["fov"], beams=p["beams"],
+                              z=p["z"], ignore_teammates=p["filter_teammates"])
+        points = world_points(pose, ranges, angles, p["range"])
+        ra.scans += 1
+        every = p["send"] == "every"
+        if not len(points):
+            if every:
+                ra.queue(Message("MAPPED", ra.name, ra.hmia, body={"points": None, "finished": [], "rank": ra.rank}))
+            return
+        cells = np.floor(points / p["cell"]).astype(np.int64)
+        keys = cells[:, 0] * 1_000_003 + cells[:, 1]
+        keys, first = np.unique(keys, return_index=True)
+        new = [k for k in range(len(keys)) if int(keys[k]) not in ra.seen]
+        if not new and not every:
+            return
+        ra.seen.update(int(keys[k]) for k in new)
+        fresh = points[first[new]].astype(np.float32)
+        ra.queue(Message("MAPPED", ra.name, ra.hmia, body={"points": fresh, "finished": [], "rank": ra.rank}))
+
+
+class Send(_Instant):
+    """Any agent: the next message waiting for ``peer`` into its mailbox."""
+
+    params = {"peer": Param(str, doc="the receiving agent"), "box": Param(str, doc="its mailbox (channel place)"),
+              "state": Param(str, doc="the work place the state goes back to")}
+
+    def run(self, ctx: ActionContext) -> Any:
+        state = ctx.inputs[self.params["state"]][0]
+        message = state.take(self.params["peer"])
+        if message is None:
+            raise ActionFailure(f"bidding.send: nothing waits for {self.params['peer']!r}")
+        ctx.put(self.params["box"], message.token())
+        ctx.put(self.params["state"], state)
+        ctx.emit("bidding.sent", message=message.kind, to=message.receiver, bytes=message.size,
+                 broadcast=message.cast)
+        return state
+
+
+class Wait(Action):
+    """An agent with nothing to do: wait until something is (at most ``period`` s)."""
+
+    params = {"period": Param(float, 1.0, "longest wait (s)")}
+
+    def start(self, ctx: ActionContext) -> None:
+        self.state = ctx.token()
+        self.until = ctx.now + self.params["period"]
+        ctx.result = self.state
+
+    def poll(self, ctx: ActionContext) -> Status:
+        state = self.state
+        state.now = ctx.now
+        if isinstance(state, Interface):
+            _hmia_alive(ctx, state)
+        elif isinstance(state, RobotAgent):
+            _robot_alive(ctx, state)
+        if ctx.world is None or ctx.now >= self.until - 1e-9 or (ctx.now > ctx.started and _busy(state)):
+            return Status.OK
+        return Status.RUNNING
+
+
+# Guards ----------------------------------------------------------------------------------
+
+def _find(tokens: dict[str, list[Any]], kind: type = object) -> Any:
+    for ts in tokens.values():
+        for d in ts:
+            if d is not None and isinstance(d, kind):
+                return d
+    return None
+
+
+def _hmia_next(h: Interface) -> str | None:
+    """What the HMIA should do now, or ``None``."""
+    if h.end_sent is not None:
+        return None
+    if h.requested and not h.initialise_sent:
+        return "team"
+    if not h.initialise_sent:
+        return None
+    if not h.alive:
+        return "end" if h.map_sent is not None or h.initialised else None
+    if not (h.initialised >= h.alive):
+        return None
+    if h.mode == "random" and not h.informed:
+        return "inform"
+    if h.to_offer and h.auction is None:
+        return "cfp"
+    if h.auction is not None and h.now - getattr(h, "auction_at", h.now) > 10.0:
+        h.to_offer.appendleft(h.auction)  # the winner never answered: offer again
+        h.auction = None
+        return "cfp"
+    if h.map_sent is None and h.deployed():
+        return "map"
+    if h.done():
+        return "end"
+    return None
+
+
+def _robot_next(r: RobotAgent) -> str | None:
+    if r.ended:
+        return None
+    if r.initialise is not None and not r.initialised:
+        return "ready"
+    if r.bids_in():
+        return "decide"
+    if r.to_bid():
+        return "bid"
+    if r.mapping and (r.left() or r.route or r.spin_left > 0):
+        return "explore"
+    return None
+
+
+def _busy(state: Any) -> bool:
+    if state.pending():
+        return True
+    if isinstance(state, Interface):
+        return _hmia_next(state) is not None or state.end_sent is not None
+    if isinstance(state, RobotAgent):
+        return _robot_next(state) is not None or state.ended
+    return True
+
+
+def _guard(step: str):
+    def guard(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+        state = _find(tokens, (Interface, RobotAgent))
+        if state is None:
+            return False
+        return (_hmia_next(state) if isinstance(state, Interface) else _robot_next(state)) == step
+    guard.__name__ = f"next_is_{step}"
+    guard.__doc__ = f"Guard: the agent's next step is {step!r}."
+    return guard
+
+
+def has_message(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+    """Guard: a message waits for ``params['peer']``."""
+    state = _find(tokens, (Operator, Interface, RobotAgent))
+    return state is not None and state.has_for(params["peer"])
+
+
+def finished(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+    """Guard: the agent's part is over (operator: sent everything; HMIA: END sent;
+    RA: END received) and nothing waits to be sent."""
+    state = _find(tokens, (Operator, Interface, RobotAgent))
+    if state is None or state.pending():
+        return False
+    if isinstance(state, Operator):
+        return True
+    if isinstance(state, Interface):
+        return state.end_sent is not None
+    return state.ended
+
+
+def idle(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+    """Guard: nothing to do now (the agent waits for news)."""
+    state = _find(tokens, (Interface, RobotAgent))
+    return state is not None and not _busy(state)
+
+
+GUARDS = {
+    "bidding.has_message": has_message,
+    "bidding.finished": finished,
+    "bidding.idle": idle,
+    **{f"bidding.next_{step}": _guard(step) for step in
+       ("team", "inform", "cfp", "map", "end", "ready", "bid", "decide", "explore")},
+}

@@ -1,0 +1,36 @@
+"""Registers seed 004's agents (the ``petriflow.actions`` entry point): actions, guards
+and the mission's metrics."""
+
+from __future__ import annotations
+
+__all__ = ["register"]
+
+_A = "petriflow.agents.bidding.actions"
+ACTIONS = {
+    "bidding.operator": (f"{_A}:MakeOperator", "the operator: the mission (REQUEST, INFORM)"),
+    "bidding.interface": (f"{_A}:MakeInterface", "the interface agent's state and global map"),
+    "bidding.robot": (f"{_A}:MakeRobot", "a robot agent's state"),
+    "bidding.receive": (f"{_A}:Receive", "one message from the agent's mailbox into its state"),
+    "bidding.team": (f"{_A}:Team", "HMIA: INITIALIZE every robot agent"),
+    "bidding.inform": (f"{_A}:Inform", "HMIA, random deployment: INFORM each robot of its zones"),
+    "bidding.cfp": (f"{_A}:Offer", "HMIA: CFP, the next zone to every living robot agent"),
+    "bidding.map": (f"{_A}:StartMapping", "HMIA: MAP, mapping starts"),
+    "bidding.end": (f"{_A}:End", "HMIA: END, and the map's accuracy (eq. 10)"),
+    "bidding.ready": (f"{_A}:Ready", "RA: laser and pose; INITIALIZED"),
+    "bidding.bid": (f"{_A}:Bid", "RA: eq. 6 cost to the other bidders (PROPOSE)"),
+    "bidding.decide": (f"{_A}:Decide", "RA: lowest cost wins, ties to the smallest rank (ALLOCATED)"),
+    "bidding.explore": (f"{_A}:Explore", "RA: map its zones nearest first, laser scans (MAPPED)"),
+    "bidding.send": (f"{_A}:Send", "the next message for one peer into its mailbox"),
+    "bidding.wait": (f"{_A}:Wait", "an agent with nothing to do waits for news"),
+}
+
+
+def register(registry) -> None:
+    from petriflow.agents.bidding import metrics
+    from petriflow.agents.bidding.actions import GUARDS
+
+    for name, (target, doc) in ACTIONS.items():
+        registry.register(name, target, doc=doc)
+    for name, function in GUARDS.items():
+        registry.predicate(name)(function)
+    metrics.register(registry)
