@@ -53,11 +53,26 @@ def _state(ctx: ActionContext, kind: type) -> Any:
     raise ActionFailure(f"{ctx.transition!r}: no {kind.__name__} state among the input tokens")
 
 
+_OFFICES: dict[int, tuple[Any, Any, Any]] = {}
+
+
 def _office(world: Any) -> Any:
+    """The world's office plan (``meta.office``), or ``None``; read once per world."""
     meta = getattr(world, "meta", None) or {}
     if "office" not in meta:
         return None
-    return _office_of(_frozen(meta["office"]))
+    cached = _OFFICES.get(id(meta["office"]))
+    if cached is None or cached[0] is not meta["office"]:
+        if len(_OFFICES) > 16:
+            _OFFICES.clear()
+        key = _frozen(meta["office"])
+        cached = _OFFICES[id(meta["office"])] = (meta["office"], key, _office_of(key))
+    return cached[2]
+
+
+def _office_key(world: Any) -> Any:
+    _office(world)
+    return _OFFICES[id(world.meta["office"])][1]
 
 
 def _frozen(value: Any) -> Any:
@@ -411,7 +426,7 @@ class Bid(_Instant):
         "alpha": Param(float, 1 / 3, "eq. 6 weight of travel time"),
         "beta": Param(float, 1 / 3, "eq. 6 weight of the zones held"),
         "gamma": Param(float, 1 / 3, "eq. 6 weight of sensor inaccuracy"),
-        "area": Param(float, AREA_M2, "L x W (m^2)"),
+        "area": Param((float, type(None)), None, "L x W (m^2); default: the world's office, else 32 x 22"),
     }
 
     def run(self, ctx: ActionContext) -> RobotAgent:
@@ -424,7 +439,11 @@ class Bid(_Instant):
         travel = math.dist((x, y), auction.position) / p["speed"]
         held = len(ra.mine)  # the zones this robot already holds (eq. 6's sum over k < j)
         weights = Weights(p["alpha"], p["beta"], p["gamma"])
-        cost = float(bid_costs([[travel]], [held], [p["accuracy"]], area=p["area"], weights=weights)[0, 0])
+        area = p["area"]
+        if area is None:
+            office = _office(ctx.world)
+            area = office.size[0] * office.size[1] if office is not None else AREA_M2
+        cost = float(bid_costs([[travel]], [held], [p["accuracy"]], area=area, weights=weights)[0, 0])
         auction.own = cost
         others = [b for b in auction.bidders if b != ra.name]
         if others:
@@ -553,8 +572,7 @@ class Explore(Action):
         if office is None:
             ra.route = [goal]
             return True
-        meta = _frozen(ctx.world.meta["office"])
-        route = _navigator(meta, 0.1, self.params["inflate"]).route(ra.robot.pose[:2], goal)
+        route = _navigator(_office_key(ctx.world), 0.1, self.params["inflate"]).route(ra.robot.pose[:2], goal)
         if route is None:
             ctx.emit("bidding.unreachable", goal=[round(goal[0], 3), round(goal[1], 3)])
             return bool(ra.waypoints) or self._finish_zone(ctx)
@@ -589,7 +607,7 @@ class Explore(Action):
         if office is None or not ra.route:
             return False
         where = ctx.world.position(blocker)
-        navigator = _navigator(_frozen(ctx.world.meta["office"]), 0.1, self.params["inflate"])
+        navigator = _navigator(_office_key(ctx.world), 0.1, self.params["inflate"])
         detour = navigator.around([(where[0], where[1], self.params["clearance"])]).route(ra.robot.pose[:2],
                                                                                            ra.route[-1])
         ctx.emit("bidding.detour", around=blocker, found=detour is not None)

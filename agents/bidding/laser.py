@@ -107,5 +107,9 @@ def scan(world: Any, agent: str, pose: Any, *, max_range: float = RANGE_M, fov_d
     # bring the bodies' bounding boxes up to date (a world not stepped since it was built or
     # since robots were placed has stale ones, and the rays would pass through the robots)
     world.p.performCollisionDetection(physicsClientId=world.client)
-    ranges = cast(world, (x, y), theta, angles, max_range, z=z, ignore=ignore)
+    body = world.body(agent)
+    low, high = world.p.getAABB(body, physicsClientId=world.client)
+    hx, hy = (high[0] - low[0]) / 2.0, (high[1] - low[1]) / 2.0
+    near = math.hypot(hx, hy) + 0.01 if pose is None or math.hypot(x - (low[0] + hx), y - (low[1] + hy)) < 0.05 else 0.0
+    ranges = cast(world, (x, y), theta, angles, max_range, z=z, ignore=ignore, near=near)
     return np.asarray(ranges, dtype=float), np.asarray(angles, dtype=float)

@@ -30,8 +30,11 @@ def laser_angles(fov_deg: float, beams: int) -> list[float]:
 
 
 def cast(world: Any, origin: tuple[float, float], heading: float, angles: Sequence[float], max_range: float,
-         *, z: float = 0.1, ignore: Iterable[int] = ()) -> list[float]:
+         *, z: float = 0.1, ignore: Iterable[int] = (), near: float = 0.0) -> list[float]:
     """Ranges (m) of rays from ``origin`` at ``heading + angle`` for each angle.
+
+    Rays start ``near`` metres out (past the sensor's own body: nothing nearer is
+    seen, and no ray is cast twice to leave that body); ranges are from ``origin``.
 
     A ray that hits only ignored bodies (or nothing) reads ``max_range``; one hitting an
     ignored body (each link of a robot: chassis, wheels, caster) is cast again from just
@@ -40,11 +43,12 @@ def cast(world: Any, origin: tuple[float, float], heading: float, angles: Sequen
     p = world.p
     ignored = set(ignore)
     x, y = origin
-    starts = [(x, y, z)] * len(angles)
+    near = min(max(near, 0.0), max_range)
+    starts = [(x + near * math.cos(heading + a), y + near * math.sin(heading + a), z) for a in angles]
     ends = [(x + max_range * math.cos(heading + a), y + max_range * math.sin(heading + a), z) for a in angles]
     ranges = [max_range] * len(angles)
     pending = list(range(len(angles)))
-    offset = [0.0] * len(angles)
+    offset = [near] * len(angles)
     for _ in range(64):
         if not pending:
             break
