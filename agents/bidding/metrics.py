@@ -11,6 +11,8 @@
   put into mailboxes (a broadcast once per receiver; ``core.messages`` counts these).
 * ``bidding.distance_m``: distance driven, mean over the robots.
 * ``bidding.zones_of``: each robot's zones (1-based), ``{"robot1": [6, 8], ...}``.
+* ``bidding.reauctioned``: zones offered again after robots broke down.
+* ``bidding.zones_mapped``: zones the HMIA heard were mapped.
 """
 
 from __future__ import annotations
@@ -88,10 +90,19 @@ def zones_of(record: Any) -> dict[str, list[int]]:
     return out
 
 
+def reauctioned(record: Any) -> int:
+    return sum(len(e.data["data"]["reoffered"]) for e in _custom(record, "bidding.breakdown"))
+
+
+def zones_mapped(record: Any) -> int:
+    return len({e.data["data"]["zone"] for e in _custom(record, "bidding.zone_mapped")})
+
+
 def register(registry: Any) -> None:
     """Register the metrics (the ``petriflow.actions`` plugin calls this)."""
     for name, function in (("bidding.time_s", time_s), ("bidding.accuracy_pct", accuracy_pct),
                            ("bidding.coverage", coverage), ("bidding.messages", messages), ("bidding.deliveries", deliveries),
                            ("bidding.messages_by_kind", messages_by_kind), ("bidding.distance_m", distance_m),
-                           ("bidding.zones_of", zones_of)):
+                           ("bidding.zones_of", zones_of),
+                           ("bidding.reauctioned", reauctioned), ("bidding.zones_mapped", zones_mapped)):
         registry.register_metric(name, function, events=True)
