@@ -77,7 +77,10 @@ def _build_net(spec: dict[str, Any], params: dict[str, Any], values: dict[str, A
             builder = getattr(importlib.import_module(module_name), name)
         except (ImportError, AttributeError) as exc:
             raise TrialError(f"net builder {net_spec['builder']!r}: {exc}") from None
-        built = builder(**params)
+        try:
+            built = builder(**params)
+        except (TypeError, ValueError, KeyError) as exc:  # the builder refuses these parameters
+            raise TrialError(f"net builder {net_spec['builder']!r}: {exc}") from None
         where = Path(spec["path"])
         if isinstance(built, str):
             from petriflow.io.yaml import loads_net

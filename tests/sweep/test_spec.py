@@ -127,3 +127,13 @@ def test_rows_are_built_before_anything_runs(folder, tmp_path, body, fragment):
         load_sweep(path)
     assert fragment in str(caught.value)
     assert str(caught.value).startswith(f"{path}:{3 if body.startswith(('set', 'metrics')) else 4}: ")
+
+
+def test_a_builder_refusing_a_row_is_one_error_naming_the_row(tmp_path):
+    (tmp_path / "world.yaml").write_text("dt: 0.1\n")
+    (tmp_path / "run.yaml").write_text("world: world.yaml\n")
+    path = write(tmp_path, "bad.yaml", "petriflow-sweep: 1\nnet: {builder: 'petriflow.agents.bidding.nets:build'}\n"
+                 "run: run.yaml\nmatrix: {robots: [2, 0]}\n")
+    with pytest.raises(NetFormatError) as caught:
+        load_sweep(path)
+    assert str(caught.value).startswith(f"{path}:2: row 2 ") and "robots must be from 1 to 200, got 0" in str(caught.value)
