@@ -136,6 +136,36 @@ class MakeOperator(_Instant):
                        " visiting order (default: drawn at random with the run's seed)"),
     }
 
+    @classmethod
+    def check_params(cls, given: dict[str, Any], where: str) -> dict[str, Any]:
+        """The declared types, then the shapes: zones are ``[x, y]`` pairs of finite
+        numbers, lists hold whole zone numbers from 1, robots are names."""
+        from petriflow.errors import NetFormatError
+
+        checked = super().check_params(given, where)
+
+        def fail(name: str, why: str) -> None:
+            error = NetFormatError(f"parameter {name!r}: {why}", element=where)
+            error.param = name
+            raise error
+
+        def number(v: Any) -> bool:
+            return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+        if not checked["robots"] or not all(isinstance(r, str) and r for r in checked["robots"]):
+            fail("robots", f"a non-empty list of agent names, got {checked['robots']!r}")
+        if checked["zones"] is not None and not all(
+                isinstance(z, (list, tuple)) and len(z) >= 2 and all(number(v) for v in z[:2]) for z in checked["zones"]):
+            fail("zones", "a list of [x, y] positions in metres")
+        lists = checked["lists"]
+        if lists is not None:
+            if not all(isinstance(zs, list) and all(isinstance(z, int) and not isinstance(z, bool) and z >= 1
+                                                    for z in zs) for zs in lists):
+                fail("lists", f"one list of zone numbers (1, 2, ...) per robot, got {lists!r}")
+            if len(lists) != len(checked["robots"]):
+                fail("lists", f"{len(lists)} zone lists for {len(checked['robots'])} robots")
+        return checked
+
     def run(self, ctx: ActionContext) -> Operator:
         p = self.params
         zones = p["zones"]

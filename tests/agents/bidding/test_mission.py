@@ -155,3 +155,47 @@ def test_filtering_teammates_removes_the_fictitious_obstacles(tmp_path):
     seen = _custom(_run(tmp_path, 3), "bidding.end")[0].data["data"]
     filtered = _custom(_run(tmp_path, 3, filter_teammates=True), "bidding.end")[0].data["data"]
     assert seen["xi"] > 0 and filtered["xi"] == 0 and filtered["accuracy_pct"] == 100.0
+
+
+def test_hmia_steps_and_a_robots_exploration_fire_alone():
+    from petriflow.agents.bidding.agent import Interface, RobotAgent
+    from petriflow.agents.bidding.protocol import Message
+
+    net = load_net(examples.path("bidding", "bidding-autonomous-2.yaml"))
+    config = load_config(examples.path("bidding", "run.yaml"))
+    world = World(yaml.safe_load(open(examples.path("bidding", "world.yaml"))))
+    try:
+        hmia = fire_one(net, "hmia_create", world=world, config=config,
+                        tokens={"hmia_start": [None]}).tokens["hmia_work"][0]
+        assert isinstance(hmia, Interface) and hmia.global_map is not None
+        hmia.requested, hmia.robots, hmia.alive = True, ["robot1", "robot2"], {"robot1", "robot2"}
+        hmia.zones = [tuple(z) for z in paper_office().zones]
+        hmia.initialise_sent, hmia.initialised = True, {"robot1", "robot2"}
+        hmia.to_offer.extend(range(8))
+        cfp = fire_one(net, "hmia_cfp", world=world, config=config, tokens={"hmia_work": [hmia]})
+        assert cfp.outcome == "ok" and hmia.auction == 0
+        calls = [hmia.outbox[r][0] for r in ("robot1", "robot2")]
+        assert {m.kind for m in calls} == {"CFP"} and calls[0].cast == calls[1].cast  # one broadcast
+        hmia.outbox.clear()
+        hmia.auction, hmia.to_offer = None, type(hmia.to_offer)()
+        hmia.owner = {z: "robot1" for z in range(8)}
+        fire_one(net, "hmia_map", world=world, config=config, tokens={"hmia_work": [hmia]})
+        assert hmia.map_sent is not None and hmia.outbox["robot2"][0].kind == "MAP"
+        hmia.finished = set(range(8))
+        end = fire_one(net, "hmia_end", world=world, config=config, tokens={"hmia_work": [hmia]})
+        report = [e.data["data"] for e in end.events if e.kind == "custom" and e.data["name"] == "bidding.end"][0]
+        assert report["accuracy_pct"] == 100.0 and report["sigma"] == 0  # nothing mapped, nothing wrong
+
+        robot = RobotAgent("robot1", 0, "hmia")
+        robot.initialise = Message("INITIALIZE", "hmia", "robot1", body={"rank": 0, "team": ["robot1", "robot2"]})
+        fire_one(net, "robot1_ready", world=world, config=config, tokens={"robot1_work": [robot]})
+        robot.outbox.clear()
+        robot.mapping, robot.mine, robot.zones = True, [4], {4: (13.0, -8.1)}
+        before = robot.robot.pose
+        step = fire_one(net, "robot1_explore", world=world, config=config, tokens={"robot1_work": [robot]})
+        assert step.outcome == "ok" and 0.0 < step.time <= 1.0 + 1e-9  # at most one step of 1 s
+        assert robot.robot.pose != before and robot.outbox["hmia"][0].kind == "MAPPED"  # turning towards Z5
+        points = robot.outbox["hmia"][0].body["points"]
+        assert len(points) > 50 and abs(points).max() < 17  # world points inside the office
+    finally:
+        world.close()
