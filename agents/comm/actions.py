@@ -213,6 +213,7 @@ class Explore(Action):
             raise ActionFailure("comm.explore: the agent has no robot (use comm.listen for static agents)")
         self.goal = None
         self.waiting = 0.0
+        self.at = ctx.now
         jitter = min(max(self.params["jitter"], 0.0), 0.9)
         self.speed = self.params["speed"] * (1.0 + jitter * (2.0 * ctx.rng.random() - 1.0))
         explorer = state.explorer
@@ -342,7 +343,10 @@ class Explore(Action):
     def poll(self, ctx: ActionContext) -> Status:
         state = self.state
         robot = state.robot
-        dt = ctx.world.dt
+        dt = ctx.now - self.at  # the first poll comes at the start: no time has passed yet
+        if dt <= 1e-12:
+            return Status.RUNNING
+        self.at = ctx.now
         if self.goal is None:
             self.waiting -= dt
             if self.waiting > 0:
@@ -389,12 +393,11 @@ class Listen(_Instant):
         self.state = _state(ctx)
         self.state.now = ctx.now
         self.state.patience = self.params["give_up"]
-        self.left = self.params["period"]
+        self.until = ctx.now + self.params["period"]
         ctx.result = self.state
 
     def poll(self, ctx: ActionContext) -> Status:
-        self.left -= ctx.world.dt if ctx.world is not None else self.left
-        if self.left > 1e-9:
+        if ctx.world is not None and ctx.now < self.until - 1e-9:
             return Status.RUNNING
         state = self.state
         missing = state.missing()
