@@ -60,6 +60,7 @@ class Fate(Name):
     SENT = "sent"
     DELIVERED = "delivered"
     LOST = "lost"
+    NOTICED = "noticed"  # a loss notice reached the place (``on_loss: notify``)
 
 
 @dataclass
@@ -86,7 +87,16 @@ class Message:
 
 
 class ChannelModel:
-    """Decides the fate of each message: a delay in seconds, or ``None`` for lost."""
+    """Decides the fate of each message: a delay in seconds, or ``None`` for lost.
+
+    ``on_loss`` (set from the run configuration, every model has it) says what a lost
+    message leaves behind: ``drop`` (nothing, the default) or ``notify`` (a loss notice,
+    a token ``{"lost": True, "why": ..., "data": <the message's data>}`` in the channel
+    place at once, as a receiver that sees a garbled frame or a sender's timeout would
+    learn of it; a net whose channel places are bounded by slot tokens stays live).
+    """
+
+    on_loss = "drop"
 
     def deliver(self, message: Message, rng: Any) -> float | None:
         raise NotImplementedError
@@ -185,6 +195,9 @@ def build_channel(name: str, spec: dict[str, Any], where: str = "channels") -> C
     """
     spec = dict(spec)
     model = spec.pop("model", "ideal")
+    on_loss = spec.pop("on_loss", "drop")
+    if on_loss not in ("drop", "notify"):
+        raise NetFormatError(f"on_loss is drop or notify, not {on_loss!r}", element=f"{where}.{name}")
     cls = CHANNEL_MODELS.get(model) if isinstance(model, str) else None
     if cls is None and isinstance(model, str):
         from petriflow.runtime.registry import default_registry
@@ -202,10 +215,13 @@ def build_channel(name: str, spec: dict[str, Any], where: str = "channels") -> C
     if is_dataclass(cls):
         _check_parameters(cls, model, spec, f"{where}.{name}")
     try:
-        return cls(**spec)
+        built = cls(**spec)
     except (TypeError, ValueError) as exc:
         raise NetFormatError(f"bad parameters for channel model {model!r}: {exc}",
                              element=f"{where}.{name}") from None
+    if on_loss != "drop":
+        built.on_loss = on_loss
+    return built
 
 
 def _check_parameters(cls: type, model: str, spec: dict[str, Any], element: str) -> None:
@@ -266,14 +282,16 @@ def receivers(net: Net) -> dict[str, str | None]:
 class Delivery(Scheduled):
     """A message arrives in its channel place (scheduled by :meth:`Channels.send`)."""
 
-    __slots__ = ("channels", "place", "data", "sender")
+    __slots__ = ("channels", "place", "data", "sender", "notice")
     phase = APPLY
 
-    def __init__(self, channels: "Channels", place: str, data: Any, sender: str | None) -> None:
+    def __init__(self, channels: "Channels", place: str, data: Any, sender: str | None,
+                 notice: bool = False) -> None:
         self.channels = channels
         self.place = place
         self.data = data
         self.sender = sender
+        self.notice = notice
 
     def apply(self, tick: int) -> None:
         self.channels.arrive(self)
@@ -354,6 +372,9 @@ class Channels:
             info["distance"] = round(distance, 6)
         if delay is None:
             run.emit("message", None, sender, fate=Fate.LOST.value, why=why, **info)
+            if getattr(model, "on_loss", "drop") == "notify" and (receiver is None or faults.alive(receiver)):
+                notice = {"lost": True, "why": why, "data": data}
+                run.kernel.schedule(run.kernel.ticks_at(now), Delivery(self, place, notice, sender, notice=True))
             return
         kernel = run.kernel
         arrival = kernel.ticks_at(now + delay)
@@ -363,5 +384,6 @@ class Channels:
     def arrive(self, delivery: Delivery) -> None:
         """A message reaches its place: the token appears there."""
         self.run.deliver(delivery.place, delivery.data)
-        self.run.emit("message", None, delivery.sender, fate=Fate.DELIVERED.value, place=delivery.place,
+        fate = Fate.NOTICED if delivery.notice else Fate.DELIVERED
+        self.run.emit("message", None, delivery.sender, fate=fate.value, place=delivery.place,
                       channel=self.channel[delivery.place])

@@ -34,7 +34,7 @@ def markings(events: Iterable[Event]) -> Iterator[tuple[Event, Marking]]:
         elif event.kind == "end":
             for place, n in data.get("produced", {}).items():
                 counts[place] = counts.get(place, 0) + n
-        elif event.kind == "message" and data.get("fate") == "delivered":
+        elif event.kind == "message" and data.get("fate") in ("delivered", "noticed"):
             counts[data["place"]] = counts.get(data["place"], 0) + 1
         yield event, Marking({p: c for p, c in counts.items() if c > 0})
 

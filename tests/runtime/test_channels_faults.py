@@ -159,3 +159,17 @@ def test_messages_between_many_agents_are_delivered_in_order():
     delivered = [(e.data["place"], e.time) for e in events if e.kind == "message" and e.data["fate"] == "delivered"]
     assert delivered == [(f"m{k}", round(0.01 * (k + 1) + 0.5, 9)) for k in range(20)]
     assert result.marking == {f"d{k}got": 1 for k in range(20)}
+
+
+def test_a_lost_message_can_leave_a_loss_notice():
+    """on_loss: notify puts a notice token in the channel place at once (fate noticed,
+    not delivered); the default drops the message."""
+    far = StubWorld(positions={"a": (0, 0), "b": (30, 0)})
+    radio = {"model": "range", "tx_power_dbm": -40, "exponent": 2.0, "threshold_dbm": -63.4375}
+    result, events = run(RunConfig(channels={"radio": {**radio, "on_loss": "notify"}}), far)
+    assert messages(events) == [("lost", 0.0), ("noticed", 0.0)]
+    assert result.marking == {"a_done": 1, "b_done": 1}
+    notice = [e for e in events if e.kind == "end" and e.transition == "receive"]
+    assert notice, "the receiver consumed the notice"
+    with pytest.raises(NetFormatError, match="on_loss is drop or notify"):
+        Scheduler(loads_net(TALK), config=RunConfig(channels={"radio": {**radio, "on_loss": "maybe"}}))
