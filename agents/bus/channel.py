@@ -53,6 +53,8 @@ def payload_of(message: Message) -> bytes:
     """
     if isinstance(message.data, (bytes, bytearray)):
         return bytes(message.data)
+    if isinstance(message.data, dict) and isinstance(message.data.get("payload"), (bytes, bytearray)):
+        return bytes(message.data["payload"])
     return bytes((11 + 37 * i) & 0xFF for i in range(max(message.size, 0)))
 
 
@@ -69,31 +71,52 @@ class ChannelState:
         self.timeline = Timeline()
         self.medium: Medium = bus.medium(self.timeline, rng)
         self.medium.keep_newest = False
-        self.medium.read_on_arrival = bus.read_period <= 0.0
+        self.medium.read_on_arrival = set()  # the modules that read on arrival (read period 0)
+        self.last_end = None
         self.numbers: dict[str | None, int] = {}
         self.sent = 0
+        self.multicast: tuple[Any, dict[str | None, float | None], dict[str | None, str]] | None = None
+        self.reasons: dict[str | None, str] = {}
+        self.periods: dict[int, float] = {}
 
     def module(self, agent: str | None) -> int:
         """The module number of an agent (the next free number the first time)."""
         if agent not in self.numbers:
             number = self.numbers[agent] = len(self.numbers)
             self.medium.add_module(number)
-            period = self.bus.read_period
+            period = self.bus.read_period_of(agent)
+            self.periods[number] = period
             if period > 0.0:
                 first = math.ceil(self.timeline.now / period) * period
                 self.timeline.at(first, self._read, number, rank=MODULE)
+            else:
+                self.medium.read_on_arrival.add(number)
         return self.numbers[agent]
 
     def _read(self, module: int) -> None:
         self.medium.read(module)
-        self.timeline.after(self.bus.read_period, self._read, module, rank=MODULE)
+        self.timeline.after(self.periods[module], self._read, module, rank=MODULE)
 
-    def frames(self, message: Message) -> list[Frame]:
-        """The frames that carry ``message`` (one, or several of ``payload_limit`` bytes)."""
+    def quiet_for(self, now: float) -> float:
+        """How long the medium has been silent at ``now`` (0 while a frame is on it)."""
+        ends = [t.end for t in self.medium.transmissions]
+        if any(t.start <= now < t.end for t in self.medium.transmissions):
+            return 0.0
+        done = [end for end in ends if end <= now]
+        last = max(done + ([self.last_end] if self.last_end is not None and self.last_end <= now else []),
+                   default=None)
+        return now if last is None else now - last
+
+    def frames(self, message: Message, targets: list[str | None] | None = None) -> list[Frame]:
+        """The frames that carry ``message`` (one, or several of ``payload_limit`` bytes)
+        to its receiver, or to every agent of ``targets``."""
         from petriflow.agents.bus.medium import Frame
 
         sender = self.module(message.sender)
-        receivers = (self.module(message.receiver),) if message.receiver is not None else ()
+        if targets is not None:
+            receivers = tuple(self.module(t) for t in targets)
+        else:
+            receivers = (self.module(message.receiver),) if message.receiver is not None else ()
         identifier = message.data.get("identifier") if isinstance(message.data, dict) else None
         if not isinstance(identifier, int) or isinstance(identifier, bool):
             identifier = 0x100 + sender
@@ -104,29 +127,64 @@ class ChannelState:
         return [Frame(sender, receivers, chunk, identifier, (self.sent, index)) for index, chunk in enumerate(chunks)]
 
     def deliver(self, message: Message) -> float | None:
-        """The delay until the receiver reads the whole message, or ``None`` if it is lost."""
+        """The delay until the receiver reads the whole message, or ``None`` if it is lost.
+
+        A message whose data names a ``multicast`` group and its ``receivers`` (agents)
+        is one frame addressed to all of them (as a module sends one message to both
+        neighbours): its first copy puts the frame on the bus and decides every
+        receiver's fate; the other copies of the group (same sender, same time) only
+        read theirs.
+        """
+        data = message.data if isinstance(message.data, dict) else {}
+        group = data.get("multicast")
+        if group is not None:
+            key = (message.sender, group, message.time)
+            if self.multicast is not None and self.multicast[0] == key:
+                self.bus.loss_reason = self.multicast[2].get(message.receiver)
+                return self.multicast[1].get(message.receiver)
+            targets = list(data.get("receivers") or [message.receiver])
+            if message.receiver not in targets:
+                targets.append(message.receiver)
+            fates = self._decide(message, targets)
+            self.multicast = (key, fates, dict(self.reasons))
+            self.bus.loss_reason = self.reasons.get(message.receiver)
+            return fates.get(message.receiver)
+        fates = self._decide(message, None)
+        self.bus.loss_reason = self.reasons.get(message.receiver)
+        return fates[message.receiver]
+
+    def _decide(self, message: Message, targets: list[str | None] | None) -> dict[str | None, float | None]:
         self.timeline.run(until=message.time)
-        frames = self.frames(message)
+        frames = self.frames(message, targets)
         # The bus parameters are shared, not copied (they hold this state object).
         ahead = copy.deepcopy((self.timeline, self.medium), memo={id(self.bus): self.bus})
-        arrival = _look_ahead(ahead[0], ahead[1], frames)
+        modules = {self.numbers[t]: t for t in targets} if targets is not None else {
+            self.numbers.get(message.receiver) if message.receiver is not None else None: message.receiver}
+        arrivals, reasons = _look_ahead(ahead[0], ahead[1], frames, list(modules))
+        self.reasons = {agent: reasons[module] for module, agent in modules.items() if module in reasons}
         for frame in frames:  # the same requests on the kept state: the same draws follow
             self.medium.request(frame)
         medium = self.medium  # the logs are not needed again: keep the copies small
+        ended = [t.end for t in medium.transmissions if t.end <= message.time]
+        if ended:
+            self.last_end = max(ended + ([self.last_end] if self.last_end is not None else []))
         medium.transmissions = [t for t in medium.transmissions if t.end > message.time]
         medium.deliveries.clear()
         medium.losses.clear()
-        return None if arrival is None else max(0.0, arrival - message.time)
+        return {agent: None if arrivals.get(module) is None else max(0.0, arrivals[module] - message.time)
+                for module, agent in modules.items()}
 
 
-def _look_ahead(timeline: Timeline, medium: Medium, frames: list[Frame]) -> float | None:
-    """Request ``frames`` on a copy of the bus and run it until each is read or lost;
-    the time the last is read, or ``None``."""
+def _look_ahead(timeline: Timeline, medium: Medium, frames: list[Frame],
+                modules: list[int | None]) -> dict[int | None, float | None]:
+    """Request ``frames`` on a copy of the bus and run it until each is read or lost by
+    each of ``modules`` (``None``: nobody in particular); for each module, the time it
+    read the last frame, or ``None`` if one was lost for it."""
     tags = {frame.tag for frame in frames}
-    for frame in frames:
-        if not medium.request(frame):
-            return None
-    done: dict[Any, float] = {}
+    if not all(medium.request(frame) for frame in frames):
+        return {module: None for module in modules}, {module: "queue_full" for module in modules}
+    read: dict[int | None, dict[Any, float]] = {module: {} for module in modules}
+    lost: dict[int | None, str] = {}
     limit = timeline.now + HORIZON
     seen_deliveries = len(medium.deliveries)
     seen_losses = len(medium.losses)
@@ -134,26 +192,30 @@ def _look_ahead(timeline: Timeline, medium: Medium, frames: list[Frame]) -> floa
     def settled() -> bool:
         nonlocal seen_deliveries, seen_losses
         for loss in medium.losses[seen_losses:]:
-            receivers = loss.frame.receivers
-            if loss.frame.tag in tags and (loss.module is None or not receivers or loss.module in receivers):
-                return True
+            if loss.frame.tag not in tags:
+                continue
+            for module in modules:
+                # a frame for nobody is lost only on the bus itself (a collision...)
+                if loss.module is None or (module is not None and loss.module == module):
+                    lost.setdefault(module, loss.reason.value)
         seen_losses = len(medium.losses)
         for delivery in medium.deliveries[seen_deliveries:]:
             if delivery.frame.tag in tags:
-                done[delivery.frame.tag] = delivery.read
+                for module in modules:
+                    if module is None or delivery.module == module:
+                        read[module][delivery.frame.tag] = delivery.read
         seen_deliveries = len(medium.deliveries)
         if not frames[0].receivers:  # nobody to read it: delivered when it leaves the bus
             for transmission in medium.transmissions:
                 if transmission.frame.tag in tags and not transmission.garbled and transmission.end <= timeline.now:
-                    done[transmission.frame.tag] = transmission.end
-        return len(done) == len(tags)
+                    for module in modules:
+                        read[module][transmission.frame.tag] = transmission.end
+        return all(module in lost or len(read[module]) == len(tags) for module in modules)
 
     while timeline.peek() <= limit:
         timeline.step()
         if settled():
             break
-    else:
-        return None
-    if len(done) < len(tags):
-        return None
-    return max(done.values())
+    arrivals = {module: None if module in lost or len(read[module]) < len(tags) else max(read[module].values())
+                for module in modules}
+    return arrivals, {module: lost.get(module, "unread") for module in modules if arrivals[module] is None}

@@ -114,6 +114,7 @@ from petriflow.agents.bus.frames import (
     ieee802154_frame_bits,
     uart_frame_bits,
 )
+from petriflow.agents.bus.errors import BusError
 from petriflow.agents.bus.radio import RadioLink
 from petriflow.agents.bus.timeline import MEDIUM, Timeline, Timer
 
@@ -229,6 +230,7 @@ class BusModel(ChannelModel):
     acceptance_filter: bool = False
     read_period: float = field(default=0.0, metadata={"range": (0.0, 3600.0)})
     _channel: Any = field(default=None, init=False, repr=False, compare=False)
+    loss_reason: Any = field(default=None, init=False, repr=False, compare=False)
 
     def payload_limit(self) -> int:
         """Largest payload of one frame in bytes (a longer channel message is split)."""
@@ -250,6 +252,26 @@ class BusModel(ChannelModel):
 
             self._channel = ChannelState(self, random.Random(rng.getrandbits(64)))
         return self._channel.deliver(message)
+
+    def reads_every(self, agent: str, period: float) -> None:
+        """As a channel model: ``agent``'s module reads its receive buffer every
+        ``period`` seconds (0: on arrival) instead of ``read_period`` (its firmware's
+        loop says how often; call before its first message)."""
+        if not (math.isfinite(period) and period >= 0.0):
+            raise BusError(f"a read period is a number of seconds >= 0, got {period!r}")
+        if self.__dict__.get("_readers") is None:
+            self.__dict__["_readers"] = {}
+        self.__dict__["_readers"][agent] = float(period)
+
+    def read_period_of(self, agent: str | None) -> float:
+        return (self.__dict__.get("_readers") or {}).get(agent, self.read_period)
+
+    def quiet_for(self, now: float) -> float:
+        """As a channel model: how long the bus has carried nothing at ``now`` (0 while a
+        frame is on it); since the first message when none was ever sent."""
+        if self._channel is None:
+            return now
+        return self._channel.quiet_for(now)
 
 
 @dataclass
@@ -441,14 +463,24 @@ class Medium:
         if self.bus.acceptance_filter and module not in frame.receivers:
             return
         now = self.timeline.now
-        if self.read_on_arrival:
+        if self.read_on_arrival is True or (self.read_on_arrival and module in self.read_on_arrival):
             if module in frame.receivers:
                 self.deliveries.append(Delivery(frame, module, now, now))
             return
         buffer = self._buffers[module]
         if len(buffer) >= self.bus.rx_buffer:
             if not self.keep_newest:
-                self.losses.append(Lost(frame, module, Loss.OVERWRITTEN, now))
+                # The newest frame is the one lost (a channel model decides each frame
+                # when it is sent), except over a frame this module would not keep
+                # anyway: that one is overwritten, as the hardware would.
+                stranger = next((k for k, (old, _) in enumerate(buffer) if module not in old.receivers), None)
+                if stranger is None:
+                    self.losses.append(Lost(frame, module, Loss.OVERWRITTEN, now))
+                    return
+                old, _ = buffer[stranger]
+                del buffer[stranger]
+                self.losses.append(Lost(old, module, Loss.OVERWRITTEN, now))
+                buffer.append((frame, now))
                 return
             old, _ = buffer.popleft()
             self.losses.append(Lost(old, module, Loss.OVERWRITTEN, now))

@@ -89,6 +89,9 @@ class Message:
 class ChannelModel:
     """Decides the fate of each message: a delay in seconds, or ``None`` for lost.
 
+    A model may say why it lost a message in ``loss_reason`` (read right after
+    :meth:`deliver` returned ``None``; default "channel model").
+
     ``on_loss`` (set from the run configuration, every model has it) says what a lost
     message leaves behind: ``drop`` (nothing, the default) or ``notify`` (a loss notice,
     a token ``{"lost": True, "why": ..., "data": <the message's data>}`` in the channel
@@ -362,7 +365,8 @@ class Channels:
         elif receiver is not None and not faults.alive(receiver):
             delay, why = None, "receiver not running"
         else:
-            delay, why = model.deliver(message, self.rng), "channel model"
+            delay = model.deliver(message, self.rng)
+            why = str(getattr(model, "loss_reason", None) or "channel model") if delay is None else "channel model"
             if delay is not None and (isinstance(delay, bool) or not isinstance(delay, (int, float))
                                       or not 0 <= delay < math.inf):
                 raise PetriflowError(f"channel {channel!r}: model {type(model).__name__} gave a delay of {delay!r}"
