@@ -98,7 +98,10 @@ class ChannelState:
         self.timeline.after(self.periods[module], self._read, module, rank=MODULE)
 
     def quiet_for(self, now: float) -> float:
-        """How long the medium has been silent at ``now`` (0 while a frame is on it)."""
+        """How long the medium has been silent at ``now`` (0 while a frame is on it).
+        The bus is run up to ``now`` first (later messages cannot come earlier)."""
+        if now > self.timeline.now:
+            self.timeline.run(until=now)
         ends = [t.end for t in self.medium.transmissions]
         if any(t.start <= now < t.end for t in self.medium.transmissions):
             return 0.0

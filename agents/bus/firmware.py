@@ -151,7 +151,7 @@ def _front_free(ctx: ActionContext, chain: list[str], name: str) -> bool:
     """The front proximity sensor: a ray ahead of the module's body finds nothing
     within ``reach`` (without a world: the first module of the chain is the head)."""
     world = ctx.world
-    if world is None or name not in getattr(world, "agents", {}):
+    if world is None or "chain" not in getattr(world, "bodies", {}):
         return chain.index(name) == 0
     from petriflow.agents.bus.chain import front_is_free
 
@@ -205,7 +205,7 @@ class Boot(_Timed):
             model, _ = ctx.link(place)
             if hasattr(model, "reads_every"):
                 model.reads_every(name, read_every)
-        if ctx.world is not None and name in getattr(ctx.world, "agents", {}):
+        if ctx.world is not None:
             from petriflow.agents.bus.chain import joint_of
 
             self.module.joint = joint_of(ctx.world, name)
@@ -232,6 +232,11 @@ class Cpg(_Timed):
         if ctx.now - module.last_sample >= self.params["sample"] - 1e-9:
             module.last_sample = ctx.now
             ctx.emit("bus.phase", phase=round(float(wrap(module.oscillator.phase)), 6), address=module.address)
+            if module.address == 0 and module.joint is not None:
+                from petriflow.agents.bus.chain import pose
+
+                x, y = pose(ctx.world)
+                ctx.emit("bus.pose", x=round(x, 6), y=round(y, 6))
 
     def finish(self, ctx: ActionContext) -> None:
         module = self.module

@@ -1,0 +1,152 @@
+"""Seed 002 as nets: soundness, each transition alone, the algorithms' send rules, the
+bus channel's multicast frames and read periods, whole runs and the chain's sensors."""
+
+from __future__ import annotations
+
+import math
+import random
+
+import pytest
+import yaml
+
+from petriflow import examples
+from petriflow.agents.bus.chain import front_is_free
+from petriflow.agents.bus.firmware import Module
+from petriflow.agents.bus.medium import CanBus, SerialBus
+from petriflow.agents.bus.nets import build
+from petriflow.analysis import check_net
+from petriflow.io import load_net
+from petriflow.io.yaml import loads_net
+from petriflow.runtime.channels import Message
+from petriflow.runtime.config import RunConfig
+from petriflow.testing import fire_one
+from petriflow.world import World
+
+CAN = RunConfig(channels={"bus": {"model": "bus.can", "on_loss": "notify"}}, dt=0.002)
+
+
+@pytest.mark.parametrize("modules", [2, 3, 4])
+@pytest.mark.parametrize("algorithm", [1, 2])
+def test_nets_are_sound(modules, algorithm):
+    result = check_net(loads_net(build(modules, algorithm)))
+    assert result["workflow_net"] and result["sound"], result["violations"]
+
+
+def test_shipped_nets_are_the_builders():
+    for algorithm in (1, 2):
+        shipped = load_net(examples.path("bus", f"bus-algorithm{algorithm}-3.yaml"))
+        assert shipped.structure() == loads_net("run: run.yaml\n" + build(3, algorithm)).structure()
+
+
+def test_builder_refuses_nonsense():
+    for bad in ({"algorithm": 3}, {"modules": 1}, {"messages": 0}):
+        with pytest.raises(ValueError):
+            build(**{"modules": 3, "algorithm": 1, **bad})
+
+
+def _boot(net, name, config=CAN, world=None, seed=0):
+    fired = fire_one(net, f"{name}_boot", tokens={f"{name}_start": [None]}, config=config, world=world, seed=seed)
+    assert fired.outcome == "ok" and 0.0 <= fired.time <= 0.1 + 1e-9  # start-up spread over 0.1 s
+    return fired.tokens[f"{name}_loop"][0]
+
+
+def test_algorithm_1_waits_its_delay_then_sends_one_frame_to_both_neighbours():
+    net = loads_net(build(3, 1))
+    module = _boot(net, "m2")
+    assert isinstance(module, Module) and module.address == 1 and 0.0 <= module.scheme.delay <= 1.0
+    before = module.oscillator.phase
+    cpg = fire_one(net, "m2_cpg", tokens={"m2_loop": [module]}, config=CAN)
+    assert cpg.time == pytest.approx(0.02) and module.oscillator.phase == pytest.approx(before + 0.5 * 0.02)
+    wait = fire_one(net, "m2_wait", tokens={"m2_moved": [module]}, config=CAN)
+    assert wait.time == pytest.approx(module.scheme.delay, abs=0.0021)  # to the 2 ms tick
+    sent = fire_one(net, "m2_send", config=CAN,
+                    tokens={"m2_waited": [module], "slot_m2_m1": [None], "slot_m2_m3": [None]})
+    frames = [e.data for e in sent.events if e.kind == "message" and e.data["fate"] == "sent"]
+    assert sorted(f["place"] for f in frames) == ["box_m2_m1", "box_m2_m3"] and module.sent == 1
+    tokens = [sent.tokens.get(p, [None])[0] for p in ("box_m2_m1", "box_m2_m3")]
+    assert all(t is None or t["multicast"] == 1 for t in tokens)  # the same frame, read by both
+
+
+def test_algorithm_2_sends_to_the_next_address_only_and_the_tail_to_nobody():
+    net = loads_net(build(3, 2))
+    head = fire_one(net, "m1_boot", tokens={"m1_start": [None]}, config=CAN).tokens["m1_watch"][0]
+    sent = fire_one(net, "m1_send", config=CAN, tokens={"m1_tx": [head], "slot_m1_m2": [None]})
+    assert [e.data["place"] for e in sent.events if e.kind == "message"][0] == "box_m1_m2"
+    tail = fire_one(net, "m3_boot", tokens={"m3_start": [None]}, config=CAN).tokens["m3_watch"][0]
+    gone = fire_one(net, "m3_send", config=CAN, tokens={"m3_tx": [tail], "slot_m3_void": [None]})
+    assert [e.data["place"] for e in gone.events if e.kind == "message"][0] == "void_m3"
+
+
+def test_bus_available_comes_after_a_random_quiet_time_and_overflow_sends_half_the_time():
+    net = loads_net(build(3, 2))
+    module = fire_one(net, "m1_boot", tokens={"m1_start": [None]}, config=CAN).tokens["m1_watch"][0]
+    available = fire_one(net, "m1_available", tokens={"m1_watch": [module]}, config=CAN)
+    assert available.outcome == "ok" and 0.0 < available.time <= 1.0 + 0.003
+    draws = []
+    for seed in range(40):
+        module = fire_one(net, "m1_boot", tokens={"m1_start": [None]}, config=CAN, seed=seed).tokens["m1_timer"][0]
+        tick = fire_one(net, "m1_overflow", tokens={"m1_timer": [module]}, config=CAN, seed=seed)
+        assert tick.time == pytest.approx(1.0)
+        draws.append(module.send_now)
+    assert 10 < sum(draws) < 30
+
+
+def test_reception_keeps_a_neighbours_phase_and_counts_a_lost_frame():
+    net = loads_net(build(3, 1))
+    m2 = _boot(net, "m2")
+    from petriflow.agents.bus.packet import Packet, encode
+
+    frame = {"payload": encode(Packet((1,), 0, 1.25, 0.0, 0.5), with_sender=False), "address": 0,
+             "sender": "m1", "group": 1}  # what m1_send puts on CAN
+    got = fire_one(net, "m2_receive_m1", config=CAN, tokens={"box_m1_m2": [frame], "m2_listen": [m2]})
+    assert got.marking["slot_m1_m2"] == 1 and m2.oscillator.heard[0] == pytest.approx(1.25, abs=1e-3)
+    read = [e.data["data"] for e in got.events if e.kind == "custom"][0]
+    assert read["kept"] and not read["lost"]
+    notice = {"lost": True, "why": "collision", "data": {"sender": "m1", "group": 2}}
+    lost = fire_one(net, "m2_receive_m1", config=CAN, tokens={"box_m1_m2": [notice], "m2_listen": [m2]})
+    assert [e.data["data"] for e in lost.events if e.kind == "custom"][0]["why"] == "collision"
+
+
+def test_a_multicast_message_is_one_frame_on_the_bus():
+    bus, rng = SerialBus(), random.Random(0)
+    data = {"payload": bytes(9), "multicast": 1, "receivers": ["b", "c"]}
+    first = bus.deliver(Message("box_a_b", "a", "b", data, 0.0, 9), rng)
+    second = bus.deliver(Message("box_a_c", "a", "c", data, 0.0, 9), rng)
+    assert first == second == pytest.approx(100 / 115_200) and bus._channel.sent == 1
+
+
+def test_a_module_reads_its_buffer_at_its_own_period():
+    bus, rng = CanBus(), random.Random(0)
+    bus.reads_every("b", 0.5)
+    delay = bus.deliver(Message("box_a_b", "a", "b", {"payload": bytes(8)}, 0.1, 8), rng)
+    assert delay == pytest.approx(0.4)  # the next read of b is at 0.5 s
+    assert bus.quiet_for(0.1001) == 0.0  # the frame is on the bus (about 0.2 ms)
+    assert bus.quiet_for(0.3) == pytest.approx(0.2, abs=0.001)
+
+
+def test_whole_runs_end_at_the_final_marking_with_every_message_counted(tmp_path):
+    from petriflow.agents.bus import metrics
+    from petriflow.runtime.metrics import RunRecord
+    from petriflow.runtime.scheduler import Scheduler
+
+    for algorithm in (1, 2):
+        events = []
+        scheduler = Scheduler(loads_net(build(3, algorithm, messages=8)), config=CAN, seed=2)
+        scheduler.on_event(events.append)
+        result = scheduler.run(until=300)
+        assert result.reason == "final"
+        record = RunRecord(result, events)
+        sent = [e for e in events if e.kind == "custom" and e.data["name"] == "bus.sent"]
+        assert len(sent) == 24
+        assert 0.0 <= metrics.lost_pct(record) <= 100.0 and metrics.phase_error_rad(record) is not None
+
+
+def test_the_chain_addresses_itself_with_its_front_sensors():
+    world = World(yaml.safe_load(examples.path("bus", "world-3.yaml").read_text()), base=examples.path("bus", "."))
+    try:
+        assert [front_is_free(world, f"m{k}") for k in (1, 2, 3)] == [True, False, False]
+        net = load_net(examples.path("bus", "bus-algorithm2-3.yaml"))
+        module = fire_one(net, "m3_boot", tokens={"m3_start": [None]}, config=CAN, world=world).tokens["m3_loop"][0]
+        assert module.address == 2 and module.joint is not None
+    finally:
+        world.close()
