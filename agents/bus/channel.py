@@ -70,13 +70,15 @@ class ChannelState:
         self.bus = bus
         self.timeline = Timeline()
         self.medium: Medium = bus.medium(self.timeline, rng)
-        self.medium.keep_newest = False
+        self.medium.keep_newest = True  # a frame arriving at a full buffer overwrites the oldest
+        self.pending: dict[tuple[Any, int | None], tuple[Message, float]] = {}
         self.medium.read_on_arrival = set()  # the modules that read on arrival (read period 0)
         self.last_end = None
         self.numbers: dict[str | None, int] = {}
         self.sent = 0
         self.multicast: tuple[Any, dict[str | None, float | None], dict[str | None, str]] | None = None
         self.reasons: dict[str | None, str] = {}
+        self.tags: tuple[Any, ...] = ()
         self.periods: dict[int, float] = {}
 
     def module(self, agent: str | None) -> int:
@@ -144,17 +146,38 @@ class ChannelState:
             key = (message.sender, group, message.time)
             if self.multicast is not None and self.multicast[0] == key:
                 self.bus.loss_reason = self.multicast[2].get(message.receiver)
-                return self.multicast[1].get(message.receiver)
+                return self._remember(message, self.multicast[3], self.multicast[1].get(message.receiver))
             targets = list(data.get("receivers") or [message.receiver])
             if message.receiver not in targets:
                 targets.append(message.receiver)
             fates = self._decide(message, targets)
-            self.multicast = (key, fates, dict(self.reasons))
+            self.multicast = (key, fates, dict(self.reasons), self.tags)
             self.bus.loss_reason = self.reasons.get(message.receiver)
-            return fates.get(message.receiver)
+            return self._remember(message, self.tags, fates.get(message.receiver))
         fates = self._decide(message, None)
         self.bus.loss_reason = self.reasons.get(message.receiver)
-        return fates[message.receiver]
+        return self._remember(message, self.tags, fates[message.receiver])
+
+    def _remember(self, message: Message, tags: tuple[Any, ...], delay: float | None) -> float | None:
+        """Keep a message that will be read later: a later frame may overwrite it first."""
+        if delay is not None and delay > 0.0 and message.receiver is not None:
+            module = self.numbers.get(message.receiver)
+            for tag in tags:
+                self.pending[(tag, module)] = (message, message.time + delay)
+        return delay
+
+    def _revoke(self, losses: list[Any], now: float) -> None:
+        """Frames already promised to a receiver that this new frame overwrote in its
+        buffer before the receiver read them, or garbled on the medium (a collision
+        with a frame still on the bus): their messages are lost after all."""
+        self.pending = {key: value for key, value in self.pending.items() if value[1] > now}
+        for loss in losses:
+            keys = [(loss.frame.tag, loss.module)] if loss.module is not None else [
+                key for key in self.pending if key[0] == loss.frame.tag]  # garbled on the bus: for everyone
+            for key in keys:
+                entry = self.pending.pop(key, None)
+                if entry is not None and entry[0].revoked is None:
+                    entry[0].revoked = loss.reason.value
 
     def _decide(self, message: Message, targets: list[str | None] | None) -> dict[str | None, float | None]:
         self.timeline.run(until=message.time)
@@ -165,6 +188,8 @@ class ChannelState:
             self.numbers.get(message.receiver) if message.receiver is not None else None: message.receiver}
         arrivals, reasons = _look_ahead(ahead[0], ahead[1], frames, list(modules))
         self.reasons = {agent: reasons[module] for module, agent in modules.items() if module in reasons}
+        self.tags = tuple(frame.tag for frame in frames)
+        self._revoke(ahead[1].losses, message.time)
         for frame in frames:  # the same requests on the kept state: the same draws follow
             self.medium.request(frame)
         medium = self.medium  # the logs are not needed again: keep the copies small

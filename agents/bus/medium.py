@@ -70,11 +70,12 @@ bus's full state, advanced in time order as messages come (the runtime hands the
 over in time order), and decides each message by running a copy of that state
 forward with no further traffic: the message's delay is the time until its
 receiver reads its last frame (modules read every ``read_period`` seconds; 0 means
-on arrival). What it cannot do is take back a promise: when a later message
-collides with, or would overwrite, one already promised, only the later one is lost
-(the buffer keeps the older frame). Losses are thus counted once per collision
-instead of twice on RS-485 and ZigBee, and an overwrite loses the newer message
-instead of the older; CAN frames requested within one arbitration window go in
+on arrival). A later message can still take back a promise: when its frame collides
+with one already promised or overwrites it in a receiver's buffer before it was read,
+the earlier message is revoked (:attr:`~petriflow.runtime.channels.Message.revoked`)
+and the runtime records it lost at its delivery time, so losses are counted as the bus
+makes them (both frames of a collision, the older frame of an overwrite; the receive
+buffer keeps the newest). CAN frames requested within one arbitration window go in
 request order instead of identifier order. Messages longer than a frame's payload are
 split into frames (8 bytes on CAN) and arrive with their last frame. A message's
 bytes are its data when that is ``bytes``, else a fixed pattern of its ``size``.

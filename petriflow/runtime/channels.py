@@ -75,6 +75,10 @@ class Message:
         time: simulated send time.
         size: payload size in bytes (from the token data's ``size`` if any).
         distance: sender-receiver distance in metres, when the world knows both.
+        revoked: why the message was lost after all, when its model changed its mind
+            before the delivery time (e.g. a frame overwritten in the receiver's buffer
+            by a later one before it was read): set it (a reason) and the message is
+            lost on arrival instead of delivered.
     """
 
     place: str
@@ -84,6 +88,7 @@ class Message:
     time: float
     size: int = 16
     distance: float | None = None
+    revoked: str | None = None
 
 
 class ChannelModel:
@@ -285,16 +290,17 @@ def receivers(net: Net) -> dict[str, str | None]:
 class Delivery(Scheduled):
     """A message arrives in its channel place (scheduled by :meth:`Channels.send`)."""
 
-    __slots__ = ("channels", "place", "data", "sender", "notice")
+    __slots__ = ("channels", "place", "data", "sender", "notice", "message")
     phase = APPLY
 
     def __init__(self, channels: "Channels", place: str, data: Any, sender: str | None,
-                 notice: bool = False) -> None:
+                 notice: bool = False, message: Message | None = None) -> None:
         self.channels = channels
         self.place = place
         self.data = data
         self.sender = sender
         self.notice = notice
+        self.message = message
 
     def apply(self, tick: int) -> None:
         self.channels.arrive(self)
@@ -376,17 +382,32 @@ class Channels:
             info["distance"] = round(distance, 6)
         if delay is None:
             run.emit("message", None, sender, fate=Fate.LOST.value, why=why, **info)
-            if getattr(model, "on_loss", "drop") == "notify" and (receiver is None or faults.alive(receiver)):
-                notice = {"lost": True, "why": why, "data": data}
-                run.kernel.schedule(run.kernel.ticks_at(now), Delivery(self, place, notice, sender, notice=True))
+            self._notice(model, place, data, sender, receiver, why, now)
             return
         kernel = run.kernel
         arrival = kernel.ticks_at(now + delay)
         run.emit("message", None, sender, fate=Fate.SENT.value, arrival=round(arrival * kernel.dt, 9), **info)
-        kernel.schedule(arrival, Delivery(self, place, data, sender))
+        kernel.schedule(arrival, Delivery(self, place, data, sender, message=message))
+
+    def _notice(self, model: ChannelModel, place: str, data: Any, sender: str | None, receiver: str | None,
+                why: str, now: float) -> None:
+        """With ``on_loss: notify``, a loss notice for a lost message, at once."""
+        if getattr(model, "on_loss", "drop") == "notify" and (receiver is None or self.run.faults.alive(receiver)):
+            notice = {"lost": True, "why": why, "data": data}
+            self.run.kernel.schedule(self.run.kernel.ticks_at(now), Delivery(self, place, notice, sender, notice=True))
 
     def arrive(self, delivery: Delivery) -> None:
-        """A message reaches its place: the token appears there."""
+        """A message reaches its place: the token appears there (or, if its model
+        revoked it meanwhile, it is lost now)."""
+        message = delivery.message
+        if message is not None and message.revoked:
+            model, receiver = self.model_for(delivery.place)
+            self.run.emit("message", None, delivery.sender, fate=Fate.LOST.value, why=str(message.revoked),
+                          place=delivery.place, channel=self.channel[delivery.place], receiver=receiver,
+                          size=message.size, revoked=True)
+            self._notice(model, delivery.place, delivery.data, delivery.sender, receiver, str(message.revoked),
+                         self.run.kernel.now)
+            return
         self.run.deliver(delivery.place, delivery.data)
         fate = Fate.NOTICED if delivery.notice else Fate.DELIVERED
         self.run.emit("message", None, delivery.sender, fate=fate.value, place=delivery.place,

@@ -189,7 +189,8 @@ def _count(record: RunRecord, key) -> dict[Any, Counter]:
             continue
         counter = counts.setdefault(group, Counter(sent=0, delivered=0, lost=0, bytes=0))
         fate = event.data.get("fate")
-        if fate in ("sent", "lost"):  # every message put into a channel: one or the other
+        if fate == "sent" or (fate == "lost" and not event.data.get("revoked")):
+            # every message put into a channel is sent or lost then (a revoked one was sent)
             counter["sent"] += 1
             counter["bytes"] += event.data.get("size", 0)
         if fate in ("delivered", "lost"):

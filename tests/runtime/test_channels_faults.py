@@ -173,3 +173,31 @@ def test_a_lost_message_can_leave_a_loss_notice():
     assert notice, "the receiver consumed the notice"
     with pytest.raises(NetFormatError, match="on_loss is drop or notify"):
         Scheduler(loads_net(TALK), config=RunConfig(channels={"radio": {**radio, "on_loss": "maybe"}}))
+
+
+def test_a_model_can_revoke_a_promised_message_before_it_arrives():
+    """A message its model revoked after promising it is lost at its delivery time (fate
+    lost, revoked), counted once as sent, and leaves a notice with on_loss: notify."""
+    from petriflow.runtime.channels import ChannelModel
+    from petriflow.runtime.metrics import RunRecord, messages as count
+
+    class Fickle(ChannelModel):
+        def deliver(self, message, rng):
+            self.promised = message
+            return 0.5
+
+    scheduler = Scheduler(loads_net(TALK), config=RunConfig(channels={"radio": {"model": "ideal"}}))
+    model = Fickle()
+    model.on_loss = "notify"
+    scheduler.channels.models["radio"] = model
+    events = []
+    scheduler.on_event(events.append)
+
+    def revoke(event):
+        if event.kind == "message" and event.data.get("fate") == "sent":
+            model.promised.revoked = "overwritten"
+    scheduler.on_event(revoke)
+    result = scheduler.run(until=5)
+    assert messages(events) == [("sent", 0.0), ("lost", 0.5), ("noticed", 0.5)]
+    assert result.marking == {"a_done": 1, "b_done": 1}
+    assert count(RunRecord(result, events)) == {"sent": 1, "delivered": 0, "lost": 1, "bytes": 4}

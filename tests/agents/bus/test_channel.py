@@ -18,12 +18,14 @@ def message(sender, receiver, time, size=9, data=None):
     return Message("inbox", sender, receiver, data if data is not None else {"size": size}, time, size)
 
 
-def test_serial_delay_is_the_frame_time_and_a_later_overlap_is_lost():
+def test_serial_delay_is_the_frame_time_and_an_overlap_garbles_both():
     """(9 + 1) bytes × 10 bits at 115 200 baud; a frame sent during it collides: the
-    channel can only refuse the later one."""
+    later one is lost at once, the earlier (already promised) is revoked."""
     bus, rng = SerialBus(), random.Random(0)
-    assert bus.deliver(message("a", "b", 0.0), rng) == pytest.approx(100 * BIT_SERIAL)
+    first = message("a", "b", 0.0)
+    assert bus.deliver(first, rng) == pytest.approx(100 * BIT_SERIAL)
     assert bus.deliver(message("c", "b", 50 * BIT_SERIAL), rng) is None
+    assert first.revoked == "collision"
     assert bus.deliver(message("c", "b", 0.01), rng) == pytest.approx(100 * BIT_SERIAL)
 
 
@@ -41,12 +43,17 @@ def test_read_period_adds_the_wait_for_the_next_read():
     assert bus.deliver(message("a", "b", 0.001, 8), rng) == pytest.approx(0.019)
 
 
-def test_second_message_before_a_read_is_lost_to_the_full_buffer():
-    """Count-preserving overwrite: the promised message stays, the newer one is lost."""
+def test_second_message_before_a_read_overwrites_the_first_in_the_buffer():
+    """The receive buffer keeps the newest frame, as the hardware does: the first message
+    was promised for the next read, and is revoked (lost) when the second overwrites it."""
     bus, rng = CanBus(read_period=0.02), random.Random(0)
-    assert bus.deliver(message("a", "b", 0.001, 8), rng) is not None
-    assert bus.deliver(message("c", "b", 0.005, 8), rng) is None
-    assert bus.deliver(message("c", "b", 0.025, 8), rng) is not None
+    first = message("a", "b", 0.001, 8)
+    assert bus.deliver(first, rng) is not None and first.revoked is None
+    second = message("c", "b", 0.005, 8)
+    assert bus.deliver(second, rng) is not None
+    assert first.revoked == "overwritten" and second.revoked is None
+    third = message("c", "b", 0.025, 8)  # after the read at 0.02 s: nothing to overwrite
+    assert bus.deliver(third, rng) is not None and second.revoked is None
 
 
 def test_long_message_is_split_into_can_frames():
