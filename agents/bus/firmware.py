@@ -95,6 +95,7 @@ class Module:
         self.groups = 0
         self.send_now = False        # algorithm 2's overflow drew "send"
         self.last_sample = -math.inf
+        self.updated: float | None = None  # when the oscillator was last integrated to
         self.joint: tuple[int, int] | None = None
 
     @property
@@ -209,15 +210,16 @@ class Boot(_Timed):
             from petriflow.agents.bus.chain import joint_of
 
             self.module.joint = joint_of(ctx.world, name)
+        self.module.updated = self.wake_at = ctx.now + max(0.0, self.duration(ctx))
         ctx.emit("bus.addressed", address=address, delay=round(getattr(scheme, "delay", 0.0), 6),
                  read_every=round(read_every, 6))
         ctx.result = self.module
-        self.wake_at = ctx.now + max(0.0, self.duration(ctx))
 
 
 class Cpg(_Timed):
-    """``θi = CPG(...)``, ``Move actuator()``: integrate the oscillator over one control
-    step and set the joint's target angle (eq. 1); a phase sample every ``sample`` s."""
+    """``θi = CPG(...)``, ``Move actuator()``: one control step; at its end the oscillator
+    is integrated up to now (the module's clock) and the joint's target angle set
+    (eq. 1); a phase sample every ``sample`` s."""
 
     params = {"sample": Param(float, 0.1, "seconds between phase samples (bus.phase events)"),
               "offset": Param(float, 0.0, "x, the joint's offset (rad)"),
@@ -240,7 +242,15 @@ class Cpg(_Timed):
 
     def finish(self, ctx: ActionContext) -> None:
         module = self.module
-        module.oscillator.step(module.scheme.step_time)
+        # the oscillator runs on the module's clock: the time since its last update (one
+        # control step, or more after algorithm 1's wait), in steps of at most dt
+        elapsed = ctx.now - (module.updated if module.updated is not None else ctx.now - module.scheme.step_time)
+        dt = module.oscillator.parameters.dt
+        while elapsed > 1e-12:
+            h = min(dt, elapsed)
+            module.oscillator.step(h)
+            elapsed -= h
+        module.updated = ctx.now
         if module.joint is not None:
             from petriflow.agents.bus.chain import drive
 

@@ -55,6 +55,7 @@ def test_algorithm_1_waits_its_delay_then_sends_one_frame_to_both_neighbours():
     module = _boot(net, "m2")
     assert isinstance(module, Module) and module.address == 1 and 0.0 <= module.scheme.delay <= 1.0
     before = module.oscillator.phase
+    module.updated = None  # each fire_one starts its own clock at 0: one control step from here
     cpg = fire_one(net, "m2_cpg", tokens={"m2_loop": [module]}, config=CAN)
     assert cpg.time == pytest.approx(0.02) and module.oscillator.phase == pytest.approx(before + 0.5 * 0.02)
     wait = fire_one(net, "m2_wait", tokens={"m2_moved": [module]}, config=CAN)
