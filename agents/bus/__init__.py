@@ -2,8 +2,9 @@
 
 A chain of EMERGE modules runs a CPG and shares each module's phase with its
 neighbours over one shared bus; messages collide, wait, or get overwritten in a
-module's receive buffer, and lost messages degrade the chain's phase locking. Pure
-Python and numpy, no pybullet.
+module's receive buffer, and lost messages degrade the chain's phase locking. The
+core (frames to experiment) is pure Python and numpy; :mod:`.chain` adds the pybullet
+robot and :mod:`.firmware` the actions its nets bind.
 
 * :mod:`~petriflow.agents.bus.errors`: the package's errors.
 * :mod:`~petriflow.agents.bus.frames`: frame lengths in bits (UART, CAN with bit
@@ -18,7 +19,16 @@ Python and numpy, no pybullet.
 * :mod:`~petriflow.agents.bus.algorithms`: the paper's algorithms 1 and 2.
 * :mod:`~petriflow.agents.bus.addressing`: the chain's auto-addressing.
 * :mod:`~petriflow.agents.bus.experiment`: the 100-message experiment and its table.
-* :mod:`~petriflow.agents.bus.plugin`: registers the buses as channel models.
+* :mod:`~petriflow.agents.bus.firmware`: a module's firmware as actions a net binds
+  (boot, CPG step, Wait(Delay), send, the bus-available and overflow interrupts,
+  reception).
+* :mod:`~petriflow.agents.bus.nets`: the chain as a workflow net, algorithm 1 or 2.
+* :mod:`~petriflow.agents.bus.chain`: the chain as a pybullet robot (hinges, front
+  sensors).
+* :mod:`~petriflow.agents.bus.metrics`: lost messages per module, phase error, speed.
+* :mod:`~petriflow.agents.bus.figures`: lost messages beside Tables 1-3, CPG phases.
+* :mod:`~petriflow.agents.bus.plugin`: registers the buses as channel models, the
+  firmware's actions and guards, and the metrics.
 """
 
 from petriflow.agents.bus.addressing import auto_address
