@@ -1,4 +1,4 @@
-"""Asynchronous packet transmission on a modular robot bus (seed 002), as a pure simulation.
+"""Asynchronous packet transmission on a modular robot bus (seed 002): buses, CPG, firmware, nets.
 
 A chain of EMERGE modules runs a CPG and shares each module's phase with its
 neighbours over one shared bus; messages collide, wait, or get overwritten in a
