@@ -34,7 +34,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from petriflow.agents.bidding.cost import AREA_M2, SPEED_M_S, Weights, bid_costs, travel_times
+from petriflow.agents.bidding.cost import AREA_M2, SPEED_M_S, Weights, load_term, travel_times
 from petriflow.agents.bidding.errors import BiddingError
 
 __all__ = ["Allocation", "autonomous", "best", "random_deployment", "tour"]
@@ -122,10 +122,19 @@ def autonomous(positions: Any, zones: Any, *, offer: Sequence[int] | None = None
     if offer and not bidding.any():
         raise BiddingError("no robot is alive to bid")
     sensor = np.broadcast_to(np.asarray(accuracy, dtype=float), (robots,))
+    if np.any((sensor < 0) | (sensor > 1)):
+        raise BiddingError("sensor accuracy E_i must be from 0 to 1")
+    # eq. 6 as bid_costs computes it, with the load term looked up by the count held
+    start = counts.astype(np.int64)
+    if np.any(start != counts):
+        raise BiddingError("allocated zone counts must be whole numbers")
+    table = weights.beta * load_term(np.arange(int(start.max(initial=0)) + len(offer) + 1), area, log_base)
+    sensor_term = weights.gamma * (1.0 - sensor)
+    held = start.copy()
     winners, costs = [], []
     for z in offer:
-        bids = bid_costs(travel[:, z], counts, sensor, area=area, weights=weights, log_base=log_base)
-        bids = np.where(bidding, bids, np.inf)
+        bids = weights.alpha * (held + 1.0) * travel[:, z] + (table[held] + sensor_term)
+        bids[~bidding] = np.inf
         low = bids.min()
         if math.isfinite(low):
             tied = np.flatnonzero(bids - low <= TIE * max(1.0, abs(low)))
@@ -134,8 +143,8 @@ def autonomous(positions: Any, zones: Any, *, offer: Sequence[int] | None = None
         w = int(tied[0])
         winners.append(w)
         costs.append(float(bids[w]))
-        counts[w] += 1
-    return Allocation(winners, offer, costs, [int(c) for c in counts])
+        held[w] += 1
+    return Allocation(winners, offer, costs, [int(c) for c in held])
 
 
 def random_deployment(robots: int, zones: int, rng: random.Random | int = 0) -> list[list[int]]:
