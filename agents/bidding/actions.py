@@ -311,9 +311,18 @@ def _robot_receive(ctx: ActionContext, ra: RobotAgent, message: Message) -> None
 
 # The interface agent --------------------------------------------------------------------
 
+#: Seconds the HMIA waits for an ALLOCATED before it offers the zone again.
+AUCTION_TIMEOUT = 10.0
+
+
 def _hmia_alive(ctx: ActionContext, hmia: Interface) -> None:
-    """Robots that stopped: drop what waits for them, re-offer their unmapped zones."""
+    """Robots that stopped: drop what waits for them, re-offer their unmapped zones;
+    an auction nobody answered within :data:`AUCTION_TIMEOUT` is offered again."""
     hmia.now = ctx.now
+    if hmia.auction is not None and ctx.now - hmia.auction_at > AUCTION_TIMEOUT:
+        hmia.to_offer.appendleft(hmia.auction)
+        hmia.auction = None
+        ctx.emit("bidding.reoffer", zone=hmia.to_offer[0] + 1)
     for robot in sorted(hmia.alive):
         if ctx.running(robot):
             continue
@@ -754,10 +763,6 @@ def _hmia_next(h: Interface) -> str | None:
     if h.mode == "random" and not h.informed:
         return "inform"
     if h.to_offer and h.auction is None:
-        return "cfp"
-    if h.auction is not None and h.now - getattr(h, "auction_at", h.now) > 10.0:
-        h.to_offer.appendleft(h.auction)  # the winner never answered: offer again
-        h.auction = None
         return "cfp"
     if h.map_sent is None and h.deployed():
         return "map"

@@ -52,6 +52,8 @@ class Interface(Mailbox):
         self.informed = False
         self.to_offer: deque[int] = deque()
         self.auction: int | None = None
+        self.auction_at = 0.0
+        self.request: Message | None = None
         self.owner: dict[int, str] = {}
         self.finished: set[int] = set()
         self.alive: set[str] = set()
