@@ -557,7 +557,6 @@ class Explore(Action):
 
     def poll(self, ctx: ActionContext) -> Status:
         ra = self.ra
-        world = ctx.world
         dt = ctx.now - self.at  # the first poll comes at the start: no time has passed yet
         self.at = ra.now = ctx.now
         if dt <= 1e-12:

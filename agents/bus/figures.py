@@ -103,7 +103,7 @@ def draw_phases(out: Path, bus: str = "can", seed: int = 1, lag: float = 2 * mat
         stop = min(rows[-1][0] for rows in series.values())
         grid = [start + 0.1 * k for k in range(int((stop - start) / 0.1) + 1)]
 
-        def at(agent: str, t: float) -> float:
+        def at(agent: str, t: float, series: dict[str, list[tuple[float, float]]] = series) -> float:
             """The agent's phase at ``t``: its last sample, advanced at the intrinsic rate."""
             rows = series[agent]
             last = max((r for r in rows if r[0] <= t + 1e-9), key=lambda r: r[0])

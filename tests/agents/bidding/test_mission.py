@@ -65,7 +65,7 @@ def _metric(outcome, name):
 def test_transitions_fire_one_at_a_time():
     net = load_net(examples.path("bidding", "bidding-autonomous-2.yaml"))
     config = load_config(examples.path("bidding", "run.yaml"))
-    world = World(yaml.safe_load(open(examples.path("bidding", "world.yaml"))))
+    world = World(yaml.safe_load(examples.path("bidding", "world.yaml").read_text()))
     try:
         op = fire_one(net, "operator_request", world=world, config=config, tokens={"operator_start": [None]})
         operator = op.tokens["operator_work"][0]
@@ -163,7 +163,7 @@ def test_hmia_steps_and_a_robots_exploration_fire_alone():
 
     net = load_net(examples.path("bidding", "bidding-autonomous-2.yaml"))
     config = load_config(examples.path("bidding", "run.yaml"))
-    world = World(yaml.safe_load(open(examples.path("bidding", "world.yaml"))))
+    world = World(yaml.safe_load(examples.path("bidding", "world.yaml").read_text()))
     try:
         hmia = fire_one(net, "hmia_create", world=world, config=config,
                         tokens={"hmia_start": [None]}).tokens["hmia_work"][0]

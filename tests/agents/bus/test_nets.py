@@ -3,7 +3,6 @@ bus channel's multicast frames and read periods, whole runs and the chain's sens
 
 from __future__ import annotations
 
-import math
 import random
 
 import pytest
