@@ -40,7 +40,7 @@ from petriflow.agents.bidding.agent import Auction, Interface, Operator, RobotAg
 from petriflow.agents.bidding.auction import best, random_deployment, tour
 from petriflow.agents.bidding.cost import AREA_M2, SPEED_M_S, Weights, bid_costs
 from petriflow.agents.bidding.protocol import Message
-from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 
 __all__ = ["GUARDS"]
 
@@ -107,22 +107,9 @@ def _navigator(frozen: Any, resolution: float, inflate: float) -> Any:
     return Navigator(free, frame.origin, frame.resolution)
 
 
-class _Instant(Action):
-    """Does its work in ``start``; ends ok at the first poll."""
-
-    def start(self, ctx: ActionContext) -> None:
-        ctx.result = self.run(ctx)
-
-    def poll(self, ctx: ActionContext) -> Status:
-        return Status.OK
-
-    def run(self, ctx: ActionContext) -> Any:  # pragma: no cover - overridden
-        raise NotImplementedError
-
-
 # Creating the agents ---------------------------------------------------------------------
 
-class MakeOperator(_Instant):
+class MakeOperator(InstantAction):
     """The operator's mission: REQUEST, then INFORM (deployment, team, zones, lists)."""
 
     params = {
@@ -201,7 +188,7 @@ class MakeOperator(_Instant):
         return operator
 
 
-class MakeInterface(_Instant):
+class MakeInterface(InstantAction):
     """The HMIA's state, with an empty global map over the world's office."""
 
     params = {"resolution": Param(float, 0.1, "global map cell (m)")}
@@ -218,7 +205,7 @@ class MakeInterface(_Instant):
         return hmia
 
 
-class MakeRobot(_Instant):
+class MakeRobot(InstantAction):
     """An RA's state (it waits for INITIALIZE)."""
 
     params = {"rank": Param(int, 0, "the robot's rank in the team (ties go to the smallest)"),
@@ -230,7 +217,7 @@ class MakeRobot(_Instant):
 
 # Receiving -------------------------------------------------------------------------------
 
-class Receive(_Instant):
+class Receive(InstantAction):
     """One message from the agent's mailbox into its state."""
 
     params = {"box": Param(str, doc="the mailbox (channel place)"), "state": Param(str, doc="the listening place")}
@@ -339,7 +326,7 @@ def _hmia_alive(ctx: ActionContext, hmia: Interface) -> None:
         ctx.emit("bidding.breakdown", robot=robot, reoffered=[z + 1 for z in lost])
 
 
-class Team(_Instant):
+class Team(InstantAction):
     """HMIA: create the team: INITIALIZE (with its start pose) to every RA."""
 
     def run(self, ctx: ActionContext) -> Interface:
@@ -358,7 +345,7 @@ class Team(_Instant):
         return hmia
 
 
-class Inform(_Instant):
+class Inform(InstantAction):
     """HMIA, random deployment: every RA's zone list (INFORM)."""
 
     def run(self, ctx: ActionContext) -> Interface:
@@ -378,7 +365,7 @@ class Inform(_Instant):
         return hmia
 
 
-class Offer(_Instant):
+class Offer(InstantAction):
     """HMIA: a call for proposals for the next zone to every living RA (CFP)."""
 
     def run(self, ctx: ActionContext) -> Interface:
@@ -395,7 +382,7 @@ class Offer(_Instant):
         return hmia
 
 
-class StartMapping(_Instant):
+class StartMapping(InstantAction):
     """HMIA: every zone has an owner: MAP to every living RA (mapping starts)."""
 
     def run(self, ctx: ActionContext) -> Interface:
@@ -406,7 +393,7 @@ class StartMapping(_Instant):
         return hmia
 
 
-class End(_Instant):
+class End(InstantAction):
     """HMIA: every zone is mapped: END to every living RA; the map's accuracy (eq. 10)."""
 
     params = {"tolerance": Param(int, 1, "cells between a mapped point and a real obstacle that still count"
@@ -430,7 +417,7 @@ class End(_Instant):
 
 # Robot agents ----------------------------------------------------------------------------
 
-class Ready(_Instant):
+class Ready(InstantAction):
     """RA, on INITIALIZE: take its pose and laser; INITIALIZED back."""
 
     params = {"radius": Param(float, 0.1, "wheel radius (m)"), "ppr": Param(int, 500, "encoder pulses per turn"),
@@ -456,7 +443,7 @@ class Ready(_Instant):
         return ra
 
 
-class Bid(_Instant):
+class Bid(InstantAction):
     """RA, on CFP: its cost for the zone by eq. 6, to every other bidder (PROPOSE)."""
 
     params = {
@@ -491,7 +478,7 @@ class Bid(_Instant):
         return ra
 
 
-class Decide(_Instant):
+class Decide(InstantAction):
     """RA, every proposal in: the lowest cost wins (ties: smallest rank); the winner
     takes the zone and tells the HMIA (ALLOCATED)."""
 
@@ -697,7 +684,7 @@ class Explore(Action):
         ra.queue(Message("MAPPED", ra.name, ra.hmia, body={"points": fresh, "finished": [], "rank": ra.rank}))
 
 
-class Send(_Instant):
+class Send(InstantAction):
     """Any agent: the next message waiting for ``peer`` into its mailbox."""
 
     params = {"peer": Param(str, doc="the receiving agent"), "box": Param(str, doc="its mailbox (channel place)"),

@@ -34,7 +34,7 @@ from typing import Any
 from petriflow.agents.bus.algorithms import BusAwareScheme, NativeScheme
 from petriflow.agents.bus.cpg import CpgParameters, motor_angle, wrap
 from petriflow.agents.bus.packet import Packet, can_identifier, decode, encode
-from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 
 __all__ = ["GUARDS", "Module", "Oscillator"]
 
@@ -112,17 +112,6 @@ def _module(ctx: ActionContext) -> Module:
             if isinstance(data, Module):
                 return data
     raise ActionFailure(f"{ctx.transition!r}: no module state among the input tokens")
-
-
-class _Instant(Action):
-    def start(self, ctx: ActionContext) -> None:
-        ctx.result = self.run(ctx)
-
-    def poll(self, ctx: ActionContext) -> Status:
-        return Status.OK
-
-    def run(self, ctx: ActionContext) -> Any:  # pragma: no cover - overridden
-        raise NotImplementedError
 
 
 class _Timed(Action):
@@ -266,7 +255,7 @@ class Wait(_Timed):
         return scheme.iteration() - scheme.step_time if isinstance(scheme, NativeScheme) else 0.0
 
 
-class Send(_Instant):
+class Send(InstantAction):
     """``Send a message``: the CPG message as one frame to the scheme's addressees: a
     token in each addressee's channel place (``boxes``: address offset -> place)."""
 
@@ -342,7 +331,7 @@ class Overflow(_Timed):
         self.module.send_now = self.module.scheme.overflow()
 
 
-class Receive(_Instant):
+class Receive(InstantAction):
     """The reception routine: a frame from ``box`` (or the notice that it was lost);
     keep the neighbour's phase when the scheme accepts the message."""
 
@@ -370,7 +359,7 @@ class Receive(_Instant):
         return None
 
 
-class Drain(_Instant):
+class Drain(InstantAction):
     """A frame addressed to no module left the bus (or was lost on it)."""
 
     params = {"box": Param(str, doc="the channel place")}

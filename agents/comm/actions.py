@@ -33,7 +33,7 @@ from petriflow.agents.comm.agent import CommAgent, Peer
 from petriflow.agents.comm.framework import History, addresses, dhcp_pools, dpp, grid_position, grid_size
 from petriflow.agents.comm.radio import RadioChannel, pick_threshold, threshold_sweep
 
-from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 
 __all__ = [
     "GUARDS",
@@ -55,20 +55,7 @@ def _state(ctx: ActionContext) -> CommAgent:
     return state
 
 
-class _Instant(Action):
-    """Does its work in ``start``; ends ok at the first poll."""
-
-    def start(self, ctx: ActionContext) -> None:
-        ctx.result = self.run(ctx)
-
-    def poll(self, ctx: ActionContext) -> Status:
-        return Status.OK
-
-    def run(self, ctx: ActionContext) -> Any:  # pragma: no cover - overridden
-        raise NotImplementedError
-
-
-class Characterise(_Instant):
+class Characterise(InstantAction):
     """Process 1: make the agent's state; a robot's dpp (eq. 2) and start on the grid (eq. 3)."""
 
     params = {
@@ -108,7 +95,7 @@ class Characterise(_Instant):
         return (int((y - state.origin[1]) // state.cell), int((x - state.origin[0]) // state.cell))
 
 
-class Analyse(_Instant):
+class Analyse(InstantAction):
     """Process 2: sweep the link of a channel place behind a wall (Fig. 5); keep the threshold."""
 
     params = {
@@ -129,7 +116,7 @@ class Analyse(_Instant):
         return state
 
 
-class Initialise(_Instant):
+class Initialise(InstantAction):
     """Process 3: the agent's address (eq. 4), or one from a peer's DHCP pool (eq. 5)."""
 
     params = {
@@ -160,7 +147,7 @@ class Initialise(_Instant):
         return state
 
 
-class MakeHistory(_Instant):
+class MakeHistory(InstantAction):
     """Process 4: the empty data and history arrays."""
 
     def run(self, ctx: ActionContext) -> CommAgent:
@@ -383,7 +370,7 @@ class Explore(Action):
                 ctx.emit("comm.learnt", ids=[vertex_id], distance_m=round(state.robot.travelled, 3))
 
 
-class Listen(_Instant):
+class Listen(InstantAction):
     """A static agent (monitor, central unit): wait ``period`` s, then plan what to send."""
 
     params = {"period": Param(float, 1.0, "seconds between plans"),
@@ -411,7 +398,7 @@ class Listen(_Instant):
     needs_world = True
 
 
-class Send(_Instant):
+class Send(InstantAction):
     """Process 5: the next message waiting for ``peer`` into the channel place towards it."""
 
     params = {"peer": Param(str, doc="the peer agent"), "box": Param(str, doc="the channel place towards it"),
@@ -430,7 +417,7 @@ class Send(_Instant):
         return state
 
 
-class Receive(_Instant):
+class Receive(InstantAction):
     """Take one message from a channel place into this agent's history and map."""
 
     params = {"box": Param(str, doc="the channel place"), "state": Param(str, doc="the listening place")}

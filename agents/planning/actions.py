@@ -59,7 +59,7 @@ from petriflow.agents.planning.maps import (
     robot_label,
 )
 from petriflow.agents.planning.tracking import check_track
-from petriflow.runtime.action import Action, ActionContext, Param, Port, Status
+from petriflow.runtime.action import Action, ActionContext, InstantAction, Param, Port, Status
 
 __all__ = ["PlanPath", "TrackPath", "plan_world_path", "scene_frame", "find_scene"]
 
@@ -209,24 +209,7 @@ def plan_world_path(label_map: np.ndarray, frame: GridFrame, robot: str | int, g
     }
 
 
-class _Instant(Action):
-    """An action that does its work in :meth:`start` and ends at the first poll; a
-    :class:`PlanningError` (raised from :meth:`run`) is the ``failed`` outcome with its
-    message as reason."""
-
-    needs_world = False
-
-    def start(self, ctx: ActionContext) -> None:
-        ctx.result = self.run(ctx)
-
-    def run(self, ctx: ActionContext) -> Any:  # pragma: no cover - overridden
-        raise NotImplementedError
-
-    def poll(self, ctx: ActionContext) -> Status:
-        return Status.OK
-
-
-class PlanPath(_Instant):
+class PlanPath(InstantAction):
     """Plan a robot's path with A* on the camera's label map (seed 003 §4)."""
 
     params = {
@@ -299,7 +282,7 @@ class PlanPath(_Instant):
         return result
 
 
-class TrackPath(_Instant):
+class TrackPath(InstantAction):
     """Check a robot's position against its planned path (seed 003 §4.2): on track,
     reinsert at a point, or re-plan."""
 

@@ -50,6 +50,7 @@ __all__ = [
     "Param",
     "Port",
     "Action",
+    "InstantAction",
     "ActionContext",
     "ActionFailure",
     "generator_action",
@@ -382,6 +383,30 @@ class Action:
         Raising does not change how the run ended: the error is recorded in the run's
         ``stop`` event (``teardown_errors``) and the other actions are still torn down.
         """
+
+
+class InstantAction(Action):
+    """An action that does all its work at once: :meth:`run` returns the data of the
+    output tokens when the firing starts, and the firing ends ``ok`` in the same instant
+    (an exception from :meth:`run` is its ``failed`` outcome, with the message as reason).
+
+    Examples:
+        >>> class Double(InstantAction):
+        ...     params = {"x": Param(int, 1)}
+        ...     def run(self, ctx):
+        ...         return 2 * self.params["x"]
+    """
+
+    needs_world = False
+
+    def start(self, ctx: ActionContext) -> None:
+        ctx.result = self.run(ctx)
+
+    def poll(self, ctx: ActionContext) -> Status:
+        return Status.OK
+
+    def run(self, ctx: ActionContext) -> Any:  # pragma: no cover - overridden
+        raise NotImplementedError
 
 
 def generator_action(
