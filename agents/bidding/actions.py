@@ -31,7 +31,6 @@ re-auction, in both deployments).
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -53,58 +52,44 @@ def _state(ctx: ActionContext, kind: type) -> Any:
     raise ActionFailure(f"{ctx.transition!r}: no {kind.__name__} state among the input tokens")
 
 
-_OFFICES: dict[int, tuple[Any, Any, Any]] = {}
+class _Plan:
+    """A world's office plan (``meta.office``) and the navigators planned on it."""
+
+    def __init__(self, meta: dict[str, Any]) -> None:
+        from petriflow.agents.bidding.office import from_meta
+
+        self.meta = meta  # kept so its id stays this world's
+        self.office = from_meta(meta)
+        self.navigators: dict[float, Any] = {}
+
+    def navigator(self, inflate: float) -> Any:
+        if inflate not in self.navigators:
+            from petriflow.agents.mobile.navigate import Navigator
+
+            free, frame = self.office.free_grid(0.1, inflate)
+            self.navigators[inflate] = Navigator(free, frame.origin, frame.resolution)
+        return self.navigators[inflate]
+
+
+_PLANS: dict[int, _Plan] = {}
+
+
+def _plan_of(world: Any) -> _Plan | None:
+    """The world's office plan, read once per world (``None``: the world has none)."""
+    meta = (getattr(world, "meta", None) or {}).get("office")
+    if meta is None:
+        return None
+    plan = _PLANS.get(id(meta))
+    if plan is None or plan.meta is not meta:
+        if len(_PLANS) > 16:
+            _PLANS.clear()
+        plan = _PLANS[id(meta)] = _Plan(meta)
+    return plan
 
 
 def _office(world: Any) -> Any:
-    """The world's office plan (``meta.office``), or ``None``; read once per world."""
-    meta = getattr(world, "meta", None) or {}
-    if "office" not in meta:
-        return None
-    cached = _OFFICES.get(id(meta["office"]))
-    if cached is None or cached[0] is not meta["office"]:
-        if len(_OFFICES) > 16:
-            _OFFICES.clear()
-        key = _frozen(meta["office"])
-        cached = _OFFICES[id(meta["office"])] = (meta["office"], key, _office_of(key))
-    return cached[2]
-
-
-def _office_key(world: Any) -> Any:
-    _office(world)
-    return _OFFICES[id(world.meta["office"])][1]
-
-
-def _frozen(value: Any) -> Any:
-    if isinstance(value, dict):
-        return tuple(sorted((k, _frozen(v)) for k, v in value.items()))
-    if isinstance(value, (list, tuple)):
-        return tuple(_frozen(v) for v in value)
-    return value
-
-
-def _thawed(value: Any) -> Any:
-    if isinstance(value, tuple) and value and all(isinstance(v, tuple) and len(v) == 2 and isinstance(v[0], str)
-                                                   for v in value):
-        return {k: _thawed(v) for k, v in value}
-    if isinstance(value, tuple):
-        return [_thawed(v) for v in value]
-    return value
-
-
-@lru_cache(maxsize=8)
-def _office_of(frozen: Any) -> Any:
-    from petriflow.agents.bidding.office import from_meta
-
-    return from_meta(_thawed(frozen))
-
-
-@lru_cache(maxsize=8)
-def _navigator(frozen: Any, resolution: float, inflate: float) -> Any:
-    from petriflow.agents.mobile.navigate import Navigator
-
-    free, frame = _office_of(frozen).free_grid(resolution, inflate)
-    return Navigator(free, frame.origin, frame.resolution)
+    plan = _plan_of(world)
+    return None if plan is None else plan.office
 
 
 # Creating the agents ---------------------------------------------------------------------
@@ -597,7 +582,7 @@ class Explore(Action):
         if office is None:
             ra.route = [goal]
             return True
-        route = _navigator(_office_key(ctx.world), 0.1, self.params["inflate"]).route(ra.robot.pose[:2], goal)
+        route = _plan_of(ctx.world).navigator(self.params["inflate"]).route(ra.robot.pose[:2], goal)
         if route is None:
             ctx.emit("bidding.unreachable", goal=[round(goal[0], 3), round(goal[1], 3)])
             return bool(ra.waypoints) or self._finish_zone(ctx)
@@ -632,7 +617,7 @@ class Explore(Action):
         if office is None or not ra.route:
             return False
         where = ctx.world.position(blocker)
-        navigator = _navigator(_office_key(ctx.world), 0.1, self.params["inflate"])
+        navigator = _plan_of(ctx.world).navigator(self.params["inflate"])
         detour = navigator.around([(where[0], where[1], self.params["clearance"])]).route(ra.robot.pose[:2],
                                                                                            ra.route[-1])
         ctx.emit("bidding.detour", around=blocker, found=detour is not None)
