@@ -70,7 +70,6 @@ class ChannelState:
         self.bus = bus
         self.timeline = Timeline()
         self.medium: Medium = bus.medium(self.timeline, rng)
-        self.medium.keep_newest = True  # a frame arriving at a full buffer overwrites the oldest
         self.pending: dict[tuple[Any, int | None], tuple[Message, float]] = {}
         self.medium.read_on_arrival = set()  # the modules that read on arrival (read period 0)
         self.last_end = None

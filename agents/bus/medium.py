@@ -232,6 +232,7 @@ class BusModel(ChannelModel):
     read_period: float = field(default=0.0, metadata={"range": (0.0, 3600.0)})
     _channel: Any = field(default=None, init=False, repr=False, compare=False)
     loss_reason: Any = field(default=None, init=False, repr=False, compare=False)
+    _readers: dict[str, float] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def payload_limit(self) -> int:
         """Largest payload of one frame in bytes (a longer channel message is split)."""
@@ -260,12 +261,10 @@ class BusModel(ChannelModel):
         loop says how often; call before its first message)."""
         if not (math.isfinite(period) and period >= 0.0):
             raise BusError(f"a read period is a number of seconds >= 0, got {period!r}")
-        if self.__dict__.get("_readers") is None:
-            self.__dict__["_readers"] = {}
-        self.__dict__["_readers"][agent] = float(period)
+        self._readers[agent] = float(period)
 
     def read_period_of(self, agent: str | None) -> float:
-        return (self.__dict__.get("_readers") or {}).get(agent, self.read_period)
+        return self._readers.get(agent, self.read_period)
 
     def quiet_for(self, now: float) -> float:
         """As a channel model: how long the bus has carried nothing at ``now`` (0 while a
@@ -380,8 +379,7 @@ class Medium:
         deliveries: every frame a module read that was addressed to it.
         losses: every loss, with its reason.
         keep_newest: a full receive buffer drops its oldest frame for a new one (the
-            hardware's behaviour); ``False`` drops the new one (the channel adaptor's
-            count-preserving approximation).
+            hardware's behaviour); ``False`` drops the new one.
     """
 
     def __init__(self, bus: BusModel, timeline: Timeline, rng: random.Random, modules: Iterable[int] = ()) -> None:
@@ -471,17 +469,7 @@ class Medium:
         buffer = self._buffers[module]
         if len(buffer) >= self.bus.rx_buffer:
             if not self.keep_newest:
-                # The newest frame is the one lost (a channel model decides each frame
-                # when it is sent), except over a frame this module would not keep
-                # anyway: that one is overwritten, as the hardware would.
-                stranger = next((k for k, (old, _) in enumerate(buffer) if module not in old.receivers), None)
-                if stranger is None:
-                    self.losses.append(Lost(frame, module, Loss.OVERWRITTEN, now))
-                    return
-                old, _ = buffer[stranger]
-                del buffer[stranger]
-                self.losses.append(Lost(old, module, Loss.OVERWRITTEN, now))
-                buffer.append((frame, now))
+                self.losses.append(Lost(frame, module, Loss.OVERWRITTEN, now))
                 return
             old, _ = buffer.popleft()
             self.losses.append(Lost(old, module, Loss.OVERWRITTEN, now))
