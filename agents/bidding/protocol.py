@@ -89,6 +89,11 @@ class Mailbox:
         self.sent: dict[str, int] = {}
         self.received: dict[str, int] = {}
 
+    def to_token(self) -> dict[str, Any]:
+        """What a trace records of an agent's state: who it is and its message counts."""
+        return {"agent": getattr(self, "name", type(self).__name__), "casts": self.casts,
+                "sent": sum(self.sent.values()), "received": sum(self.received.values())}
+
     def queue(self, message: Message) -> None:
         self.outbox.setdefault(message.receiver, deque()).append(message)
 

@@ -102,6 +102,10 @@ class Module:
     def done(self) -> bool:
         return self.sent >= self.messages
 
+    def to_token(self) -> dict[str, Any]:
+        """What a trace records of the module's state: who it is and how far it got."""
+        return {"agent": self.name, "address": self.address, "sent": self.sent, "groups": self.groups}
+
     def name_at(self, address: int) -> str | None:
         return self.chain[address] if 0 <= address < len(self.chain) else None
 

@@ -70,6 +70,13 @@ class CommAgent:
     sent_bytes: int = 0
     payload_bytes: int = 0
 
+    def to_token(self) -> dict[str, Any]:
+        """What a trace records of this state: who it is and how far it got (cheap,
+        and the same in every process)."""
+        return {"agent": self.name, "kind": self.kind, "address": self.address,
+                "items": len(self.history.data) if self.history is not None else 0,
+                "sent_bytes": self.sent_bytes, "finished": self.finished}
+
     # Map -------------------------------------------------------------------------------
     @property
     def vertices(self) -> dict[int, tuple[float, float]]:

@@ -88,6 +88,36 @@ class ResumeMismatch(JournalError):
     """Re-execution made a different event than the journal holds."""
 
 
+def _difference(journaled: str, event: Event) -> str:
+    """What differs between a journaled event line and a re-executed event, in words.
+
+    Examples:
+        >>> old = Event(4, 1.0, "end", "t", None, {"outcome": "ok", "firing": 2}).to_json()
+        >>> _difference(old, Event(4, 1.5, "end", "t", None, {"outcome": "failed", "firing": 2}))
+        "end of t: data.outcome 'ok' in the journal, 'failed' now; time 1.0 in the journal, 1.5 now"
+    """
+    try:
+        before = json.loads(journaled)
+    except ValueError:
+        return "the journaled line is not an event"
+    now = json.loads(event.to_json())
+    found: list[str] = []
+
+    def walk(a: Any, b: Any, where: str) -> None:
+        if len(found) >= 3 or a == b:
+            return
+        if isinstance(a, dict) and isinstance(b, dict):
+            for key in sorted(set(a) | set(b), key=lambda k: (k != "data", k)):
+                walk(a.get(key), b.get(key), f"{where}.{key}" if where else key)
+            return
+        shown = [repr(v) if len(repr(v)) <= 80 else repr(v)[:77] + "..." for v in (a, b)]
+        found.append(f"{where} {shown[0]} in the journal, {shown[1]} now")
+
+    walk(before, now, "")
+    what = f"{event.kind} of {event.transition}" if event.transition else event.kind
+    return f"{what}: {'; '.join(found) or 'the same fields, written differently'}"
+
+
 class Journal:
     """A run journal in a SQLite file.
 
@@ -180,10 +210,9 @@ class Journal:
         if event.seq < self.journaled:
             journaled = self._journaled_line(event.seq)
             if journaled != line:
-                raise ResumeMismatch(
-                    f"{self.path}: event {event.seq} differs on re-execution:\n"
-                    f"  journal: {journaled}\n  now:     {line}"
-                )
+                raise ResumeMismatch(f"{self.path}: event {event.seq} differs on re-execution "
+                                     f"({_difference(journaled, event)}); the journal and outputs are left "
+                                     "as they were")
             return
         self._chunk = []
         self._pending.append(event)

@@ -8,8 +8,8 @@ holds only what is still in flight (an XES log keeps the firings not yet ended).
 
 Token data can be large (camera frames) or not JSON at all; events carry
 :func:`summarize`\\ d data instead: plain JSON kept as it is, anything else replaced by
-a short description with a content digest, so traces stay small and still compare
-bit for bit between runs.
+what its ``to_token()`` returns or a short description, so traces stay small and
+compare bit for bit between runs and processes.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import math
 import os
 import tempfile
 import time
+from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable
@@ -92,13 +93,21 @@ class Event:
 
 
 def summarize(value: Any, *, depth: int = 0) -> Any:
-    """A JSON-able, deterministic stand-in for token data.
+    """A JSON-able stand-in for token data that is the same in every process.
+
+    Plain JSON is kept as it is (tuples become lists, non-finite floats text); sets are
+    sorted; numpy values become lists, or a content digest when large; an object that
+    offers ``to_token()`` is recorded as what that returns; any other object as its type
+    name only. Nothing depends on memory addresses, ``id()`` or hash randomisation, so
+    two runs of the same net, world and seed record the same bytes.
 
     Examples:
-        >>> summarize({"pose": (1.0, 2.0)})
-        {'pose': [1.0, 2.0]}
+        >>> summarize({"pose": (1.0, 2.0), "seen": {"b", "a"}})
+        {'pose': [1.0, 2.0], 'seen': ['a', 'b']}
         >>> summarize(float("nan"))
         'nan'
+        >>> summarize(object())
+        '<object>'
     """
     if value is None or isinstance(value, (bool, int, str)):
         return value
@@ -108,61 +117,93 @@ def summarize(value: Any, *, depth: int = 0) -> Any:
         return f"<{type(value).__name__}>"
     if isinstance(value, dict):
         return {str(k): summarize(v, depth=depth + 1) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        if len(value) > 64:
-            return _digest(value)
-        return [summarize(v, depth=depth + 1) for v in value]
-    try:  # numpy scalars and arrays without importing numpy here
-        if hasattr(value, "shape") and hasattr(value, "tobytes"):
+    if isinstance(value, (list, tuple, set, frozenset, deque)):
+        items = [summarize(v, depth=depth + 1) for v in value]
+        if isinstance(value, (set, frozenset)):
+            items.sort(key=_canonical)
+        if len(items) > 64:
+            return f"<{type(value).__name__} {len(items)} sha1={_sha1(_canonical(items))}>"
+        return items
+    if hasattr(value, "shape") and hasattr(value, "tobytes"):  # numpy without importing it here
+        try:
             if getattr(value, "ndim", 1) == 0:
-                return summarize(value.item())
-            if value.size <= 16:
+                return summarize(value.item(), depth=depth + 1)
+            if value.size <= 16 or getattr(getattr(value, "dtype", None), "kind", "") == "O":
                 return summarize(value.tolist(), depth=depth + 1)
             shape = "x".join(str(s) for s in value.shape)
-            sha = hashlib.sha1(value.tobytes()).hexdigest()[:12]
-            return f"<array {shape} {value.dtype} sha1={sha}>"
-    except Exception:  # pragma: no cover - exotic array-likes
-        pass
-    if hasattr(value, "to_token"):
-        return summarize(value.to_token(), depth=depth + 1)
-    return _digest(value)
+            return f"<array {shape} {value.dtype} sha1={_sha1(value.tobytes())}>"
+        except Exception:  # pragma: no cover - exotic array-likes
+            return f"<{type(value).__name__}>"
+    to_token = getattr(value, "to_token", None)
+    if callable(to_token) and not isinstance(value, type):
+        return summarize(to_token(), depth=depth + 1)
+    return f"<{type(value).__name__}>"
 
 
-def _digest(value: Any) -> str:
-    text = repr(value).encode("utf-8", "replace")
-    return f"<{type(value).__name__} sha1={hashlib.sha1(text).hexdigest()[:12]}>"
+def _canonical(value: Any) -> str:
+    """Summarized data as one canonical JSON text (for sorting and digests)."""
+    return json.dumps(value, sort_keys=True, separators=(",", ":"), default=str)
+
+
+def _sha1(data: str | bytes) -> str:
+    if isinstance(data, str):
+        data = data.encode("utf-8", "replace")
+    return hashlib.sha1(data).hexdigest()[:12]
 
 
 class _PartialFile:
     """A text file written under a unique temporary name in its target folder and
     renamed into place when finished: an existing file of that name is never
-    half-overwritten, and two writers never share a temporary file."""
+    half-overwritten, and two writers never share a temporary file.
+
+    The temporary name carries the writer's process id
+    (``.NAME.<pid>-<random>.partial``), so the temporary files of writers that were
+    killed are recognised and removed by the next writer of the same file: at its start
+    (a resume that fails leaves nothing behind either) and when it finishes.
+    """
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
         self._started = time.time()
-        fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".partial",
+        _remove_stale(self.path, self._started)
+        fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.{os.getpid()}-", suffix=".partial",
                                              dir=self.path.parent if str(self.path.parent) else ".")
         self.file = os.fdopen(fd, "w", encoding="utf-8")
 
     def finish(self, keep: bool = True) -> None:
-        """Close the file and rename it into place (ordinary file mode), or drop it.
-
-        Temporary files of the same name left by killed writers (untouched for a minute
-        before this one began) are removed once the file is in place.
-        """
+        """Close the file and rename it into place (ordinary file mode), or drop it."""
         self.file.close()
         if not keep:
             os.unlink(self._partial)
             return
         os.chmod(self._partial, 0o666 & ~_umask())
         os.replace(self._partial, self.path)
-        for stale in self.path.parent.glob(f".{glob.escape(self.path.name)}.*.partial"):
-            try:  # untouched for a minute before this writer began: its writer is gone
-                if stale.stat().st_mtime < self._started - 60:
-                    stale.unlink()
-            except OSError:  # gone already, or not ours to remove
-                pass
+        _remove_stale(self.path, self._started)
+
+
+def _remove_stale(path: Path, started: float) -> None:
+    """Remove the temporary files of ``path`` whose writer is gone: its process no longer
+    exists, or (a name without a process id, or a process on another machine sharing
+    the folder) the file was untouched for a minute before ``started``."""
+    for stale in path.parent.glob(f".{glob.escape(path.name)}.*.partial"):
+        writer = stale.name[len(path.name) + 2:].split("-", 1)[0]
+        try:
+            if writer.isdigit() and int(writer) != os.getpid() and not _alive(int(writer)):
+                stale.unlink()
+            elif stale.stat().st_mtime < started - 60:
+                stale.unlink()
+        except OSError:  # gone already, or not ours to remove
+            pass
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return True
+    return True
 
 
 def _umask() -> int:
