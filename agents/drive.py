@@ -100,11 +100,12 @@ class GoTo(Action):
         "y": Param(float, doc="goal y (m)"),
         "path": Param(list, [], "waypoints [[x, y], ...] driven through before the goal"),
         "robot": Param((str, type(None)), None, "body or agent to drive (default: the agent)"),
-        "speed": Param(float, 0.4, "cruise speed (m/s)"),
-        "tolerance": Param(float, 0.05, "arrival distance (m)"),
-        "turn_gain": Param(float, 3.0, "turn rate per radian of heading error"),
+        "speed": Param(float, 0.4, "cruise speed (m/s)", low=1e-9),
+        "tolerance": Param(float, 0.05, "arrival distance (m)", low=1e-9),
+        "turn_gain": Param(float, 3.0, "turn rate per radian of heading error", low=1e-9),
     }
     needs_world = True
+    requires = frozenset({"world", "robot"})
 
     def setup(self, world: Any) -> None:
         if world is None:

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
+import os
+import re
 import sys
 import warnings
 from typing import Any, Sequence
@@ -31,11 +32,25 @@ class _Parser(argparse.ArgumentParser):
     """argparse with the one-line error style of the rest of the tool."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
+        # a value of thousands of characters is shown by its start, on one line
+        message = re.sub(r"'([^']{60})[^']{20,}'", r"'\1...'", " ".join(message.split()))
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message}\n")
 
 
 def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
     print(f"warning: {message}", file=sys.stderr)
+
+
+def _stdout_gone() -> bool:
+    """Whether standard output is a pipe whose reader has closed it."""
+    try:
+        import select
+
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(events & (select.POLLERR | select.POLLHUP) for _, events in poller.poll(0))
+    except (AttributeError, OSError, ValueError):  # no poll (Windows), or no real file
+        return True
 
 
 def _start_marking(net: Net, text: str | None) -> Marking:
@@ -61,17 +76,36 @@ def _format_marking(marking: Marking) -> str:
 # Commands ----------------------------------------------------------------------------
 
 
-def _load_bound(path: str) -> Net:
-    """Load a net as a run would: its run configuration found, the configuration's action
-    modules imported, every action, parameter, port and guard bound (``file:line``
-    errors with close matches, before anything else happens)."""
+def _load_bound(path: str, import_actions: bool = False) -> tuple[Net, list[str]]:
+    """Load a net as a run would: its run configuration found, every action, parameter,
+    port and guard bound (``file:line`` errors with close matches, before anything else
+    happens). The configuration's action modules (user code) are imported only when
+    ``import_actions``; otherwise the names only they could provide are not checked,
+    and the notes returned (also printed to standard error) say which."""
+    from pathlib import Path
+
     from petriflow.runtime.session import prepare
 
-    return prepare(path).net
+    prepared = prepare(path, import_actions=import_actions)
+    config = prepared.config
+    if not prepared.binding.unchecked:
+        return prepared.net, []
+    modules = ", ".join(repr(Path(m).name if Path(m).is_absolute() else m) for m in config.unimported_actions())
+    where = config.path or path
+    line = config.lines.get("actions") if config.path else prepared.net.lines.get("run")
+    notes = []
+    for item in prepared.binding.unchecked:
+        at = f"{path}:{item.line}" if item.line else path
+        notes.append(f"{at}: {item.transition!r}: {item.kind} {item.name!r} not checked: provided by module"
+                     f" {modules} named in {where}{f':{line}' if line else ''} (not imported;"
+                     " --import-actions to check)")
+    for note in notes:
+        print(f"petriflow: note: {note}", file=sys.stderr)
+    return prepared.net, notes
 
 
 def cmd_info(args: argparse.Namespace) -> int:
-    net = _load_bound(args.net)
+    net, notes = _load_bound(args.net, args.import_actions)
     info = {
         "net": net.id,
         "label": net.label,
@@ -92,6 +126,7 @@ def cmd_info(args: argparse.Namespace) -> int:
             for s in net.subnets.values()
         },
         "actions": net.actions(),
+        "not_checked": notes,
     }
     if args.json:
         _print_json(info)
@@ -123,8 +158,9 @@ def cmd_info(args: argparse.Namespace) -> int:
 
 def cmd_simulate(args: argparse.Namespace) -> int:
     net = load_net(args.net)
-    if args.steps < 0:
-        raise PetriflowError(f"--steps must be >= 0, got {args.steps}")
+    if not 0 <= args.steps <= limits.SIMULATE_STEPS:
+        raise PetriflowError(f"--steps must be from 0 to {limits.SIMULATE_STEPS:,} (raise the limit with"
+                             f" PETRIFLOW_LIMITS=SIMULATE_STEPS=N), got {args.steps}")
     sim = Simulation(net, _start_marking(net, args.marking), seed=args.seed)
     fired = sim.run(until=args.steps)
     result = {
@@ -189,6 +225,9 @@ def cmd_export(args: argparse.Namespace) -> int:
     from petriflow.export import export_net, format_of
 
     format = format_of(args.output, args.format)  # a bad format or ending fails before any work
+    from petriflow.runtime.session import _check_outputs
+
+    _check_outputs({"--output": args.output}, [args.net])
     size = _size(args.size)
     net = load_net(args.net)
     marking = _start_marking(net, args.marking)
@@ -230,9 +269,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     else:
         if args.net is None:
             raise PetriflowError("give the net to run (or --resume --db RUN_DB)")
-        for option, value in (("--until", args.until), ("--max-firings", args.max_firings)):
-            if value is not None and not (math.isfinite(value) and value >= 0):
-                raise PetriflowError(f"{option} must be a finite number >= 0, got {value}")
+        if args.until is not None:
+            limits.check_seconds(args.until, "--until")
+        if args.max_firings is not None and args.max_firings < 0:
+            raise PetriflowError(f"--max-firings must be >= 0, got {args.max_firings}")
         outcome = run_files(args.net, world=args.world, config=args.config, seed=args.seed,
                             until=args.until, trace=args.trace, xes=args.xes, db=args.db,
                             realtime=args.realtime, gui=args.gui, progress=not args.json,
@@ -313,7 +353,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
     if args.max_states is not None and args.max_states < 1:
         raise PetriflowError(f"--max-states must be >= 1, got {args.max_states}")
-    net = _load_bound(args.net)
+    net, _ = _load_bound(args.net, args.import_actions)
     result = check_net(net, max_states=args.max_states or DEFAULT_MAX_STATES)
     if args.json:
         _print_json(plain(result))
@@ -341,8 +381,11 @@ def build_parser() -> argparse.ArgumentParser:
         command.set_defaults(handler=handler)
         return command
 
+    import_help = ("import the action modules the net's run configuration names (user code) and check"
+                   " their actions too; by default looking at a net never runs its code")
     info = net_command("info", "Show sizes, subnets and bound actions of a net.", cmd_info)
     info.add_argument("--json", action="store_true", help="print JSON")
+    info.add_argument("--import-actions", action="store_true", help=import_help)
 
     simulate = net_command("simulate", "Play the random token game.", cmd_simulate)
     simulate.add_argument("--steps", type=int, default=100, help="firings to make (default 100)")
@@ -408,6 +451,7 @@ def build_parser() -> argparse.ArgumentParser:
         "check", "Analyse a net: WF-net soundness, boundedness, deadlocks, liveness, invariants.",
         cmd_check)
     check.add_argument("--json", action="store_true", help="print JSON")
+    check.add_argument("--import-actions", action="store_true", help=import_help)
     check.add_argument("--max-states", type=int, default=None, metavar="N",
                        help="most markings to explore (default 2,000,000); beyond it, exit 2")
     from petriflow.sweep.command import add_parser as add_sweep
@@ -427,8 +471,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except PetriflowError as exc:
         print("petriflow: " + " ".join(str(exc).split()), file=sys.stderr)  # one line, always
         return EXIT_BAD_INPUT
-    except BrokenPipeError:
-        return EXIT_OK
+    except BrokenPipeError as exc:
+        if _stdout_gone():  # the reader of our output went away (| head): nothing more to say
+            sys.stdout = open(os.devnull, "w")  # so the interpreter's own flush at exit stays quiet
+            return EXIT_OK
+        print(f"petriflow: {args.command}: a pipe to another process broke: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         return 130
     except MemoryError:

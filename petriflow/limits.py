@@ -29,7 +29,7 @@ import os
 
 from petriflow.errors import PetriflowError, did_you_mean
 
-__all__ = ["LIMITS", "ENVIRONMENT_VARIABLE", "parse", "from_environment"]
+__all__ = ["LIMITS", "ENVIRONMENT_VARIABLE", "MAX_SECONDS", "parse", "from_environment", "check_seconds"]
 
 #: Nesting depth of YAML collections (nets, worlds, run configurations).
 YAML_DEPTH = 64
@@ -54,10 +54,18 @@ FIRINGS_PER_INSTANT = 100_000
 WORLD_BODIES = 100_000
 #: Width and height of a world camera's image, in pixels.
 CAMERA_PIXELS = 4096
+#: Firings one ``petriflow simulate`` may make (``--steps``): the token game of an
+#: unbounded net never deadlocks, and every firing is printed and kept.
+SIMULATE_STEPS = 1_000_000
+
+#: The longest simulated time anything may name (a run's ``until``, a fault's time, a
+#: stall limit): 10**12 s, about 31,700 years. A fixed rule, not a capacity: beyond it
+#: a time divided by a world's step no longer fits a float's exact integers.
+MAX_SECONDS = 1e12
 
 #: The names :func:`parse` accepts.
 LIMITS = ("YAML_DEPTH", "YAML_VALUES", "JSON_DEPTH", "PNML_PAGE_DEPTH", "INVARIANT_CELLS", "BASIS_ENTRIES",
-          "RUN_TOKENS", "FIRINGS_PER_INSTANT", "WORLD_BODIES", "CAMERA_PIXELS")
+          "RUN_TOKENS", "FIRINGS_PER_INSTANT", "WORLD_BODIES", "CAMERA_PIXELS", "SIMULATE_STEPS")
 
 #: The environment variable :func:`from_environment` reads.
 ENVIRONMENT_VARIABLE = "PETRIFLOW_LIMITS"
@@ -83,6 +91,35 @@ def parse(text: str) -> dict[str, int]:
             raise PetriflowError(f"{ENVIRONMENT_VARIABLE}: {name} must be a whole number >= 1, got {value!r}")
         values[name] = int(number)
     return values
+
+
+def check_seconds(value: object, what: str) -> float:
+    """``value`` as a simulated time in seconds: a finite number from 0 to
+    :data:`MAX_SECONDS`.
+
+    Raises:
+        PetriflowError: naming ``what`` and the value.
+
+    Examples:
+        >>> check_seconds(2, "--until")
+        2.0
+        >>> check_seconds(1e308, "--until")
+        Traceback (most recent call last):
+        ...
+        petriflow.errors.PetriflowError: --until must be a time from 0 to 1e+12 s, got 1e+308
+    """
+    good = not isinstance(value, bool) and isinstance(value, (int, float))
+    if good:
+        try:
+            seconds = float(value)
+        except OverflowError:
+            good = False
+        else:
+            good = 0 <= seconds <= MAX_SECONDS
+    if not good:
+        shown = repr(value) if not isinstance(value, int) or abs(value) < 10**30 else "a number of more than 30 digits"
+        raise PetriflowError(f"{what} must be a time from 0 to {MAX_SECONDS:g} s, got {shown}")
+    return seconds
 
 
 def from_environment() -> None:

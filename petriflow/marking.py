@@ -7,7 +7,6 @@ same count.
 
 from __future__ import annotations
 
-import json
 from typing import Any, Iterator, Mapping
 
 from petriflow.errors import MarkingError
@@ -127,10 +126,12 @@ def parse_marking(text: str, places: Any = None) -> Marking:
         >>> parse_marking('{"p1": 2}')
         Marking({'p1': 2})
     """
+    from petriflow.io.files import parse_json
+
     try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise MarkingError(f"marking is not valid JSON: {exc.msg} at column {exc.colno}") from None
+        data = parse_json(text)
+    except ValueError as exc:
+        raise MarkingError(f"marking is not valid JSON: {exc}") from None
     if not isinstance(data, dict):
         raise MarkingError("marking must be a JSON object such as {\"p1\": 1}")
     if places is not None:

@@ -99,3 +99,13 @@ def sequence_net():
 def oracle_dir() -> Path:
     """The folder of nets written by other tools (copied into the tests)."""
     return ORACLE
+
+
+def pytest_collection_modifyitems(config, items):
+    """The smoke tests of the benchmarks (files named ``test_bench*`` or ``*bench_smoke*``)
+    are ``slow``: they run each benchmark end to end. The default run leaves ``slow``
+    tests out; ``scripts/test.sh`` runs them too under CI (see README)."""
+    for item in items:
+        name = item.path.name
+        if name.startswith("test_bench") or "bench_smoke" in name:
+            item.add_marker(pytest.mark.slow)

@@ -86,7 +86,7 @@ def test_fire_not_enabled_exits_1_naming_step_and_place(capsys, sequence_file):
         (["fire", "{net}", "x"], "unknown transition 'x'"),
         (["fire", "{net}", "a", "--marking", '{"i": 1.5}'], "--marking: place 'i': token count"),
         (["fire", "{net}", "a", "--marking", '{"zz": 1}'], "unknown place 'zz'"),
-        (["simulate", "{net}", "--steps", "-1"], "--steps must be >= 0"),
+        (["simulate", "{net}", "--steps", "-1"], "--steps must be from 0 to"),
         (["info", "missing.yaml"], "missing.yaml: no such file"),
     ],
 )

@@ -71,12 +71,16 @@ NETS_RUN = [p for p in net_files() if _runnable(p)]
 @pytest.fixture(scope="module")
 def two_runs(tmp_path_factory):
     """Every shipped net run in two processes with different hash seeds."""
-    folders = []
-    for hash_seed in (1, 2):
+    folders, children = [], []
+    for hash_seed in (1, 2):  # side by side: two processes, two cores
         out = tmp_path_factory.mktemp(f"hash{hash_seed}")
-        done = _python(RUN_ALL, out, *NETS_RUN, hash_seed=hash_seed)
-        assert done.returncode == 0, done.stderr[-2000:]
+        env = {**os.environ, "PYTHONHASHSEED": str(hash_seed)}
+        children.append(subprocess.Popen([sys.executable, "-c", RUN_ALL, str(out), *map(str, NETS_RUN)], env=env,
+                                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
         folders.append(out)
+    for child in children:
+        _, err = child.communicate(timeout=900)
+        assert child.returncode == 0, err[-2000:]
     return folders
 
 
@@ -98,17 +102,17 @@ def test_no_object_addresses_or_process_digests_in_traces(two_runs):
         assert " object at 0x" not in text, trace
 
 
-#: One net per scenario (and the example), killed mid-way and resumed.
+#: One net per scenario, killed mid-way and resumed (the philosophers and the inspection
+#: example are nets to analyse: they stall at once, or need a camera world they lack).
 SCENARIOS = sorted({p.parent.name: p for p in reversed(NETS_RUN) if p.suffix == ".yaml"
-                    and p.parent.name != "philosophers"}.items())
+                    and p.parent.name not in ("philosophers", "examples")}.items())
 
 
 @pytest.mark.parametrize("net", [p for _, p in SCENARIOS], ids=[name for name, _ in SCENARIOS])
-def test_a_run_killed_mid_way_resumes_in_another_process_to_the_same_trace(tmp_path, net):
+def test_a_run_killed_mid_way_resumes_in_another_process_to_the_same_trace(two_runs, tmp_path, net):
+    """The uninterrupted trace is the first process's run of the same options."""
     options = ["--seed", SEED, "--until", UNTIL, "--max-firings", FIRINGS]
-    whole = tmp_path / "whole.jsonl"
-    done = _python(KILL_AT, 10**9, "run", net, *options, "--trace", whole, hash_seed=1)
-    assert done.returncode in (0, 1), done.stderr
+    whole = two_runs[0] / f"{NETS_RUN.index(net)}.jsonl"
     events = len(whole.read_text().splitlines())
     assert events >= 4
     db, trace = tmp_path / "run.sqlite", tmp_path / "run.jsonl"
@@ -118,7 +122,7 @@ def test_a_run_killed_mid_way_resumes_in_another_process_to_the_same_trace(tmp_p
     resumed = _python(KILL_AT, 10**9, "run", "--resume", "--db", db, hash_seed=3)
     assert resumed.returncode in (0, 1), resumed.stderr
     assert trace.read_bytes() == whole.read_bytes()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.jsonl", "run.sqlite", "whole.jsonl"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.jsonl", "run.sqlite"]
 
 
 def test_a_resume_that_diverges_says_where_and_changes_nothing(tmp_path):

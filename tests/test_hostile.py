@@ -48,7 +48,7 @@ def test_two_outputs_on_one_file_are_refused(tmp_path, ticker, capsys):
 
 
 def test_an_output_over_an_input_is_refused(tmp_path, ticker, capsys):
-    one_line_error(capsys, ["run", ticker, "--trace", ticker], "would overwrite an input")
+    one_line_error(capsys, ["run", ticker, "--trace", ticker], "would overwrite one of the inputs")
     assert ticker.read_text() == TICKER
 
 
@@ -90,7 +90,7 @@ def test_a_run_that_cannot_start_leaves_no_journal(tmp_path, capsys):
     db = tmp_path / "run.sqlite"
     one_line_error(capsys, ["run", net, "--db", db], "world.yaml:1: dt must be a number of seconds")
     assert not db.exists()
-    one_line_error(capsys, ["run", _ticker(tmp_path), "--until", "nan", "--db", db], "--until must be a finite")
+    one_line_error(capsys, ["run", _ticker(tmp_path), "--until", "nan", "--db", db], "--until must be a time from 0 to 1e+12 s")
     assert not db.exists()
 
 
@@ -210,11 +210,11 @@ def test_malformed_worlds_are_one_line_before_anything_runs(tmp_path, capsys, wo
 
 
 @pytest.mark.parametrize("config, fragment", [
-    ("until: .nan", "until must be a finite number"),
-    ("faults: [{kill: r, at: .inf}]", "'at' must be a finite time"),
+    ("until: .nan", "until must be a number of seconds from 0 to 1e12"),
+    ("faults: [{kill: r, at: .inf}]", "'at' must be a time in seconds from 0 to 1e12"),
     ("dt: .nan", "dt must be a number of seconds"),
     ("world: ../../../../../../../../etc/passwd", "outside the configuration's folder"),
-    ("stall: -1", "stall must be a finite number"),
+    ("stall: -1", "stall must be a number of seconds > 0"),
 ])
 def test_malformed_run_configurations_are_one_line(tmp_path, capsys, ticker, config, fragment):
     (tmp_path / "run.yaml").write_text(config + "\n")
@@ -344,4 +344,127 @@ def test_a_parameter_named_by_a_number_is_one_line(tmp_path, capsys):
     net = tmp_path / "k.yaml"
     net.write_text("petriflow: 1\nplaces: [{id: i, tokens: 1}, o]\n"
                    "transitions: [{id: t, action: core.wait, params: {seconds: 1, -1}, in: [i], out: [o]}]\n")
-    one_line_error(capsys, ["info", net], "k.yaml:3: 't': action has no parameter -1")
+    one_line_error(capsys, ["info", net], "k.yaml:3: 't': 'params': key -1 must be text")
+
+
+# The classes of the second hostile corpus ------------------------------------------------
+HUGE = "9" * 5000
+
+
+@pytest.mark.parametrize("argv", [
+    ["fire", PASSAGE, "red_approach", "--marking", '{"red_ready": %s}' % HUGE],
+    ["export", PASSAGE, "-f", "dot", "-o", "x.dot", "--marking", '{"red_ready": %s}' % HUGE],
+    ["simulate", PASSAGE, "--marking", '{"red_ready": %s}' % HUGE],
+], ids=["fire", "export", "simulate"])
+def test_integers_of_thousands_of_digits_are_one_line(tmp_path, capsys, monkeypatch, argv):
+    monkeypatch.chdir(tmp_path)
+    err = one_line_error(capsys, argv, "--marking", "more than 4,300 digits")
+    assert len(err) < 300
+    assert not (tmp_path / "x.dot").exists()
+
+
+@pytest.mark.parametrize("option", ["--steps", "--seed"])
+def test_an_unreadable_option_value_is_shown_by_its_start(capsys, option):
+    with pytest.raises(SystemExit) as stopped:
+        main(["simulate", str(PASSAGE), option, HUGE])
+    err = capsys.readouterr().err
+    assert stopped.value.code == 2 and err.count("\n") == 1 and len(err) < 200, err
+    assert f"argument {option}: invalid int value: '9999" in err
+
+
+@pytest.mark.parametrize("until", ["1e308", "1e13", "-1", "inf"])
+def test_absurd_time_limits_are_refused_before_the_run(tmp_path, capsys, ticker, until):
+    db = tmp_path / "run.sqlite"
+    one_line_error(capsys, ["run", ticker, "--until", until, "--db", db], "--until must be a time from 0 to 1e+12 s")
+    assert not db.exists()
+
+
+def test_absurd_times_in_a_run_configuration_and_from_python(tmp_path, capsys, ticker):
+    from petriflow import run
+    from petriflow.errors import PetriflowError
+
+    (tmp_path / "run.yaml").write_text("until: 1e300\n")
+    one_line_error(capsys, ["run", ticker], "run.yaml:1: until must be a number of seconds from 0 to 1e12")
+    (tmp_path / "run.yaml").write_text(f"until: {'9' * 400}\n")
+    one_line_error(capsys, ["run", ticker], "until must be a number of seconds from 0 to 1e12")
+    (tmp_path / "run.yaml").unlink()
+    with pytest.raises(PetriflowError, match="until must be a time"):
+        run(ticker, until=1e308)
+
+
+def test_simulate_is_bounded_by_a_documented_limit(capsys, own_limits):
+    one_line_error(capsys, ["simulate", PASSAGE, "--steps", "1000001"], "--steps must be from 0 to 1,000,000",
+                   "SIMULATE_STEPS")
+    own_limits.SIMULATE_STEPS = 5
+    one_line_error(capsys, ["simulate", PASSAGE, "--steps", "6"], "--steps must be from 0 to 5")
+    assert main(["simulate", str(PASSAGE), "--steps", "5"]) == 0
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["run", "{ticker}", "--trace", "{blocker}/t.jsonl"], "--trace"),
+    (["run", "{ticker}", "--db", "{blocker}/t.sqlite"], "--db"),
+    (["export", "{ticker}", "-o", "{blocker}/x.svg"], "--output"),
+    (["replay", "{trace}", "--net", "{ticker}", "--draw", "{blocker}/x.svg"], "--draw"),
+], ids=["trace", "db", "export", "replay"])
+def test_an_output_that_cannot_be_written_is_one_line_before_any_work(tmp_path, capsys, ticker, argv, option):
+    """An output inside something that is not a writable folder (here a file, which no
+    user, root included, can write into)."""
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file, not a folder")
+    trace = tmp_path / "t.jsonl"
+    run_files(ticker, until=1, trace=trace)
+    capsys.readouterr()
+    filled = [a.format(ticker=ticker, blocker=blocker, trace=trace) for a in argv]
+    one_line_error(capsys, filled, option, "cannot write into")
+    assert capsys.readouterr().out == ""
+    assert blocker.read_text() == "a file, not a folder"
+
+
+def test_ids_yaml_reads_as_numbers_follow_one_rule(tmp_path, capsys):
+    """A whole number is its decimal text everywhere (places, arcs, final marking,
+    exports); a value YAML turns into something else is refused with its line."""
+    from petriflow.io import load_net
+    from petriflow.io.pnml import loads_pnml, dumps_pnml
+    from petriflow.io.yaml import dumps_net, loads_net
+
+    path = tmp_path / "n.yaml"
+    path.write_text("petriflow: 1\nplaces: [{id: 0, tokens: 1}, 1]\ntransitions: [{id: 2, in: [0], out: {1: 1}}]\n"
+                    "final: {1: 1}\n")
+    net = load_net(path)
+    assert list(net.places) == ["0", "1"] and list(net.transitions) == ["2"]
+    assert net.final_marking.to_dict() == {"1": 1}
+    assert loads_net(dumps_net(net)).structure() == net.structure()
+    assert loads_pnml(dumps_pnml(net)).structure() == net.structure()
+    assert main(["check", str(path)]) == 0
+    capsys.readouterr()
+    for text, fragment in [("places: [{id: p, tokens: 1}, yes]", "n.yaml:2: a place id must be text"),
+                           ("places: [{id: p, tokens: 1}, null]", "YAML reads this one as null"),
+                           ("places: [{id: p, tokens: 1}, q]\nfinal: {1.5: 1}", "final marking must be text"),
+                           ("places: [{id: p, tokens: 1}, q]\ntransitions: [{id: t, in: [p], out: [on]}]",
+                            "a place in 'out' must be text")]:
+        path.write_text(f"petriflow: 1\n{text}\n")
+        one_line_error(capsys, ["info", path], fragment, "put it in quotes")
+
+
+@pytest.mark.parametrize("transition, fragment", [
+    ("{id: t, action: core.fail, params: {probability: 2}, in: [i], out: [o]}",
+     "parameter 'probability' must be from 0 to 1, got 2.0"),
+    ("{id: t, action: core.wait, params: {seconds: -3}, in: [i], out: [o]}", "parameter 'seconds' must be >= 0"),
+    ("{id: t, action: drive.goto, params: {x: 1, y: 0}, in: [i], out: [o]}",
+     "action drive.goto moves a robot: give params.robot or put the transition in an agent subnet"),
+])
+def test_parameter_ranges_and_requirements_fail_when_the_net_binds(tmp_path, capsys, transition, fragment):
+    path = tmp_path / "n.yaml"
+    path.write_text(f"petriflow: 1\nplaces: [{{id: i, tokens: 1}}, o]\ntransitions:\n  - {transition}\n")
+    for command in ("info", "check", "run"):
+        one_line_error(capsys, [command, path], "n.yaml:4: 't': " + fragment)
+
+
+def test_an_action_that_needs_a_world_is_refused_before_a_worldless_run(tmp_path, capsys):
+    path = tmp_path / "n.yaml"
+    path.write_text("petriflow: 1\nplaces: [{id: i, tokens: 1}, o]\ntransitions:\n"
+                    "  - {id: look, action: vision.capture, in: [i], out: [o]}\n")
+    db = tmp_path / "run.sqlite"
+    one_line_error(capsys, ["run", path, "--db", db], "n.yaml:4: 'look': action vision.capture needs a world")
+    assert not db.exists()
+    assert main(["info", str(path)]) == 0  # looking needs no world

@@ -115,6 +115,7 @@ class Capture(Action):
         "height": Param((int, type(None)), None, "image height in pixels (default: the camera's, 480)"),
     }
     needs_world = False
+    requires = frozenset({"world"})
 
     def setup(self, world: Any) -> None:
         self.world = world

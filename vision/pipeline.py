@@ -281,7 +281,8 @@ class Locate(Action):
         "camera": Param((str, type(None)), None,
                         "camera for world coordinates (default: the one that took the frame)"),
         "marker_z": Param(float, DEFAULT_GEOMETRY.marker_z, "height of the marker discs' tops (m)"),
-        "robot_side": Param(float, DEFAULT_GEOMETRY.side, "side L of a robot's square in the map (m)"),
+        "robot_side": Param(float, DEFAULT_GEOMETRY.side, "side L of a robot's square in the map (m)",
+                            low=1e-9),
         "mode_filter": Param(bool, True, "remove loose pixels with the 8-neighbourhood mode filter"),
         "require": Param(list, [], "colours that must be found, else the action fails"),
     }

@@ -176,7 +176,7 @@ class MakeOperator(InstantAction):
 class MakeInterface(InstantAction):
     """The HMIA's state, with an empty global map over the world's office."""
 
-    params = {"resolution": Param(float, 0.1, "global map cell (m)")}
+    params = {"resolution": Param(float, 0.1, "global map cell (m)", low=1e-9)}
 
     def run(self, ctx: ActionContext) -> Interface:
         hmia = Interface(ctx.agent or ctx.transition)
@@ -382,7 +382,7 @@ class End(InstantAction):
     """HMIA: every zone is mapped: END to every living RA; the map's accuracy (eq. 10)."""
 
     params = {"tolerance": Param(int, 1, "cells between a mapped point and a real obstacle that still count"
-                                 " as real (eq. 10's sigma)")}
+                                 " as real (eq. 10's sigma)", low=0)}
 
     def run(self, ctx: ActionContext) -> Interface:
         hmia = _state(ctx, Interface)
@@ -405,8 +405,10 @@ class End(InstantAction):
 class Ready(InstantAction):
     """RA, on INITIALIZE: take its pose and laser; INITIALIZED back."""
 
-    params = {"radius": Param(float, 0.1, "wheel radius (m)"), "ppr": Param(int, 500, "encoder pulses per turn"),
-              "track": Param(float, 0.33, "wheel track (m)")}
+    params = {"radius": Param(float, 0.1, "wheel radius (m)", low=1e-9),
+              "ppr": Param(int, 500, "encoder pulses per turn", low=1),
+              "track": Param(float, 0.33, "wheel track (m)", low=1e-9)}
+    requires = frozenset({"world"})
 
     def run(self, ctx: ActionContext) -> RobotAgent:
         ra = _state(ctx, RobotAgent)
@@ -432,11 +434,12 @@ class Bid(InstantAction):
     """RA, on CFP: its cost for the zone by eq. 6, to every other bidder (PROPOSE)."""
 
     params = {
-        "speed": Param(float, SPEED_M_S, "the speed turning distance into travel time P_ij (m/s)"),
-        "accuracy": Param(float, 1.0, "E_i, the laser's accuracy (0..1)"),
-        "alpha": Param(float, 1 / 3, "eq. 6 weight of travel time"),
-        "beta": Param(float, 1 / 3, "eq. 6 weight of the zones held"),
-        "gamma": Param(float, 1 / 3, "eq. 6 weight of sensor inaccuracy"),
+        "speed": Param(float, SPEED_M_S, "the speed turning distance into travel time P_ij (m/s)",
+                       low=1e-9),
+        "accuracy": Param(float, 1.0, "E_i, the laser's accuracy (0..1)", low=0, high=1),
+        "alpha": Param(float, 1 / 3, "eq. 6 weight of travel time", low=0, high=1),
+        "beta": Param(float, 1 / 3, "eq. 6 weight of the zones held", low=0, high=1),
+        "gamma": Param(float, 1 / 3, "eq. 6 weight of sensor inaccuracy", low=0, high=1),
         "area": Param((float, type(None)), None, "L x W (m^2); default: the world's office, else 32 x 22"),
     }
 
@@ -496,24 +499,26 @@ class Explore(Action):
     """
 
     params = {
-        "speed": Param(float, SPEED_M_S, "cruise speed (m/s)"),
-        "turn_rate": Param(float, 1.0, "turn rate (rad/s)"),
-        "step": Param(float, 1.0, "longest run of one firing (s)"),
-        "scan_period": Param(float, 1.0, "seconds between laser scans"),
-        "range": Param(float, 8.0, "laser range (m)"),
-        "fov": Param(float, 180.0, "laser field of view (degrees)"),
-        "beams": Param(int, 360, "laser beams"),
+        "speed": Param(float, SPEED_M_S, "cruise speed (m/s)", low=1e-9),
+        "turn_rate": Param(float, 1.0, "turn rate (rad/s)", low=1e-9),
+        "step": Param(float, 1.0, "longest run of one firing (s)", low=1e-9),
+        "scan_period": Param(float, 1.0, "seconds between laser scans", low=0),
+        "range": Param(float, 8.0, "laser range (m)", low=1e-9),
+        "fov": Param(float, 180.0, "laser field of view (degrees)", low=1e-9, high=360),
+        "beams": Param(int, 360, "laser beams", low=1),
         "z": Param(float, 0.13, "laser height (m): at the robots' body height, so teammates are seen"),
         "filter_teammates": Param(bool, False, "drop laser returns on teammates (the paper's drawback, fixed)"),
-        "cell": Param(float, 0.1, "a point is new when its cell (m) was not sent before"),
+        "cell": Param(float, 0.1, "a point is new when its cell (m) was not sent before", low=1e-9),
         "send": Param(str, "every", "MAPPED after every scan (every, the paper's: its message counts follow"
                       " the mapping time) or only after scans that saw new cells (new)", choices=("every", "new")),
         "spin": Param(bool, True, "turn a full circle at every waypoint"),
         "visit": Param(str, "centre", "what mapping a zone means: drive to its position (centre, the paper's)"
                        " or through waypoints spread over its room (room)", choices=("centre", "room")),
-        "clearance": Param(float, 0.8, "hold while a robot of smaller rank is this close ahead (m)"),
-        "patience": Param(float, 3.0, "seconds held before planning a detour around the robot in the way"),
-        "inflate": Param(float, 0.35, "obstacle margin for path planning (m)"),
+        "clearance": Param(float, 0.8, "hold while a robot of smaller rank is this close ahead (m)",
+                           low=0),
+        "patience": Param(float, 3.0, "seconds held before planning a detour around the robot in the way",
+                          low=0),
+        "inflate": Param(float, 0.35, "obstacle margin for path planning (m)", low=0),
     }
     needs_world = True
 
@@ -690,7 +695,7 @@ class Send(InstantAction):
 class Wait(Action):
     """An agent with nothing to do: wait until something is (at most ``period`` s)."""
 
-    params = {"period": Param(float, 1.0, "longest wait (s)")}
+    params = {"period": Param(float, 1.0, "longest wait (s)", low=1e-9)}
 
     def start(self, ctx: ActionContext) -> None:
         self.state = ctx.token()

@@ -159,12 +159,13 @@ class Boot(_Timed):
     params = {
         "chain": Param(list, doc="the modules' agents, head first (who is behind whom)"),
         "algorithm": Param(int, 2, "the paper's algorithm: 1 (native) or 2 (bus-aware)", choices=(1, 2)),
-        "messages": Param(int, 100, "messages each module sends"),
-        "step_time": Param(float, 0.02, "one loop iteration: CPG and actuator (s)"),
-        "max_delay": Param(float, 1.0, "algorithm 1: Delay ~ U[0, max_delay] s"),
-        "idle_window": Param(float, 1.0, "algorithm 2: bus available comes U[0, idle_window] s into a quiet"),
+        "messages": Param(int, 100, "messages each module sends", low=1),
+        "step_time": Param(float, 0.02, "one loop iteration: CPG and actuator (s)", low=1e-9),
+        "max_delay": Param(float, 1.0, "algorithm 1: Delay ~ U[0, max_delay] s", low=0),
+        "idle_window": Param(float, 1.0, "algorithm 2: bus available comes U[0, idle_window] s into a quiet",
+                             low=0),
         "lag": Param(float, 2 * math.pi / 3, "the phase lag between neighbours (rad)"),
-        "spread": Param(float, 0.1, "start-up times are U[0, spread] s"),
+        "spread": Param(float, 0.1, "start-up times are U[0, spread] s", low=0),
         "mailboxes": Param(list, [], "this module's channel places (to tell the bus its read period)"),
     }
 
@@ -214,9 +215,9 @@ class Cpg(_Timed):
     is integrated up to now (the module's clock) and the joint's target angle set
     (eq. 1); a phase sample every ``sample`` s."""
 
-    params = {"sample": Param(float, 0.1, "seconds between phase samples (bus.phase events)"),
+    params = {"sample": Param(float, 0.1, "seconds between phase samples (bus.phase events)", low=0),
               "offset": Param(float, 0.0, "x, the joint's offset (rad)"),
-              "amplitude": Param(float, 0.5, "r, the joint's amplitude (rad)")}
+              "amplitude": Param(float, 0.5, "r, the joint's amplitude (rad)", low=0)}
 
     def duration(self, ctx: ActionContext) -> float:
         return self.module.scheme.step_time
@@ -326,7 +327,7 @@ class Overflow(_Timed):
     """Algorithm 2's overflow interrupt: after ``period`` s, ``Indicator ~ U[0, 1]``;
     the module sends if it is below the probability (0.5)."""
 
-    params = {"period": Param(float, 1.0, "seconds between overflow interrupts")}
+    params = {"period": Param(float, 1.0, "seconds between overflow interrupts", low=1e-9)}
 
     def duration(self, ctx: ActionContext) -> float:
         return self.params["period"]

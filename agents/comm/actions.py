@@ -60,14 +60,18 @@ class Characterise(InstantAction):
 
     params = {
         "kind": Param(str, "robot", "robot, monitor or central", choices=("robot", "monitor", "central")),
-        "wheel_radius": Param(float, 0.025, "wheel radius r (m)"),
-        "ppr": Param(int, 200, "encoder pulses per wheel revolution"),
-        "track": Param(float, 0.2, "distance between the wheels (m)"),
+        "wheel_radius": Param(float, 0.025, "wheel radius r (m)", low=1e-9),
+        "ppr": Param(int, 200, "encoder pulses per wheel revolution", low=1),
+        "track": Param(float, 0.2, "distance between the wheels (m)", low=1e-9),
         "area": Param(list, [5.0, 5.0], "the environment's size D = [Dx, Dy] (m)"),
-        "cell": Param(float, 0.5, "the maze's cell size (m): where the robot stops to sense"),
-        "cols": Param(int, 10, "cells per maze row (a vertex id is row * cols + col)"),
+        "cell": Param(float, 0.5, "the maze's cell size (m): where the robot stops to sense", low=1e-9),
+        "cols": Param(int, 10, "cells per maze row (a vertex id is row * cols + col)", low=1),
         "origin": Param(list, [0.0, 0.0], "world (x, y) of the maze's south-west corner"),
     }
+
+    @classmethod
+    def requirements(cls, params: dict[str, Any]) -> frozenset[str]:
+        return frozenset({"world"}) if params["kind"] == "robot" else frozenset()
 
     def run(self, ctx: ActionContext) -> CommAgent:
         p = self.params
@@ -100,8 +104,8 @@ class Analyse(InstantAction):
 
     params = {
         "channel_place": Param(str, doc="a channel place of this agent whose radio to analyse"),
-        "distances": Param(int, 10, "distances 1..N m"),
-        "trials": Param(int, 100, "frames per distance"),
+        "distances": Param(int, 10, "distances 1..N m", low=1),
+        "trials": Param(int, 100, "frames per distance", low=1),
     }
 
     def run(self, ctx: ActionContext) -> CommAgent:
@@ -120,9 +124,9 @@ class Initialise(InstantAction):
     """Process 3: the agent's address (eq. 4), or one from a peer's DHCP pool (eq. 5)."""
 
     params = {
-        "index": Param(int, 0, "this agent's index i among the initial agents"),
-        "agents": Param(int, 1, "N, the initial agents (the robots)"),
-        "available": Param(int, 253, "A, the addresses available"),
+        "index": Param(int, 0, "this agent's index i among the initial agents", low=0),
+        "agents": Param(int, 1, "N, the initial agents (the robots)", low=1),
+        "available": Param(int, 253, "A, the addresses available", low=2),
         "pool_of": Param((int, type(None)), None, "a late joiner: take the first free address of agent i's pool"),
         "address": Param((int, type(None)), None, "a fixed address instead (the central unit)"),
         "peers": Param(dict, {}, "peer agent -> {address: A, box: channel place towards it}"),
@@ -180,13 +184,14 @@ class Explore(Action):
     """
 
     params = {
-        "speed": Param(float, 0.15, "cruise speed (m/s)"),
-        "turn_rate": Param(float, 1.5, "turn rate on the spot (rad/s)"),
+        "speed": Param(float, 0.15, "cruise speed (m/s)", low=1e-9),
+        "turn_rate": Param(float, 1.5, "turn rate on the spot (rad/s)", low=1e-9),
         "sensor_z": Param(float, 0.1, "height of the distance sensors (m)"),
-        "give_up": Param(float, 240.0, "seconds after its exploration to wait for silent robots"),
+        "give_up": Param(float, 240.0, "seconds after its exploration to wait for silent robots", low=0),
         "reexplore": Param(bool, True, "re-explore silent robots' cells after give_up (decentralised)"),
-        "wait": Param(float, 1.0, "seconds between plans while waiting"),
-        "jitter": Param(float, 0.1, "each move's speed is the cruise speed times U(1 - j, 1 + j) (seeded)"),
+        "wait": Param(float, 1.0, "seconds between plans while waiting", low=1e-9),
+        "jitter": Param(float, 0.1, "each move's speed is the cruise speed times U(1 - j, 1 + j) (seeded)",
+                         low=0, high=1),
         "stop_at": Param((float, int, type(None)), None, "a mechanical failure at this time: the robot stops"
                          " moving for good, its radio goes on"),
     }
@@ -373,8 +378,9 @@ class Explore(Action):
 class Listen(InstantAction):
     """A static agent (monitor, central unit): wait ``period`` s, then plan what to send."""
 
-    params = {"period": Param(float, 1.0, "seconds between plans"),
-              "give_up": Param(float, 240.0, "seconds without news after which missing robots are given up")}
+    params = {"period": Param(float, 1.0, "seconds between plans", low=1e-9),
+              "give_up": Param(float, 240.0, "seconds without news after which missing robots are given up",
+                                 low=0)}
 
     def start(self, ctx: ActionContext) -> None:
         self.state = _state(ctx)

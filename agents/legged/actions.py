@@ -78,6 +78,7 @@ class _LeggedAction(Action):
     """Shared lifecycle: find the robot, tick the current motion, hold on cancel."""
 
     needs_world = True
+    requires = frozenset({"world", "robot"})
 
     def setup(self, world: Any) -> None:
         if world is None or not hasattr(world, "p"):
@@ -120,7 +121,7 @@ class Walk(_LeggedAction):
         "heading": Param(_FLOAT_OR_NONE, None, "final heading (rad, world), if any"),
         "stride": Param(_FLOAT_OR_NONE, None, "body travel per gait cycle (m; default: the gait's)"),
         "speed": Param(_FLOAT_OR_NONE, None, "walking speed at full stride (m/s; default: the gait's)"),
-        "tolerance": Param(float, 0.03, "arrival distance (m)"),
+        "tolerance": Param(float, 0.03, "arrival distance (m)", low=0),
     }
 
     #: Heading error (rad) over which the robot turns on the spot before walking.
@@ -330,7 +331,7 @@ class Turn(Walk):
     params: ClassVar[dict[str, Param]] = {
         "robot": Param(_STR_OR_NONE, None, "body or agent to turn (default: the agent)"),
         "angle": Param(float, doc="turn (rad, counter-clockwise positive)"),
-        "tolerance": Param(float, 0.05, "final heading tolerance (rad)"),
+        "tolerance": Param(float, 0.05, "final heading tolerance (rad)", low=0),
         "stride": Param(_FLOAT_OR_NONE, None, "body travel per gait cycle (m; default: the gait's)"),
         "speed": Param(_FLOAT_OR_NONE, None, "walking speed at full stride (m/s; sets the cycle time)"),
     }
@@ -379,11 +380,11 @@ class Brace(Walk):
     params: ClassVar[dict[str, Param]] = {
         "robot": Param(_STR_OR_NONE, None, "the helper's body or agent (default: the agent)"),
         "target": Param(str, doc="the fallen robot's body or agent"),
-        "gap": Param(float, 0.17, "distance from the fallen robot's centre to the helper's (m)"),
-        "approach": Param(float, 0.15, "extra distance of the approach point (m)"),
+        "gap": Param(float, 0.17, "distance from the fallen robot's centre to the helper's (m)", low=0),
+        "approach": Param(float, 0.15, "extra distance of the approach point (m)", low=0),
         "stride": Param(_FLOAT_OR_NONE, None, "body travel per gait cycle (m; default: the gait's)"),
         "speed": Param(_FLOAT_OR_NONE, None, "walking speed at full stride (m/s; sets the cycle time)"),
-        "tolerance": Param(float, 0.03, "arrival distance (m)"),
+        "tolerance": Param(float, 0.03, "arrival distance (m)", low=0),
     }
 
     def _route(self, ctx: ActionContext) -> list[tuple]:
@@ -411,9 +412,9 @@ class StandUp(_LeggedAction):
     params: ClassVar[dict[str, Param]] = {
         "robot": Param(_STR_OR_NONE, None, "the fallen robot's body or agent (default: the agent)"),
         "helper": Param(_STR_OR_NONE, None, "the helper bracing it, if any"),
-        "reach": Param(float, 0.12, "largest distance of the helper from its brace point (m)"),
-        "gap": Param(float, 0.17, "brace distance the helper was sent to (m)"),
-        "attempts": Param(int, 2, "righting attempts before failing"),
+        "reach": Param(float, 0.12, "largest distance of the helper from its brace point (m)", low=0),
+        "gap": Param(float, 0.17, "brace distance the helper was sent to (m)", low=0),
+        "attempts": Param(int, 2, "righting attempts before failing", low=1),
     }
 
     def start(self, ctx: ActionContext) -> None:

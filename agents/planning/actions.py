@@ -218,8 +218,8 @@ class PlanPath(InstantAction):
         "goal": Param(_OPTIONAL_LIST, None, "goal [x, y] (m); default: the input token's goal"),
         "start": Param(_OPTIONAL_LIST, None, "start [x, y] (m); default: the token's pose of the robot, "
                        "else the centre of its pixels"),
-        "radius": Param(float, 0.1, "robot radius (m): obstacles grow by it (C-space)"),
-        "cell": Param(int, 2, "cell side n in pixels (640x480 with n=2: a 320x240 grid)"),
+        "radius": Param(float, 0.1, "robot radius (m): obstacles grow by it (C-space)", low=0),
+        "cell": Param(int, 2, "cell side n in pixels (640x480 with n=2: a 320x240 grid)", low=1),
         "variant": Param(str, "optimal", "A* costs: optimal (sqrt 2 diagonals) or paper (cells travelled)",
                          choices=VARIANTS),
         "cut_corners": Param(bool, False, "allow a diagonal move between two occupied cells"),
@@ -289,8 +289,9 @@ class TrackPath(InstantAction):
     params = {
         "robot": Param((str, int, type(None)), None,
                        "the robot (colour, label or body name); default: the agent"),
-        "step": Param(float, 0.05, "dmin: length of one standard move (m)"),
-        "radius": Param(float, 0.1, "r: robot radius (m); farther than this from the path, re-plan"),
+        "step": Param(float, 0.05, "dmin: length of one standard move (m)", low=1e-9),
+        "radius": Param(float, 0.1, "r: robot radius (m); farther than this from the path, re-plan",
+                        low=1e-9),
         "reach": Param(_OPTIONAL_FLOAT, None, "longest single move (m), the reinsertion search radius; "
                        "default 2 x step"),
     }

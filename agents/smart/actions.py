@@ -129,12 +129,16 @@ class Dispatch(Action):
     params: ClassVar[dict[str, Param]] = {
         "helper": Param(str, "yellow", "the helper's colour", choices=tuple(LABELS)),
         "fallen": Param(str, "red", "the fallen robot's colour", choices=tuple(LABELS)),
-        "gap": Param(float, 0.17, "brace distance from the fallen robot's centre (m), as gait.brace"),
-        "approach": Param(float, 0.15, "the final point lies this much farther out (m), as gait.brace"),
+        "gap": Param(float, 0.17, "brace distance from the fallen robot's centre (m), as gait.brace",
+                     low=0),
+        "approach": Param(float, 0.15, "the final point lies this much farther out (m), as gait.brace",
+                          low=0),
         "height": Param(float, 0.13, "height of the fallen robot's visible side (m), for its position"),
-        "obstacle": Param(float, 0.15, "radius (m) of the fallen robot drawn as an obstacle in the helper's map"),
-        "side": Param(float, 0.26, "side L of a marker patch (m)"),
-        "resolution": Param(float, _CELLS["resolution"], "size of a command's coordinate cell (m)"),
+        "obstacle": Param(float, 0.15, "radius (m) of the fallen robot drawn as an obstacle in the helper's map",
+                          low=0),
+        "side": Param(float, 0.26, "side L of a marker patch (m)", low=1e-9),
+        "resolution": Param(float, _CELLS["resolution"], "size of a command's coordinate cell (m)",
+                            low=1e-9),
         "origin": Param(list, list(_CELLS["origin"]), "world [x, y] of command cell (0, 0)"),
     }
     needs_world = False
@@ -296,18 +300,20 @@ class Follow(Walk):
         "colour": Param(_STR_OR_NONE, None, "its marker colour for the camera (default: from the world's meta)"),
         "path": Param(list, [], "waypoints [[x, y], ...] (default: the input token's path)"),
         "brace": Param(_STR_OR_NONE, None, "end braced behind this fallen robot (body or agent), as gait.brace"),
-        "gap": Param(float, 0.17, "brace distance from the fallen robot's centre (m)"),
-        "approach": Param(float, 0.15, "extra distance of the brace approach point (m)"),
+        "gap": Param(float, 0.17, "brace distance from the fallen robot's centre (m)", low=0),
+        "approach": Param(float, 0.15, "extra distance of the brace approach point (m)", low=0),
         "step": Param(_FLOAT_OR_NONE, None, "dmin: one standard move (m; default: the gait's stride)"),
-        "radius": Param(float, 0.15, "r: robot radius (m); farther than this from the path, re-plan"),
+        "radius": Param(float, 0.15, "r: robot radius (m); farther than this from the path, re-plan",
+                        low=1e-9),
         "reach": Param(_FLOAT_OR_NONE, None, "longest single move (m), the reinsertion search radius; default 2 x step"),
-        "simplify": Param(float, 0.02, "corner tolerance of the walked polyline (m)"),
+        "simplify": Param(float, 0.02, "corner tolerance of the walked polyline (m)", low=0),
         "localise": Param(str, "vision", "pose for path tracking: vision (the last scene) or world (ground truth)",
                           choices=("vision", "world", "off")),
         "stride": Param(_FLOAT_OR_NONE, None, "body travel per gait cycle (m; default: the gait's)"),
         "speed": Param(_FLOAT_OR_NONE, None, "walking speed at full stride (m/s; default: the gait's)"),
-        "tolerance": Param(float, 0.03, "arrival distance (m)"),
-        "resolution": Param(float, _CELLS["resolution"], "size of a command's coordinate cell (m)"),
+        "tolerance": Param(float, 0.03, "arrival distance (m)", low=0),
+        "resolution": Param(float, _CELLS["resolution"], "size of a command's coordinate cell (m)",
+                            low=1e-9),
         "origin": Param(list, list(_CELLS["origin"]), "world [x, y] of command cell (0, 0)"),
         "scene": Port("place holding the camera's latest scene (read for vision tracking)"),
         "orders": Port("place holding the decision maker's standing orders (read: hold, re-plan)"),
@@ -502,9 +508,9 @@ class Avoid(Action):
 
     params: ClassVar[dict[str, Param]] = {
         "priorities": Param(dict, doc="{colour: priority}, higher goes first"),
-        "step": Param(float, 0.08, "standard step (m)"),
-        "radius": Param(float, 0.13, "robot radius (m): distances are gaps between discs"),
-        "steps": Param(float, 2.0, "a conflict is a gap under this many standard steps"),
+        "step": Param(float, 0.08, "standard step (m)", low=1e-9),
+        "radius": Param(float, 0.13, "robot radius (m): distances are gaps between discs", low=0),
+        "steps": Param(float, 2.0, "a conflict is a gap under this many standard steps", low=0),
         "orders": Port("place of the standing orders (an input and output of the transition)"),
     }
     needs_world = False
@@ -557,9 +563,10 @@ class Push(Action):
     params: ClassVar[dict[str, Param]] = {
         "robot": Param(_STR_OR_NONE, None, "body or agent to push (default: the agent)"),
         "force": Param(list, doc="[fx, fy, fz] (N, world frame)"),
-        "duration": Param(float, 0.2, "how long the force acts (s)"),
+        "duration": Param(float, 0.2, "how long the force acts (s)", low=0),
     }
     needs_world = True
+    requires = frozenset({"world", "robot"})
 
     def setup(self, world: Any) -> None:
         if world is None or not hasattr(world, "p"):

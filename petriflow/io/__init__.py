@@ -23,12 +23,9 @@ def _format_of(path: Path) -> str:
         return "yaml"
     if suffix in _PNML:
         return "pnml"
-    try:
-        with path.open("rb") as handle:
-            head = handle.read(512).lstrip()
-    except OSError as exc:
-        raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
-    return "pnml" if head.startswith(b"<") else "yaml"
+    from petriflow.io.files import read_text_file
+
+    return "pnml" if read_text_file(path).lstrip().startswith("<") else "yaml"
 
 
 def load_net(path: str | Path) -> Net:

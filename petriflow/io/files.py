@@ -9,7 +9,7 @@ from typing import Any
 
 from petriflow import limits
 
-__all__ = ["write_atomic", "read_yaml_file", "parse_json"]
+__all__ = ["write_atomic", "read_yaml_file", "parse_json", "decode_text", "read_text_file"]
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> None:
@@ -32,6 +32,73 @@ def write_atomic(path: str | Path, data: str | bytes) -> None:
         except FileNotFoundError:
             pass
         raise
+
+
+#: Byte-order marks, longest first (UTF-32's little-endian mark starts with UTF-16's).
+_BOMS = ((b"\x00\x00\xfe\xff", "utf-32-be"), (b"\xff\xfe\x00\x00", "utf-32-le"), (b"\xef\xbb\xbf", "utf-8"),
+         (b"\xfe\xff", "utf-16-be"), (b"\xff\xfe", "utf-16-le"))
+
+
+def decode_text(data: bytes) -> str:
+    """The text of a net, world or configuration file, in any encoding XML and YAML allow.
+
+    A byte-order mark decides (UTF-8, UTF-16 or UTF-32, either byte order; the mark is
+    dropped); without one, UTF-16 is recognised by its first character (``<`` or an
+    ASCII letter, as XML's and YAML's autodetection do), then an XML declaration's
+    ``encoding`` is used, else UTF-8.
+
+    Raises:
+        ValueError: the bytes are not text in that encoding, or the declared encoding
+            is unknown (the message says which).
+
+    Examples:
+        >>> decode_text("\ufeffnet: a".encode("utf-8"))
+        'net: a'
+        >>> decode_text("<pnml/>".encode("utf-16"))
+        '<pnml/>'
+        >>> decode_text("<?xml version='1.0' encoding='latin-1'?><a>é</a>".encode("latin-1"))[-8:]
+        '<a>é</a>'
+    """
+    import codecs
+    import re
+
+    for mark, encoding in _BOMS:
+        if data.startswith(mark):
+            return _decode(data[len(mark):], encoding)
+    if len(data) >= 2 and data[0] == 0 and data[1] != 0:
+        return _decode(data, "utf-16-be")
+    if len(data) >= 2 and data[1] == 0 and data[0] != 0 and not (len(data) >= 4 and data[2] == 0):
+        return _decode(data, "utf-16-le")
+    declared = re.match(rb"\s*<\?xml[^>]*?encoding\s*=\s*[\"']([A-Za-z0-9._-]+)[\"']", data[:512])
+    encoding = declared.group(1).decode("ascii") if declared else "utf-8"
+    try:
+        codecs.lookup(encoding)
+    except LookupError:
+        raise ValueError(f"unknown encoding {encoding!r} in the XML declaration") from None
+    return _decode(data, encoding)
+
+
+def _decode(data: bytes, encoding: str) -> str:
+    try:
+        return data.decode(encoding)
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"not {exc.encoding} text (byte {exc.start})") from None
+
+
+def read_text_file(path: str | Path) -> str:
+    """Read a text file petriflow did not write itself (see :func:`decode_text`).
+
+    Raises:
+        NetFormatError: unreadable or undecodable, naming the file.
+    """
+    from petriflow.errors import NetFormatError
+
+    try:
+        return decode_text(Path(path).read_bytes())
+    except OSError as exc:
+        raise NetFormatError(f"cannot read: {exc.strerror or exc}", path=str(path)) from None
+    except ValueError as exc:
+        raise NetFormatError(f"cannot read: {exc}", path=str(path)) from None
 
 
 def _umask() -> int:
@@ -59,10 +126,7 @@ def read_yaml_file(path: str | Path, *, lines: bool = False) -> Any:
     from petriflow.io.yaml import _plain, parse_yaml
 
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
+    text = read_text_file(path)
     try:
         data = parse_yaml(text)
         return data if lines else _plain(data)

@@ -905,6 +905,14 @@ def loads_pnml(data: str | bytes, *, path: str | None = None) -> Net:
 def _loads(data: str | bytes, path: str | None, stacklevel: int) -> Net:
     if not isinstance(data, (str, bytes)):
         raise NetFormatError(f"PNML must be text or bytes, got {type(data).__name__}", path=path)
+    if isinstance(data, bytes):  # byte-order marks and UTF-16 without one, as the XML spec allows
+        from petriflow.io.files import decode_text
+
+        try:
+            data = decode_text(data)
+        except ValueError as exc:
+            raise NetFormatError(f"cannot decode the file: {exc}", path=path) from None
+    data = data.removeprefix("\ufeff")
     root = _parse_xml(data, path)
     # warnings point at the caller of the public function: +1 for emit, read, _loads
     net = _Reader(root, path, stacklevel + 2).read()
@@ -918,9 +926,7 @@ def load_pnml(path: str | Path) -> Net:
     Raises:
         NetFormatError: also when the file is missing or unreadable.
     """
+    from petriflow.io.files import read_text_file
+
     name = str(path)
-    try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
-        raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=name) from None
-    return _loads(data, name, stacklevel=3)
+    return _loads(read_text_file(path), name, stacklevel=3)

@@ -199,7 +199,7 @@ class _Reader:
         if type(version) is not int or version != FORMAT_VERSION:
             self.fail(f"unsupported format version {version!r}; this petriflow reads {FORMAT_VERSION}", data)
         if "net" in data:
-            self.net.id = str(data["net"])
+            self.net.id = self.ident(data["net"], "the net's id", data)
         self.net.label = _text(data.get("label"), "the net's label", lambda m: self.fail(m, data))
         self.net.meta = _meta(data.get("meta"), lambda m: self.fail(m, data))
         if data.get("run") is not None:
@@ -207,7 +207,8 @@ class _Reader:
             if not isinstance(run, (str, dict)):
                 self.fail("'run' must name a run configuration file or be one (a mapping)", data,
                           line=data.key_lines.get("run"))
-            self.net.run = _plain(run)
+            self.net.run = _exact(run, "an inline 'run' configuration", lambda m: self.fail(
+                m, data, line=data.key_lines.get("run")))
             self.net.lines["run"] = data.key_lines.get("run", data.line)
         for subnet in self.as_list(data.get("subnets"), "subnets", data):
             self.read_subnet(subnet)
@@ -218,7 +219,7 @@ class _Reader:
         for subnet in self.as_list(data.get("subnets"), "subnets", data):
             members = self.as_list(subnet.get("transitions"), "transitions", subnet)
             for transition in members:
-                self.read_transition(transition, str(subnet["id"]), _line(members))
+                self.read_transition(transition, self.ident(subnet.get("id"), "a subnet id", subnet), _line(members))
         for transition in transitions:
             self.read_transition(transition, None, _line(transitions))
         for arc in self.as_list(data.get("arcs"), "arcs", data):
@@ -244,7 +245,7 @@ class _Reader:
         self.check_keys(item, _SUBNET_KEYS, "subnet")
         if "id" not in item:
             self.fail("subnet without 'id'", item)
-        sid = str(item["id"])
+        sid = self.ident(item["id"], "a subnet id", item)
         if sid in self.net.subnets:
             self.fail("duplicate subnet id", item, sid)
         fail = (lambda m: self.fail(m, item, sid))
@@ -254,13 +255,13 @@ class _Reader:
             self.read_place(place, sid, _line(places))
 
     def read_place(self, item: Any, subnet: str | None, list_line: int | None = None) -> None:
-        if isinstance(item, (str, int)) and not isinstance(item, bool):
-            item = _LineDict(id=str(item))
+        if not isinstance(item, dict):
+            item = _LineDict(id=self.ident(item, "a place id", None, line=list_line))
             item.line = list_line or 0
-        self.check_keys(item, _PLACE_KEYS, "place", item.get("id") if isinstance(item, dict) else None)
+        self.check_keys(item, _PLACE_KEYS, "place", item.get("id"))
         if "id" not in item:
             self.fail("place without 'id'", item)
-        pid = str(item["id"])
+        pid = self.ident(item["id"], "a place id", item)
         tokens = item.get("tokens", 0)
         if isinstance(tokens, bool) or not isinstance(tokens, int) or tokens < 0:
             self.fail(f"tokens must be a whole number >= 0, got {tokens!r}", item, pid)
@@ -280,9 +281,9 @@ class _Reader:
         if isinstance(value, str):
             value = [value]
         if isinstance(value, list):
-            pairs = [(str(p), 1) for p in value]
+            pairs = [(self.ident(p, f"a place in '{key}'", item), 1) for p in value]
         elif isinstance(value, dict):
-            pairs = [(str(p), w) for p, w in value.items()]
+            pairs = [(self.ident(p, f"a place in '{key}'", item), w) for p, w in value.items()]
         else:
             self.fail(f"'{key}' must be a list of places or a mapping place: weight", item, tid)
         branches: dict[str, int] = {}
@@ -301,13 +302,13 @@ class _Reader:
             self.fail(f"arc weight must be a whole number >= 1, got {weight!r}", item, element)
 
     def read_transition(self, item: Any, subnet: str | None, list_line: int | None = None) -> None:
-        if isinstance(item, (str, int)) and not isinstance(item, bool):
-            item = _LineDict(id=str(item))
+        if not isinstance(item, dict):
+            item = _LineDict(id=self.ident(item, "a transition id", None, line=list_line))
             item.line = list_line or 0
-        self.check_keys(item, _TRANSITION_KEYS, "transition", item.get("id") if isinstance(item, dict) else None)
+        self.check_keys(item, _TRANSITION_KEYS, "transition", item.get("id"))
         if "id" not in item:
             self.fail("transition without 'id'", item)
-        tid = str(item["id"])
+        tid = self.ident(item["id"], "a transition id", item)
         if tid in self.net.places or tid in self.net.transitions:
             self.fail("duplicate id", item, tid)
         params = item.get("params") or {}
@@ -328,10 +329,10 @@ class _Reader:
             self.fail("'cancels' must be a list of place and transition ids", item, tid)
         attributes: dict[str, Any] = dict(
             timeout=None if timeout is None else float(timeout),
-            cancels=tuple(str(c) for c in cancels),
+            cancels=tuple(self.ident(c, "an id in 'cancels'", item) for c in cancels),
             label=_text(item.get("label"), "label", lambda m: self.fail(m, item, tid)),
             action=item.get("action"),
-            params=_plain(params),
+            params=_exact(params, "'params'", lambda m: self.fail(m, item, tid)),
             guard=item.get("guard"),
             subnet=subnet,
             silent=bool(item.get("silent", False)),
@@ -372,7 +373,7 @@ class _Reader:
                     if operator.get(side) is not None and operator.get(side) not in OPERATOR_KINDS:
                         self.fail(f"operator {side} must be one of {', '.join(OPERATOR_KINDS)}, got"
                                   f" {operator.get(side)!r}", item, tid)
-                attributes["operator"] = Operator(str(operator["group"]), operator.get("split"),
+                attributes["operator"] = Operator(self.ident(operator["group"], "an operator group", item), operator.get("split"),
                                                   operator.get("join"))
             self.net.add_transition(tid, **attributes)
             for place, weight in inputs.items():
@@ -400,7 +401,7 @@ class _Reader:
 
     def read_arc(self, item: Any) -> None:
         if isinstance(item, list) and len(item) in (2, 3):
-            source, target = str(item[0]), str(item[1])
+            source, target = (self.ident(end, "an arc's end", item) for end in item[:2])
             weight = item[2] if len(item) == 3 else 1
             self.pending_arcs.append((source, target, weight, _line(item), None, None))
             return
@@ -412,7 +413,8 @@ class _Reader:
         if when is not None and when != "ok" and when not in OUTCOMES:
             self.fail(f"'when' must be ok or one of {', '.join(OUTCOMES)}, got {when!r}", item)
         self.pending_arcs.append(
-            (str(item["from"]), str(item["to"]), item.get("weight", 1), _line(item), item.get("id"), when)
+            (self.ident(item["from"], "an arc's 'from'", item), self.ident(item["to"], "an arc's 'to'", item),
+             item.get("weight", 1), _line(item), item.get("id"), when)
         )
 
     def add_pending_arcs(self) -> None:
@@ -434,13 +436,29 @@ class _Reader:
     def read_marking(self, value: Any, what: str) -> dict[str, int]:
         if not isinstance(value, dict):
             self.fail(f"{what} must be a mapping place: tokens", value)
-        for place, count in value.items():
+        marking: dict[str, int] = {}
+        for key, count in value.items():
+            place = self.ident(key, f"a place in the {what}", value)
             if place not in self.net.places:
-                self.fail(f"{what} names unknown place {place!r}{did_you_mean(str(place), self.net.places)}",
-                          value)
+                self.fail(f"{what} names unknown place {place!r}{did_you_mean(place, self.net.places)}", value)
             if isinstance(count, bool) or not isinstance(count, int) or count < 0:
                 self.fail(f"{what}: tokens of {place!r} must be a whole number >= 0", value)
-        return {str(p): c for p, c in value.items()}
+            marking[place] = count
+        return marking
+
+    def ident(self, value: Any, what: str, item: Any, line: int | None = None) -> str:
+        """An id as written: text, or a whole number taken as its decimal text (``1`` is
+        ``'1'``). Anything else YAML reads as another type (``yes``, ``null``, ``1.50``,
+        a date) is refused, since the text would not be what the file says."""
+        if isinstance(value, str):
+            return value
+        if isinstance(value, int) and not isinstance(value, bool):
+            return str(value)
+        shown = {True: "true", False: "false", None: "null"}.get(value, repr(value)) \
+            if isinstance(value, (bool, type(None))) else repr(value)
+        kind = {bool: "a boolean", type(None): "null", float: "a number"}.get(type(value), type(value).__name__)
+        self.fail(f"{what} must be text; YAML reads this one as {kind} ({shown}): put it in quotes",
+                  item, line=line)
 
 
 def _plain(value: Any) -> Any:
@@ -450,6 +468,30 @@ def _plain(value: Any) -> Any:
         return {k: _plain(v) for k, v in value.items()}
     if isinstance(value, list):
         return [_plain(v) for v in value]
+    return value
+
+
+def _exact(value: Any, what: str, fail) -> Any:
+    """Plain data that JSON (and so PNML, journals and traces) keeps exactly: text keys,
+    finite numbers; ``fail`` is told the first thing that is not."""
+    import math
+
+    value = _plain(value)
+    stack: list[tuple[Any, str]] = [(value, "")]
+    while stack:
+        item, where = stack.pop()
+        if isinstance(item, dict):
+            for key, inner in item.items():
+                if not isinstance(key, str):
+                    fail(f"{what}: key {key!r}{where and f' in {where}'} must be text (quote it)")
+                stack.append((inner, f"{where}.{key}" if where else repr(key)))
+        elif isinstance(item, list):
+            stack.extend((inner, f"{where}[{i}]") for i, inner in enumerate(item))
+        elif isinstance(item, float) and not math.isfinite(item):
+            fail(f"{what}: {where or 'the value'} must be a finite number, got {item!r}")
+        elif not (item is None or isinstance(item, (str, int, float, bool))):
+            fail(f"{what}: {where or 'the value'} must be text, a number, a list or a mapping, "
+                 f"got {type(item).__name__}")
     return value
 
 
@@ -520,12 +562,10 @@ def _yaml_problem(exc: Exception) -> str:
 
 def load_yaml(path: str | Path) -> Net:
     """Read a net from a YAML file (see :func:`loads_net`)."""
+    from petriflow.io.files import read_text_file
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
-    return loads_net(text, path=str(path))
+    return loads_net(read_text_file(path), path=str(path))
 
 
 # Writing -----------------------------------------------------------------------------

@@ -82,12 +82,22 @@ class Param:
         default: value used when the net gives none; :data:`REQUIRED` if it must.
         doc: one line for ``petriflow actions``.
         choices: allowed values, if limited.
+        low: the smallest value a number may take (``None``: no bound).
+        high: the largest value a number may take (``None``: no bound).
+
+    Examples:
+        >>> Param(float, 0.5, low=0, high=1).check("probability", 2, where="t")
+        Traceback (most recent call last):
+        ...
+        petriflow.errors.NetFormatError: 't': parameter 'probability' must be from 0 to 1, got 2.0
     """
 
     type: Any = object
     default: Any = REQUIRED
     doc: str = ""
     choices: tuple = ()
+    low: float | None = None
+    high: float | None = None
 
     def check(self, name: str, value: Any, where: str) -> Any:
         types = self.type if isinstance(self.type, tuple) else (self.type,)
@@ -106,6 +116,12 @@ class Param:
             raise NetFormatError(
                 f"parameter {name!r} must be one of {list(self.choices)}, got {value!r}", element=where
             )
+        if (self.low is not None or self.high is not None) and isinstance(value, (int, float)) \
+                and not isinstance(value, bool):
+            if (self.low is not None and value < self.low) or (self.high is not None and value > self.high):
+                span = (f"from {self.low:g} to {self.high:g}" if self.low is not None and self.high is not None
+                        else f">= {self.low:g}" if self.low is not None else f"<= {self.high:g}")
+                raise NetFormatError(f"parameter {name!r} must be {span}, got {value!r}", element=where)
         return value
 
 
@@ -286,6 +302,17 @@ class Action:
 
     params: ClassVar[dict[str, Param]] = {}
     needs_world: ClassVar[bool] = True
+    #: What a transition bound to this action must have, checked when the net is bound
+    #: (exit 2, ``file:line``) instead of failing when it fires: ``"agent"`` (the
+    #: transition is in an agent subnet), ``"robot"`` (a ``robot`` parameter, or an agent
+    #: subnet whose agent is the robot), ``"world"`` (the run has a world). Override
+    #: :meth:`requirements` when they depend on the parameters.
+    requires: ClassVar[frozenset[str]] = frozenset()
+
+    @classmethod
+    def requirements(cls, params: dict[str, Any]) -> frozenset[str]:
+        """What a transition with these (checked) ``params`` needs (see :attr:`requires`)."""
+        return cls.requires
 
     def __init__(self, params: dict[str, Any] | None = None) -> None:
         self.params = dict(params or {})  # type: ignore[misc]

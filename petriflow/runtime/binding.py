@@ -50,7 +50,7 @@ from petriflow.net import Net
 from petriflow.runtime.action import Action, Port
 from petriflow.runtime.registry import Predicate, Registry, UnknownActionError, default_registry
 
-__all__ = ["Binding", "BoundTransition", "bind", "check_sizes"]
+__all__ = ["Binding", "BoundTransition", "Unchecked", "bind", "check_sizes", "check_world"]
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,24 @@ class BoundTransition:
 
 
 @dataclass(frozen=True)
+class Unchecked:
+    """A name a static command could not check: only an action module named in the run
+    configuration, which looking at a net never imports, could provide it.
+
+    Attributes:
+        transition: the transition naming it.
+        kind: ``action`` or ``guard``.
+        name: the action or guard name.
+        line: where the net names it.
+    """
+
+    transition: str
+    kind: str
+    name: str
+    line: int | None
+
+
+@dataclass(frozen=True)
 class Binding:
     """A net whose transitions are all resolved: what a run needs before it starts.
 
@@ -86,6 +104,7 @@ class Binding:
     net: Net
     registry: Registry
     transitions: dict[str, BoundTransition]
+    unchecked: tuple["Unchecked", ...] = ()
 
     def actions(self) -> dict[str, type[Action]]:
         """``{transition id: Action class}`` of the bound transitions."""
@@ -122,13 +141,18 @@ def check_sizes(net: Net, path: str | None = None) -> None:
                                  path=path, line=_line(net, transition), element=transition)
 
 
-def bind(net: Net, registry: Registry | None = None, *, path: str | None = None) -> Binding:
+def bind(net: Net, registry: Registry | None = None, *, path: str | None = None,
+         unimported: bool = False) -> Binding:
     """Resolve every transition of ``net`` against ``registry`` (default: the run registry).
 
     Args:
         net: the net, as loaded (its ``lines`` give error lines).
         registry: where action and guard names are looked up.
         path: the file named in errors (default: the file the net was read from).
+        unimported: action modules the net's run configuration names were not imported
+            (a static command): an action or guard name nothing registered is recorded
+            in :attr:`Binding.unchecked` instead of failing, since one of those modules
+            may provide it.
 
     Raises:
         NetFormatError: ``file:line: 'transition': ...`` for an unknown action or guard,
@@ -136,6 +160,7 @@ def bind(net: Net, registry: Registry | None = None, *, path: str | None = None)
     """
     registry = registry or default_registry
     path = path or net.path
+    unchecked: list[Unchecked] = []
     bound: dict[str, BoundTransition] = {}
     resolved: dict[str, type[Action]] = {}
     guards: dict[str, Predicate] = {}
@@ -150,7 +175,11 @@ def bind(net: Net, registry: Registry | None = None, *, path: str | None = None)
                 try:
                     cache[name] = find(name)
                 except UnknownActionError as exc:
-                    raise fail(str(exc), f"{tid}/{key}") from None
+                    if not unimported:
+                        raise fail(str(exc), f"{tid}/{key}") from None
+                    cache[name] = None
+            if cache[name] is None:
+                unchecked.append(Unchecked(tid, key, name, _line(net, f"{tid}/{key}", tid)))
             return cache[name]
 
         guard = None if transition.guard is None else lookup(guards, transition.guard, registry.guard, "guard")
@@ -158,6 +187,9 @@ def bind(net: Net, registry: Registry | None = None, *, path: str | None = None)
             bound[tid] = BoundTransition(tid, None, dict(transition.params), guard)
             continue
         cls = lookup(resolved, transition.action, registry.resolve, "action")
+        if cls is None:  # not checked: its module was not imported
+            bound[tid] = BoundTransition(tid, None, dict(transition.params), guard)
+            continue
         try:
             params = cls.check_params(transition.params, tid)
         except NetFormatError as exc:
@@ -172,5 +204,36 @@ def bind(net: Net, registry: Registry | None = None, *, path: str | None = None)
                 raise fail(f"port {name!r} names unknown place {place!r}{did_you_mean(place, net.places)}",
                            f"{tid}/params/{name}", f"{tid}/params")
             ports[name] = place
+        needs = cls.requirements(params)
+        agent = _agent_of(net, tid)
+        if "agent" in needs and agent is None:
+            raise fail(f"action {transition.action} runs as an agent: put the transition in an agent subnet",
+                       f"{tid}/action")
+        if "robot" in needs and params.get("robot") is None and agent is None:
+            raise fail(f"action {transition.action} moves a robot: give params.robot or put the transition in"
+                       " an agent subnet", f"{tid}/action")
         bound[tid] = BoundTransition(tid, cls, params, guard, ports)
-    return Binding(net, registry, bound)
+    return Binding(net, registry, bound, tuple(unchecked))
+
+
+def _agent_of(net: Net, tid: str) -> str | None:
+    subnet = net.transitions[tid].subnet
+    if subnet is None:
+        return None
+    return net.subnets[subnet].agent or subnet
+
+
+def check_world(binding: Binding, has_world: bool, path: str | None = None) -> None:
+    """Refuse a run without a world when a bound action needs one.
+
+    Raises:
+        NetFormatError: ``file:line: 'transition': action X needs a world ...``.
+    """
+    if has_world:
+        return
+    net = binding.net
+    for tid, bound in binding.transitions.items():
+        if bound.action is not None and "world" in bound.action.requirements(bound.params):
+            raise NetFormatError(f"action {net.transitions[tid].action} needs a world: run with --world or name"
+                                 " one in the run configuration (world: FILE)", path=path or net.path,
+                                 line=_line(net, f"{tid}/action", tid), element=tid)

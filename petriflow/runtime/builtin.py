@@ -29,7 +29,7 @@ class Wait(Action):
     time comes.
     """
 
-    params: ClassVar[dict[str, Param]] = {"seconds": Param(float, 1.0, "simulated seconds to wait")}
+    params: ClassVar[dict[str, Param]] = {"seconds": Param(float, 1.0, "simulated seconds to wait", low=0)}
     needs_world = False
 
     @classmethod
@@ -77,8 +77,8 @@ def register(registry) -> None:
     registry.action(
         "core.fail",
         {
-            "seconds": Param(float, 0.0, "simulated seconds before the outcome"),
-            "probability": Param(float, 1.0, "chance of failing"),
+            "seconds": Param(float, 0.0, "simulated seconds before the outcome", low=0),
+            "probability": Param(float, 1.0, "chance of failing", low=0, high=1),
             "reason": Param(str, "injected failure", "failure message"),
         },
     )(fail)

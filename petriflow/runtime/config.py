@@ -49,8 +49,16 @@ PATH_VARIABLE = "PETRIFLOW_PATH"
 
 
 def _finite(value: Any, low: float = 0.0, low_open: bool = False) -> bool:
-    return (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
-            and (value > low if low_open else value >= low))
+    """A number of seconds from ``low`` to :data:`petriflow.limits.MAX_SECONDS`."""
+    from petriflow import limits
+
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        value = float(value)
+    except OverflowError:  # an integer of hundreds of digits
+        return False
+    return math.isfinite(value) and value <= limits.MAX_SECONDS and (value > low if low_open else value >= low)
 
 
 def allowed_folders(folder: Path | None) -> list[Path]:
@@ -168,13 +176,13 @@ class RunConfig:
             fail(f"seed must be a whole number, got {seed!r}", key="seed")
         until = data.get("until")
         if until is not None and not _finite(until):
-            fail(f"until must be a finite number of seconds >= 0, got {until!r}", key="until")
+            fail(f"until must be a number of seconds from 0 to 1e12, got {until!r}", key="until")
         dt = data.get("dt", 0.01)
         if not _finite(dt, 1e-6) or dt > 3600:
             fail(f"dt must be a number of seconds from 0.000001 to 3600, got {dt!r}", key="dt")
         stall = data.get("stall", DEFAULT_STALL)
         if stall is not None and not _finite(stall, 0.0, low_open=True):
-            fail(f"stall must be a finite number of seconds > 0, or null (never), got {stall!r}", key="stall")
+            fail(f"stall must be a number of seconds > 0 and at most 1e12, or null (never), got {stall!r}", key="stall")
         channels = data.get("channels") or {}
         if not isinstance(channels, dict) or not all(isinstance(v, dict) for v in channels.values()):
             fail("channels must map a channel name to its model, e.g. {radio: {model: range}}", key="channels")
@@ -185,6 +193,7 @@ class RunConfig:
                   for entry in entries]
         lines = {f"faults/{i}": getattr(entry, "line", None) for i, entry in enumerate(entries)}
         lines.update({f"channels/{name}": getattr(channels, "key_lines", {}).get(name) for name in channels})
+        lines["actions"] = getattr(data, "key_lines", {}).get("actions")
         lines = {key: at or getattr(data, "key_lines", {}).get(key.split("/")[0]) or line
                  for key, at in lines.items()}
         world = data.get("world")
@@ -232,6 +241,11 @@ class RunConfig:
                 raise NetFormatError(f"cannot import action module {entry!r}: {type(exc).__name__}: {exc}",
                                      path=self.path, element="actions") from None
 
+    def unimported_actions(self) -> list[str]:
+        """The modules of :attr:`actions` not imported in this process (their actions are
+        not registered: a command that does not import user code cannot check them)."""
+        return [entry for entry in self.actions if not _imported(entry)]
+
     @staticmethod
     def _fault(entry: Any, fail) -> Fault:
         if not isinstance(entry, dict):
@@ -244,14 +258,14 @@ class RunConfig:
         kind = kinds[0]
         at = entry.get("at")
         if not _finite(at):
-            fail(f"fault {kind}: 'at' must be a finite time in seconds >= 0, got {at!r}")
+            fail(f"fault {kind}: 'at' must be a time in seconds from 0 to 1e12, got {at!r}")
         until = entry.get("until")
         if kind == "drop_link":
             link = entry[kind]
             if not (isinstance(link, list) and len(link) == 2 and all(isinstance(a, str) for a in link)):
                 fail(f"drop_link takes two agent names, got {link!r}")
             if until is not None and (not _finite(until) or until < at):
-                fail(f"drop_link: 'until' must be a finite time >= 'at', got {until!r}")
+                fail(f"drop_link: 'until' must be a time >= 'at' and at most 1e12, got {until!r}")
             return Fault(kind, float(at), None, tuple(link), None if until is None else float(until))
         if until is not None:
             fail(f"fault {kind}: 'until' only applies to drop_link")
@@ -311,6 +325,19 @@ def _locate_module(entry: str, folder: Path | None) -> str:
         if (folder / entry / "__init__.py").is_file():
             return str((folder / entry).resolve())
     return entry
+
+
+def _imported(entry: str) -> bool:
+    """Whether the action module ``entry`` (as :func:`_locate_module` stores it) is imported."""
+    path = Path(entry)
+    if entry.endswith(".py") or path.is_absolute():
+        name = path.stem if entry.endswith(".py") else path.name
+        loaded = sys.modules.get(name)
+        if loaded is None:
+            return False
+        where = Path(getattr(loaded, "__file__", "") or "").resolve()
+        return where in (path.resolve(), (path / "__init__.py").resolve())
+    return entry in sys.modules
 
 
 def _import_module(entry: str) -> None:

@@ -631,7 +631,7 @@ class Scheduler:
             How the run ended; an action that failed with no failure route ends it
             with reason ``failed`` (recorded in the trace first).
         """
-        until = self.config.until if until is None else until
+        until = self.config.until if until is None else limits.check_seconds(until, "until")
         kernel = self.kernel
         limit = None if until is None else kernel.ticks_at(until)
         stall = None if self.config.stall is None else kernel.ticks_at(self.config.stall)

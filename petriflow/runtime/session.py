@@ -41,7 +41,7 @@ from typing import Any, TextIO
 
 from petriflow.errors import NetFormatError
 from petriflow.net import Net
-from petriflow.runtime.binding import Binding, bind, check_sizes
+from petriflow.runtime.binding import Binding, bind, check_sizes, check_world
 from petriflow.runtime.config import RunConfig, load_config
 from petriflow.runtime.journal import Journal, JournalError
 from petriflow.runtime.registry import Registry
@@ -136,13 +136,13 @@ class Progress:
 
 
 def _read_text(path: Path) -> str:
-    try:
-        return path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise NetFormatError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(path)) from None
+    from petriflow.io.files import read_text_file
+
+    return read_text_file(path)
 
 
 def _net_from_text(text: str, path: str) -> Net:
+    text = text.removeprefix("\ufeff")
     if text.lstrip().startswith("<"):
         from petriflow.io.pnml import loads_pnml
 
@@ -167,9 +167,17 @@ def net_config(net: Net, path: Path) -> RunConfig | None:
 
 
 def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = None,
-            world: str | Path | None = None, registry: Registry | None = None) -> Prepared:
+            world: str | Path | None = None, registry: Registry | None = None,
+            import_actions: bool = True) -> Prepared:
     """Read the net in ``net_path`` once, resolve its run configuration, import the
     configuration's action modules and bind the net.
+
+    Args:
+        import_actions: import the action modules the run configuration names (user
+            code: what running does). ``False`` is how the commands that only look at a
+            net bind it: installed plugins are checked as always; a name only a module
+            not imported could provide lands in ``binding.unchecked`` (see
+            docs/security.md).
 
     Raises:
         NetFormatError: a file is missing or malformed, an action, parameter or guard
@@ -189,8 +197,10 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
         if run_config is None and (net_path.parent / "run.yaml").is_file():
             run_config = load_config(net_path.parent / "run.yaml")
         run_config = run_config or RunConfig()
-    run_config.import_actions()
-    binding = bind(net, registry, path=str(net_path))
+    if import_actions:
+        run_config.import_actions()
+    pending = [] if import_actions else run_config.unimported_actions()
+    binding = bind(net, registry, path=str(net_path), unimported=bool(pending))
     run_config.check(net)
     world_path = Path(world) if world is not None else (Path(run_config.world) if run_config.world else None)
     return Prepared(net, text, run_config, binding, world_path)
@@ -246,7 +256,7 @@ def _check_outputs(outputs: dict[str, str | Path | None], read: list[Path | str 
         if where in seen:
             raise NetFormatError(f"{option} and {seen[where]} name the same file", path=str(path))
         if where in inputs:
-            raise NetFormatError(f"{option} would overwrite an input of the run", path=str(path))
+            raise NetFormatError(f"{option} would overwrite one of the inputs", path=str(path))
         if where.is_dir():
             raise NetFormatError(f"{option} names a folder, not a file", path=str(path))
         seen[where] = option
@@ -375,6 +385,7 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     """
     net_path = Path(net_path)
     prepared = prepare(net_path, config=config, world=world, registry=registry)
+    check_world(prepared.binding, prepared.world is not None, str(net_path))
     inputs = _inputs(prepared, net_path, seed, until)
     inputs["max_firings"] = max_firings
     inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())

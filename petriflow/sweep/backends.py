@@ -46,10 +46,19 @@ def _failed(status: str, error: str, wall: float) -> dict[str, Any]:
     return {"status": status, "metrics": {}, "outcome": None, "error": error, "wall": wall}
 
 
-def _serve(connection: Connection) -> None:
-    """A worker: run each payload received, send its result back, until ``None``."""
-    from petriflow.sweep.trial import run_trial
+#: What a worker sends once its imports are done, before it takes its first trial.
+_READY = "ready"
+#: Seconds a new worker process may take to import petriflow and say it is ready.
+START_TIMEOUT = 300.0
 
+
+def _serve(connection: Connection) -> None:
+    """A worker: import what trials need, say so, then run each payload received and
+    send its result back, until ``None``."""
+    from petriflow.sweep.trial import run_trial
+    import petriflow.runtime.session  # noqa: F401  (imported before the clock of the first trial starts)
+
+    connection.send(_READY)
     while True:
         try:
             payload = connection.recv()
@@ -61,17 +70,27 @@ def _serve(connection: Connection) -> None:
 
 
 class _Worker:
+    """One worker process: starting (not yet ready), idle, or running ``job`` since
+    ``started`` (the moment the payload went to a worker that was ready for it, so a
+    trial's timeout measures the trial, never the queue or the worker's start-up)."""
+
     def __init__(self, context: Any) -> None:
         self.connection, child = context.Pipe()
         self.process = context.Process(target=_serve, args=(child,), daemon=True)
         self.process.start()
         child.close()
+        self.ready = False
         self.job: int | None = None
-        self.started = 0.0
+        self.started = wallclock.perf_counter()
 
-    def give(self, index: int, payload: dict[str, Any]) -> None:
+    def give(self, index: int, payload: dict[str, Any]) -> bool:
+        """Send a trial; ``False`` when the worker is gone (the trial was not given)."""
+        try:
+            self.connection.send(payload)
+        except OSError:
+            return False
         self.job, self.started = index, wallclock.perf_counter()
-        self.connection.send(payload)
+        return True
 
     def kill(self) -> None:
         self.process.kill()
@@ -89,57 +108,100 @@ class _Worker:
         self.connection.close()
 
 
-def run_local(payloads: list[dict[str, Any]], workers: int, timeout: float) -> Iterator[tuple[int, dict[str, Any]]]:
-    """Run ``payloads`` on ``workers`` local processes; yields ``(index, result)``."""
-    if not payloads:
-        return
-    context = multiprocessing.get_context("spawn")
-    pending = deque(range(len(payloads)))
-    pool = [_Worker(context) for _ in range(min(workers, len(payloads)))]
-    try:
-        while pending or any(w.job is not None for w in pool):
-            for worker in pool:
-                if worker.job is None and pending:
-                    index = pending.popleft()
-                    worker.give(index, payloads[index])
-            busy = [w for w in pool if w.job is not None]
-            now = wallclock.perf_counter()
-            soonest = min(w.started + timeout for w in busy)
-            waiting = {w.connection: w for w in busy}
-            waiting.update({w.process.sentinel: w for w in busy})
-            ready = wait(list(waiting), timeout=max(0.0, soonest - now))
-            finished: list[_Worker] = []
-            for handle in ready:
-                worker = waiting[handle]
-                if worker in finished:
-                    continue
-                finished.append(worker)
-                index, wall = worker.job, wallclock.perf_counter() - worker.started
-                try:
-                    result = worker.connection.recv() if worker.connection.poll() else None
-                except (EOFError, OSError):
-                    result = None
-                worker.job = None
-                if result is None:
-                    worker.process.join(2)  # the pipe closes a moment before the process is gone
-                    code = worker.process.exitcode
-                    worker.kill()
-                    pool[pool.index(worker)] = _Worker(context)
-                    result = _failed("crashed", f"the worker process died (exit code {code})", wall)
-                yield index, result
-            now = wallclock.perf_counter()
-            for position, worker in enumerate(pool):
-                if worker.job is not None and now - worker.started >= timeout:
-                    index = worker.job
-                    worker.kill()
-                    pool[position] = _Worker(context)
-                    yield index, _failed("timeout", f"ran past the sweep's timeout of {timeout:g} s", now - worker.started)
-    finally:
-        for worker in pool:
-            if worker.job is None:
+class _Pool:
+    """Worker processes that are replaced when they die or time out."""
+
+    def __init__(self, size: int) -> None:
+        self.context = multiprocessing.get_context("spawn")
+        self.workers = [_Worker(self.context) for _ in range(size)]
+        self.failed_starts = 0
+
+    def replace(self, worker: _Worker) -> None:
+        worker.kill()
+        self.workers[self.workers.index(worker)] = _Worker(self.context)
+
+    def started_badly(self, worker: _Worker, why: str) -> None:
+        """A worker died or hung before it was ready: replace it, unless no worker starts."""
+        self.failed_starts += 1
+        code = worker.process.exitcode
+        self.replace(worker)
+        if self.failed_starts >= 2 * len(self.workers) + 1:
+            raise BackendError(f"local sweep workers cannot start: {why}"
+                               + (f" (exit code {code})" if code is not None else ""))
+
+    def close(self) -> None:
+        for worker in self.workers:
+            if worker.job is None and worker.ready:
                 worker.stop()
             else:
                 worker.kill()
+
+
+def run_local(payloads: list[dict[str, Any]], workers: int, timeout: float) -> Iterator[tuple[int, dict[str, Any]]]:
+    """Run ``payloads`` on ``workers`` local processes; yields ``(index, result)``.
+
+    A trial's ``timeout`` counts from the moment it goes to a worker that has finished
+    starting, so neither waiting in the queue nor a worker's imports count against it.
+
+    Raises:
+        BackendError: worker processes die or hang before they are ready, again and
+            again (nothing a trial did).
+    """
+    if not payloads:
+        return
+    pending = deque(range(len(payloads)))
+    pool = _Pool(min(workers, len(payloads)))
+    try:
+        while pending or any(w.job is not None for w in pool.workers):
+            for worker in list(pool.workers):
+                if worker.ready and worker.job is None and pending:
+                    index = pending.popleft()
+                    if not worker.give(index, payloads[index]):
+                        pending.appendleft(index)
+                        pool.started_badly(worker, "a worker exited before its first trial")
+            busy = [w for w in pool.workers if w.job is not None]
+            starting = [w for w in pool.workers if not w.ready]
+            deadlines = [w.started + timeout for w in busy] + [w.started + START_TIMEOUT for w in starting]
+            waiting = {w.connection: w for w in busy + starting}
+            waiting.update({w.process.sentinel: w for w in busy + starting})
+            if not waiting:
+                continue
+            ready = wait(list(waiting), timeout=max(0.0, min(deadlines) - wallclock.perf_counter()))
+            handled: list[_Worker] = []
+            for handle in ready:
+                worker = waiting[handle]
+                if worker in handled:
+                    continue
+                handled.append(worker)
+                try:
+                    message = worker.connection.recv() if worker.connection.poll() else None
+                except (EOFError, OSError):
+                    message = None
+                if not worker.ready:
+                    if message == _READY:
+                        worker.ready = True
+                        pool.failed_starts = 0
+                    else:
+                        pool.started_badly(worker, "a worker exited while importing petriflow")
+                    continue
+                index, wall = worker.job, wallclock.perf_counter() - worker.started
+                worker.job = None
+                if message is None:
+                    worker.process.join(2)  # the pipe closes a moment before the process is gone
+                    code = worker.process.exitcode
+                    pool.replace(worker)
+                    message = _failed("crashed", f"the worker process died (exit code {code})", wall)
+                yield index, message
+            now = wallclock.perf_counter()
+            for worker in list(pool.workers):
+                if worker.job is not None and now - worker.started >= timeout:
+                    index = worker.job
+                    pool.replace(worker)
+                    yield index, _failed("timeout", f"ran past the sweep's timeout of {timeout:g} s", now - worker.started)
+                elif not worker.ready and now - worker.started >= START_TIMEOUT:
+                    pool.started_badly(worker, f"a worker did not start within {START_TIMEOUT:g} s")
+    finally:
+        pool.close()
 
 
 def _ray_trial(payload: dict[str, Any]) -> dict[str, Any]:

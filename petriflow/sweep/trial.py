@@ -186,7 +186,7 @@ def build(spec: dict[str, Any], params: dict[str, Any], seed: int) -> Built:
         NetFormatError: a file is malformed or an action does not bind (``file:line``).
         TrialError: a set target names nothing, a metric is unknown.
     """
-    from petriflow.runtime.binding import bind, check_sizes
+    from petriflow.runtime.binding import bind, check_sizes, check_world
     from petriflow.runtime.registry import UnknownActionError, default_registry
 
     values = dict(params, seed=seed)
@@ -200,6 +200,7 @@ def build(spec: dict[str, Any], params: dict[str, Any], seed: int) -> Built:
     binding = bind(net, default_registry, path=str(net_path))
     config.check(net)
     check_sizes(net, str(net_path))
+    check_world(binding, config.world is not None, str(net_path))
     metrics = []
     for name, metric, args in spec["metrics"]:
         try:

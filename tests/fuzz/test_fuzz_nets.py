@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import re
 
-from hypothesis import given
+from hypothesis import event, given
 from hypothesis import strategies as st
 
 from petriflow.errors import PetriflowError
 from petriflow.io.pnml import dumps_pnml, loads_pnml
-from petriflow.io.yaml import loads_net
+from petriflow.io.yaml import dumps_net, loads_net
 from tests.conftest import NETS, ORACLE, SEQUENCE_YAML
 from tests.fuzz.contract import HOSTILE_VALUES, assert_contract, mutate_yaml
 
@@ -77,25 +77,58 @@ def mutated_pnml(draw: st.DrawFn) -> bytes:
     return text.encode("utf-8")
 
 
-def _loads_or_refuses(read, data) -> None:
+def _loads_and_round_trips_or_refuses(read, data, path: str) -> str:
+    """Read ``data``: a net that loads survives load -> dump -> load in both formats
+    (YAML and PNML give the same net); a refusal is one line naming the file. Returns
+    which happened."""
     try:
-        read(data)
-    except PetriflowError:
-        pass
+        net = read(data)
+    except PetriflowError as exc:
+        message = str(exc)
+        assert "\n" not in message.strip() and message.startswith(path), message
+        return "refused"
+    import warnings
+
+    assert loads_net(dumps_net(net)).structure() == net.structure()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a net's own PNML holds nothing petriflow cannot represent
+        again = loads_pnml(dumps_pnml(net))
+    assert again.structure() == net.structure()
+    assert loads_net(dumps_net(again)).structure() == net.structure()
+    return "loaded"
 
 
 @given(mutated_yaml())
-def test_yaml_reader_loads_or_refuses(data):
-    _loads_or_refuses(lambda d: loads_net(d.decode("utf-8", "replace"), path="fuzz.yaml"), data)
+def test_yaml_reader_round_trips_or_refuses(data):
+    outcome = _loads_and_round_trips_or_refuses(
+        lambda d: loads_net(d.decode("utf-8", "replace"), path="fuzz.yaml"), data, "fuzz.yaml")
+    event(outcome)
 
 
 @given(mutated_pnml())
-def test_pnml_reader_loads_or_refuses(data):
+def test_pnml_reader_round_trips_or_refuses(data):
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        _loads_or_refuses(lambda d: loads_pnml(d, path="fuzz.pnml"), data)
+        outcome = _loads_and_round_trips_or_refuses(lambda d: loads_pnml(d, path="fuzz.pnml"), data, "fuzz.pnml")
+    event(outcome)
+
+
+def test_the_fuzzers_reach_both_outcomes():
+    """The mutations are neither all harmless nor all fatal: each reader both loads and
+    refuses some of them (otherwise the round-trip assertions would test nothing)."""
+    from hypothesis import find
+
+    for strategy, read, path in ((mutated_yaml(), lambda d: loads_net(d.decode("utf-8", "replace"),
+                                                                         path="fuzz.yaml"), "fuzz.yaml"),
+                                 (mutated_pnml(), lambda d: loads_pnml(d, path="fuzz.pnml"), "fuzz.pnml")):
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for wanted in ("loaded", "refused"):
+                find(strategy, lambda d, w=wanted: _loads_and_round_trips_or_refuses(read, d, path) == w)
 
 
 @given(mutated_yaml())

@@ -762,3 +762,25 @@ def test_a_reference_node_on_the_arcs_page_joins_pages():
         </net></pnml>""")
     assert net.preset("t") == {"p": 1}
     assert warned == ["net.pnml: net 'n': pages 'one', 'two' flattened into one page (every node kept)"]
+
+
+@pytest.mark.parametrize("name", ["windows_bom.pnml", "windows_utf16.pnml"])
+def test_byte_order_marks_and_utf16_read_as_the_same_net(name, tmp_path):
+    """XML allows a UTF-8 byte-order mark and UTF-16 (Windows tools write both): the
+    net is the one its UTF-8 original holds, from the file, from bytes, and by the
+    reader that sniffs the format (no .pnml ending)."""
+    expected = load_pnml(DATA / "snakes_pt.pnml").structure()
+    assert load_pnml(DATA / name).structure() == expected
+    assert loads_pnml((DATA / name).read_bytes()).structure() == expected
+    unnamed = tmp_path / "net.txt"
+    unnamed.write_bytes((DATA / name).read_bytes())
+    assert load_net(unnamed).structure() == expected
+
+
+def test_utf16_without_a_mark_and_undecodable_bytes(tmp_path):
+    text = (DATA / "snakes_pt.pnml").read_text().replace('encoding="utf-8"', 'encoding="UTF-16LE"')
+    (tmp_path / "le.pnml").write_bytes(text.encode("utf-16-le"))
+    assert load_net(tmp_path / "le.pnml").structure() == load_pnml(DATA / "snakes_pt.pnml").structure()
+    (tmp_path / "bad.pnml").write_bytes(b"<?xml version='1.0'?><pnml>\xff\xfe\xfa</pnml>")
+    with pytest.raises(NetFormatError, match=r"bad.pnml: cannot read: not utf-8 text"):
+        load_net(tmp_path / "bad.pnml")

@@ -148,3 +148,14 @@ def test_example_nets_round_trip(tmp_path):
     for path in (p for p in net_files() if p.suffix == ".yaml"):
         net = load_yaml(path)
         assert loads_net(dumps_net(net)).structure() == net.structure(), path
+
+
+@pytest.mark.parametrize("encoding", ["utf-8-sig", "utf-16", "utf-16-le", "utf-32"])
+def test_yaml_nets_in_any_encoding_yaml_allows(tmp_path, encoding):
+    """YAML allows UTF-8 with a mark, UTF-16 and UTF-32: the same net every time."""
+    from petriflow.io import load_net
+
+    text = "petriflow: 1\nplaces: [{id: p, tokens: 1}, q]\ntransitions: [{id: t, in: [p], out: [q]}]\n"
+    path = tmp_path / "net.yaml"
+    path.write_bytes(text.encode(encoding))
+    assert load_net(path).structure() == loads_net(text).structure()

@@ -104,7 +104,7 @@ def test_a_run_configuration_imports_the_users_action_module(tmp_path, capsys):
 
 def test_an_action_module_that_does_not_import_is_one_line(tmp_path, capsys):
     net = write(tmp_path, "cell.yaml", USER_NET.replace("my_actions", "no_such_module"))
-    assert main(["info", str(net)]) == 2
+    assert main(["info", str(net), "--import-actions"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"petriflow: {net}: 'actions': cannot import action module 'no_such_module'")
     assert "ModuleNotFoundError" in err and len(err.splitlines()) == 1

@@ -93,6 +93,7 @@ def test_a_failed_central_unit_leaves_partial_maps():
     assert metrics["maps_complete"] < 1.0
 
 
+@pytest.mark.slow
 def test_a_late_monitor_relays_to_the_broken_down_robot():
     metrics, params = trial_metrics("table9", 0)
     assert params["monitor"] is True
