@@ -249,7 +249,12 @@ class _Reader:
         if sid in self.net.subnets:
             self.fail("duplicate subnet id", item, sid)
         fail = (lambda m: self.fail(m, item, sid))
-        self.net.add_subnet(sid, _text(item.get("label"), "label", fail), _text(item.get("agent"), "agent", fail))
+        try:
+            self.net.add_subnet(sid, _text(item.get("label"), "label", fail), _text(item.get("agent"), "agent", fail))
+        except NetFormatError:
+            raise
+        except PetriflowError as exc:
+            self.fail(str(exc), item, sid)
         places = self.as_list(item.get("places"), "places", item)
         for place in places:
             self.read_place(place, sid, _line(places))
@@ -271,8 +276,13 @@ class _Reader:
         if channel is not None and not isinstance(channel, str):
             self.fail("'channel' must be a channel name (a string)", item, pid)
         fail = (lambda m: self.fail(m, item, pid))
-        self.net.add_place(pid, tokens=tokens, label=_text(item.get("label"), "label", fail), subnet=subnet,
-                           meta=_meta(item.get("meta"), fail), channel=channel)
+        try:
+            self.net.add_place(pid, tokens=tokens, label=_text(item.get("label"), "label", fail), subnet=subnet,
+                               meta=_meta(item.get("meta"), fail), channel=channel)
+        except NetFormatError:
+            raise
+        except PetriflowError as exc:
+            self.fail(str(exc), item, pid)
         self.net.lines[pid] = item.line
 
     def read_branches(self, value: Any, item: Any, tid: str, key: str) -> dict[str, int]:
@@ -451,6 +461,8 @@ class _Reader:
         ``'1'``). Anything else YAML reads as another type (``yes``, ``null``, ``1.50``,
         a date) is refused, since the text would not be what the file says."""
         if isinstance(value, str):
+            if not value.strip():
+                self.fail(f"{what} must be non-empty text, got {value!r}", item, line=line)
             return value
         if isinstance(value, int) and not isinstance(value, bool):
             return str(value)

@@ -242,4 +242,4 @@ def register(registry: Any) -> None:
         ("core.messages_per_agent", messages_per_agent, True),
         ("core.wall_s", wall_s, False),
     ):
-        registry.register_metric(name, function, events=events)
+        registry.register_metric(name, function, events=events, wall_clock=name == "core.wall_s")

@@ -88,12 +88,15 @@ class MetricSpec:
         target: ``f(record, **params)``, or a lazy ``"module:function"`` string.
         events: whether it reads the run's events (the run then keeps them in memory).
         doc: one line of documentation.
+        wall_clock: it measures wall-clock time (or anything else outside the simulation),
+            so it differs between runs of the same trial; reports mark it.
     """
 
     name: str
     target: Callable[..., Any] | str
     events: bool = False
     doc: str = ""
+    wall_clock: bool = False
 
     def load(self) -> Callable[..., Any]:
         """The metric function, importing a lazy target once."""
@@ -162,13 +165,14 @@ class Registry:
         return decorate
 
     def register_metric(self, name: str, target: Callable[..., Any] | str, *, events: bool = False,
-                        doc: str = "", replace: bool = False) -> None:
-        """Register a metric ``f(record, **params)`` (or a lazy ``"module:function"``)."""
+                        doc: str = "", replace: bool = False, wall_clock: bool = False) -> None:
+        """Register a metric ``f(record, **params)`` (or a lazy ``"module:function"``);
+        ``wall_clock``: it is not reproducible between runs (see :class:`MetricSpec`)."""
         if name in self._metrics and not replace:
             raise PetriflowError(f"metric {name!r} is already registered")
         if not doc and not isinstance(target, str) and target.__doc__:
             doc = target.__doc__.strip().splitlines()[0]
-        self._metrics[name] = MetricSpec(name, target, events, doc)
+        self._metrics[name] = MetricSpec(name, target, events, doc, wall_clock)
 
     def register_channel(self, name: str, target: type | str, *, replace: bool = False) -> None:
         """Register a channel model class (a :class:`~petriflow.runtime.channels.ChannelModel`

@@ -69,7 +69,21 @@ class SweepResult:
 
     def to_json(self) -> dict[str, Any]:
         """``{"spec": PATH, "rows": [...]}`` (the rows of :func:`~petriflow.sweep.report.summary`)."""
-        return {"spec": self.sweep.path, "rows": self.rows}
+        return {"spec": self.sweep.path, "rows": self.rows, "wall_clock": self.wall_clock()}
+
+    def wall_clock(self) -> list[str]:
+        """The reported metrics that measure wall-clock time: not reproducible between
+        runs of the same trial, unlike every other metric."""
+        from petriflow.runtime.registry import default_registry
+
+        names = []
+        for ref in self.sweep.metrics:
+            try:
+                if default_registry.metric_spec(ref.metric).wall_clock:
+                    names.append(ref.name)
+            except PetriflowError:
+                pass
+        return names
 
 
 def _progress(total: int, enabled: bool) -> Any:

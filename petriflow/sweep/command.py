@@ -71,6 +71,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         print(f"{title}: {len(result.trials)} trials in {len(result.rows)} rows"
               f" ({result.ran} run now in {result.wall:.1f} s wall, {len(result.failures)} failed)")
         print(text_table(result.rows, result.names, parameters))
+        if result.wall_clock():
+            print(f"  wall-clock (not reproducible between runs, unlike the other metrics):"
+                  f" {', '.join(result.wall_clock())}")
         for failure in result.failures[:5]:
             print(f"  failed: row {failure['row'] + 1} seed {failure['seed']}: {failure['status']}:"
                   f" {failure['error']}")
