@@ -463,6 +463,8 @@ class _Reader:
         if isinstance(value, str):
             if not value.strip():
                 self.fail(f"{what} must be non-empty text, got {value!r}", item, line=line)
+            if not value.isprintable():
+                self.fail(f"{what} must be printable text (no control characters), got {value!r}", item, line=line)
             return value
         if isinstance(value, int) and not isinstance(value, bool):
             return str(value)

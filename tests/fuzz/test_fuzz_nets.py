@@ -92,7 +92,12 @@ def _loads_and_round_trips_or_refuses(read, data, path: str) -> str:
     assert loads_net(dumps_net(net)).structure() == net.structure()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a net's own PNML holds nothing petriflow cannot represent
-        again = loads_pnml(dumps_pnml(net))
+        try:
+            written = dumps_pnml(net)
+        except PetriflowError as exc:  # text XML cannot hold (a control character in a label)
+            assert "characters XML cannot represent" in str(exc), str(exc)
+            return "loaded"
+        again = loads_pnml(written)
     assert again.structure() == net.structure()
     assert loads_net(dumps_net(again)).structure() == net.structure()
     return "loaded"
