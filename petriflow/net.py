@@ -137,11 +137,15 @@ class Subnet:
         id: unique id among subnets.
         label: readable title (drawn on the cluster).
         agent: the agent that runs this subnet (defaults to the id).
+        state: the registered type of the agent's state (``bidding.robot``), or
+            ``None``: the actions bound in the subnet that read an agent state must
+            expect this type (checked when the net is bound).
     """
 
     id: str
     label: str | None = None
     agent: str | None = None
+    state: str | None = None
 
 
 class Net:
@@ -197,11 +201,17 @@ class Net:
                 f"{node_id!r}: unknown subnet {subnet!r}{did_you_mean(subnet, self.subnets)}"
             )
 
-    def add_subnet(self, id: str, label: str | None = None, agent: str | None = None) -> Subnet:
+    def add_subnet(self, id: str, label: str | None = None, agent: str | None = None,
+                   state: str | None = None) -> Subnet:
         """Add an agent subnet; nodes join it through their ``subnet`` attribute."""
+        if not isinstance(id, str) or not id.strip():
+            raise NetStructureError(f"subnet id must be non-empty text, got {id!r}")
         if id in self.subnets:
             raise NetStructureError(f"duplicate subnet id {id!r}")
-        subnet = Subnet(id, label, agent)
+        for what, value in (("agent", agent), ("state", state)):
+            if value is not None and (not isinstance(value, str) or not value.strip()):
+                raise NetStructureError(f"subnet {id!r}: {what} must be non-empty text, got {value!r}")
+        subnet = Subnet(id, label, agent, state)
         self.subnets[id] = subnet
         return subnet
 
@@ -459,7 +469,7 @@ class Net:
                 )
             ),
             tuple(sorted((a.source, a.target, a.weight, a.outcome or "") for a in self._arcs.values())),
-            tuple(sorted((s.id, s.label, s.agent) for s in self.subnets.values())),
+            tuple(sorted((s.id, s.label, s.agent, s.state or "") for s in self.subnets.values())),
             tuple(self.initial_marking.items()),
             None if self.final_marking is None else tuple(self.final_marking.items()),
             repr(self.run),

@@ -413,9 +413,9 @@ class _Reader:
     def read_net_annotations(self, net_element: Element) -> None:
         self.net.label = _name_of(net_element)
         data = self.read_toolspecifics(net_element, "net", self.net.id, {})
-        for subnet_id, label, agent, element in data.get("subnets", []):
+        for subnet_id, label, agent, state, element in data.get("subnets", []):
             try:
-                self.net.add_subnet(subnet_id, label, agent)
+                self.net.add_subnet(subnet_id, label, agent, state)
             except PetriflowError as exc:
                 self.fail(str(exc), element, subnet_id)
         if "label" in data:
@@ -639,11 +639,11 @@ class _Reader:
             else:
                 self.note(kind, node, f"petriflow data <{name}> is not understood; ignored")
 
-    def subnet_of(self, element: Element) -> tuple[str, str | None, str | None, Element]:
+    def subnet_of(self, element: Element) -> tuple[str, str | None, str | None, str | None, Element]:
         subnet = element.get("id")
         if not subnet:
             self.fail("petriflow <subnet> without an id", element, self.net.id)
-        return subnet, element.get("label"), element.get("agent"), element
+        return subnet, element.get("label"), element.get("agent"), element.get("state"), element
 
     def operator_of(self, element: Element, node: str | None) -> Operator:
         group = element.get("group")

@@ -12,7 +12,7 @@ other tools read:
 What only petriflow knows goes into ``<toolspecific tool="petriflow" version="1">``
 elements, which other tools keep or skip:
 
-* on the net: ``<subnet id label agent/>`` per subnet, ``<meta>`` (JSON);
+* on the net: ``<subnet id label agent state/>`` per subnet, ``<meta>`` (JSON);
 * on places: ``<subnet>``, ``<channel>``, ``<meta>`` (JSON);
 * on transitions: ``<action>``, ``<params>`` (JSON), ``<guard>``, ``<priority>``,
   ``<subnet>``, ``<operator group split join/>``, ``<timeout>``, one
@@ -116,7 +116,8 @@ class _Writer:
         for subnet in net.subnets.values():
             _sub(tool, "subnet", id=self.check(subnet.id, "subnet id", subnet.id),
                  label=self.check(subnet.label, "subnet label", subnet.id),
-                 agent=self.check(subnet.agent, "subnet agent", subnet.id))
+                 agent=self.check(subnet.agent, "subnet agent", subnet.id),
+                 state=self.check(subnet.state, "subnet state", subnet.id))
         self.meta(tool, net.meta, f"net {net.id!r}")
         if net.run is not None:
             run = _json_exact(net.run)

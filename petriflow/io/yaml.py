@@ -41,7 +41,7 @@ __all__ = ["FORMAT_VERSION", "load_yaml", "loads_net", "dumps_net", "save_yaml",
 FORMAT_VERSION = 1
 
 _TOP_KEYS = {"petriflow", "net", "label", "subnets", "places", "transitions", "arcs", "final", "meta", "run"}
-_SUBNET_KEYS = {"id", "label", "agent", "places", "transitions"}
+_SUBNET_KEYS = {"id", "label", "agent", "state", "places", "transitions"}
 _PLACE_KEYS = {"id", "label", "tokens", "channel", "meta"}
 _TRANSITION_KEYS = {
     "id", "label", "action", "params", "guard", "priority", "silent", "timeout", "cancels",
@@ -250,7 +250,8 @@ class _Reader:
             self.fail("duplicate subnet id", item, sid)
         fail = (lambda m: self.fail(m, item, sid))
         try:
-            self.net.add_subnet(sid, _text(item.get("label"), "label", fail), _text(item.get("agent"), "agent", fail))
+            self.net.add_subnet(sid, _text(item.get("label"), "label", fail), _text(item.get("agent"), "agent", fail),
+                                _text(item.get("state"), "state", fail))
         except NetFormatError:
             raise
         except PetriflowError as exc:
@@ -712,6 +713,8 @@ def net_to_dict(net: Net) -> dict[str, Any]:
                 entry["label"] = subnet.label
             if subnet.agent is not None:
                 entry["agent"] = subnet.agent
+            if subnet.state is not None:
+                entry["state"] = subnet.state
             entry["places"] = [place_entry(p) for p in net.places.values() if p.subnet == subnet.id]
             entry["transitions"] = transitions_by_subnet.get(subnet.id, [])
             data["subnets"].append(entry)

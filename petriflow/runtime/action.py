@@ -212,6 +212,7 @@ class ActionContext:
     _reader: Callable[[str], list[Any]] | None = field(default=None, repr=False)
     _links: Callable[[str], tuple[Any, str | None]] | None = field(default=None, repr=False)
     _alive: Callable[[str | None], bool] | None = field(default=None, repr=False)
+    _agents: Any = field(default=None, repr=False)
 
     @property
     def rng(self) -> random.Random:
@@ -219,6 +220,24 @@ class ActionContext:
         if self._rng is None:
             self._rng = random.Random(self.seed)
         return self._rng
+
+    @property
+    def state(self) -> Any:
+        """The state of this firing's agent (``None`` until one of its actions sets it).
+
+        Setting it makes the object the agent's state for the rest of the run (see
+        :mod:`petriflow.runtime.agents`); it must be of the type the agent's subnet
+        declares, if it declares one.
+        """
+        if self._agents is None:
+            raise PetriflowError(f"{self.transition!r}: no run to keep an agent state in")
+        return self._agents.state(self.agent)
+
+    @state.setter
+    def state(self, value: Any) -> None:
+        if self._agents is None:
+            raise PetriflowError(f"{self.transition!r}: no run to keep an agent state in")
+        self._agents.set_state(self.agent, value, self._agents.index.state_type.get(self.agent))
 
     @property
     def elapsed(self) -> float:
@@ -308,6 +327,10 @@ class Action:
     #: subnet whose agent is the robot), ``"world"`` (the run has a world). Override
     #: :meth:`requirements` when they depend on the parameters.
     requires: ClassVar[frozenset[str]] = frozenset()
+    #: The type of agent state the action reads and writes through ``ctx.state`` (a class
+    #: or a tuple of classes), or ``None``. Binding checks that the transition's subnet
+    #: declares a state of that type (``state:`` in the net).
+    agent_state: ClassVar[Any] = None
 
     @classmethod
     def requirements(cls, params: dict[str, Any]) -> frozenset[str]:
@@ -457,46 +480,49 @@ def generator_action(
         {'seconds': 1.0}
     """
 
-    is_generator = inspect.isgeneratorfunction(function)
+    name = getattr(function, "__name__", "action")
+    return type(name, (_FunctionAction,), {
+        "__doc__": function.__doc__, "__qualname__": name, "params": dict(params or {}),
+        "needs_world": needs_world, "function": staticmethod(function),
+        "is_generator": inspect.isgeneratorfunction(function)})
 
-    class FunctionAction(Action):
-        __doc__ = function.__doc__
 
-        def start(self, ctx: ActionContext) -> None:
-            self._done = False
+class _FunctionAction(Action):
+    """An action made of a function or generator function (see :func:`generator_action`)."""
+
+    function: Callable[..., Any]
+    is_generator = False
+
+    def start(self, ctx: ActionContext) -> None:
+        self._done = False
+        self.wake_at = None
+        if not self.is_generator:
+            ctx.result = self.function(ctx)
+            self._done = True
+            return
+        self._steps = self.function(ctx)
+        self._advance(ctx, None)
+
+    def _advance(self, ctx: ActionContext, sent: Any) -> None:
+        try:
+            wait = self._steps.send(sent)
+        except StopIteration as stop:
+            ctx.result = stop.value
+            self._done = True
+            return
+        if wait is None:
             self.wake_at = None
-            if not is_generator:
-                ctx.result = function(ctx)
-                self._done = True
-                return
-            self._steps = function(ctx)
+        else:
+            if isinstance(wait, bool) or not isinstance(wait, (int, float)) or wait < 0:
+                raise ActionFailure(f"yielded {wait!r}; yield nothing or a number of seconds")
+            self.wake_at = ctx.now + float(wait)
+
+    def poll(self, ctx: ActionContext) -> Status:
+        if not self._done and (self.wake_at is None or ctx.now >= self.wake_at - 1e-12):
             self._advance(ctx, None)
+        return Status.OK if self._done else Status.RUNNING
 
-        def _advance(self, ctx: ActionContext, sent: Any) -> None:
-            try:
-                wait = self._steps.send(sent)
-            except StopIteration as stop:
-                ctx.result = stop.value
-                self._done = True
-                return
-            if wait is None:
-                self.wake_at = None
-            else:
-                if isinstance(wait, bool) or not isinstance(wait, (int, float)) or wait < 0:
-                    raise ActionFailure(f"yielded {wait!r}; yield nothing or a number of seconds")
-                self.wake_at = ctx.now + float(wait)
-
-        def poll(self, ctx: ActionContext) -> Status:
-            if not self._done and (self.wake_at is None or ctx.now >= self.wake_at - 1e-12):
-                self._advance(ctx, None)
-            return Status.OK if self._done else Status.RUNNING
-
-        def cancel(self, ctx: ActionContext) -> bool:
-            if is_generator and not self._done:
-                self._steps.close()
-            return True
-
-    FunctionAction.params = dict(params or {})
-    FunctionAction.needs_world = needs_world
-    FunctionAction.__name__ = FunctionAction.__qualname__ = getattr(function, "__name__", "action")
-    return FunctionAction
+    def cancel(self, ctx: ActionContext) -> bool:
+        if self.is_generator and not self._done:
+            self._steps.close()
+        return True

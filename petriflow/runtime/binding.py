@@ -64,6 +64,8 @@ class BoundTransition:
         params: the checked parameters (defaults filled in).
         guard: the guard predicate, or ``None``.
         ports: ``{port: place}`` of the action's ports that name a place.
+        reads: the agent-state keys the guard reads (its ``reads`` formatted with the
+            transition's parameters), or ``None`` for a guard over tokens (or none).
     """
 
     id: str
@@ -71,6 +73,7 @@ class BoundTransition:
     params: dict[str, Any]
     guard: Predicate | None = None
     ports: dict[str, str] | None = None
+    reads: tuple[str, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -158,62 +161,115 @@ def bind(net: Net, registry: Registry | None = None, *, path: str | None = None,
         NetFormatError: ``file:line: 'transition': ...`` for an unknown action or guard,
             a bad parameter, or a port that names no place (with close matches).
     """
-    registry = registry or default_registry
-    path = path or net.path
-    unchecked: list[Unchecked] = []
-    bound: dict[str, BoundTransition] = {}
-    resolved: dict[str, type[Action]] = {}
-    guards: dict[str, Predicate] = {}
-    for transition in net.transitions.values():
+    binder = _Binder(net, registry or default_registry, path or net.path, unimported)
+    bound = {t.id: binder.transition(t) for t in net.transitions.values()}
+    return Binding(net, binder.registry, bound, tuple(binder.unchecked))
+
+
+class _Binder:
+    """Binds one net's transitions, one at a time (see :func:`bind`)."""
+
+    def __init__(self, net: Net, registry: Registry, path: str | None, unimported: bool) -> None:
+        self.net, self.registry, self.path, self.unimported = net, registry, path, unimported
+        self.unchecked: list[Unchecked] = []
+        self.cache: dict[tuple[str, str], Any] = {}
+
+    def fail(self, tid: str, message: str, *keys: str) -> NetFormatError:
+        return NetFormatError(message, path=self.path, line=_line(self.net, *keys, tid), element=tid)
+
+    def lookup(self, tid: str, kind: str, name: str) -> Any:
+        """The action class or guard named ``name`` (``None``: not checked, see ``unimported``)."""
+        if (kind, name) not in self.cache:
+            find = self.registry.guard if kind == "guard" else self.registry.resolve
+            try:
+                self.cache[kind, name] = find(name)
+            except UnknownActionError as exc:
+                if not self.unimported:
+                    raise self.fail(tid, str(exc), f"{tid}/{kind}") from None
+                self.cache[kind, name] = None
+        if self.cache[kind, name] is None:
+            self.unchecked.append(Unchecked(tid, kind, name, _line(self.net, f"{tid}/{kind}", tid)))
+        return self.cache[kind, name]
+
+    def transition(self, transition: Any) -> BoundTransition:
         tid = transition.id
-
-        def fail(message: str, *keys: str) -> NetFormatError:
-            return NetFormatError(message, path=path, line=_line(net, *keys, tid), element=tid)
-
-        def lookup(cache: dict, name: str, find, key: str):
-            if name not in cache:
-                try:
-                    cache[name] = find(name)
-                except UnknownActionError as exc:
-                    if not unimported:
-                        raise fail(str(exc), f"{tid}/{key}") from None
-                    cache[name] = None
-            if cache[name] is None:
-                unchecked.append(Unchecked(tid, key, name, _line(net, f"{tid}/{key}", tid)))
-            return cache[name]
-
-        guard = None if transition.guard is None else lookup(guards, transition.guard, registry.guard, "guard")
-        if transition.action is None:
-            bound[tid] = BoundTransition(tid, None, dict(transition.params), guard)
-            continue
-        cls = lookup(resolved, transition.action, registry.resolve, "action")
-        if cls is None:  # not checked: its module was not imported
-            bound[tid] = BoundTransition(tid, None, dict(transition.params), guard)
-            continue
+        guard = None if transition.guard is None else self.lookup(tid, "guard", transition.guard)
+        cls = None if transition.action is None else self.lookup(tid, "action", transition.action)
+        if cls is None:  # no action, or not checked (its module was not imported)
+            params = dict(transition.params)
+            return BoundTransition(tid, None, params, guard, None, self.reads(transition, guard, params))
         try:
             params = cls.check_params(transition.params, tid)
         except NetFormatError as exc:
             param = getattr(exc, "param", None)
-            raise fail(exc.message, f"{tid}/params/{param}", f"{tid}/params") from None
+            raise self.fail(tid, exc.message, f"{tid}/params/{param}", f"{tid}/params") from None
+        ports = self.ports(tid, cls, params)
+        self.requirements(tid, transition.action, cls.requirements(params), params)
+        self.state(tid, transition.action, cls)
+        return BoundTransition(tid, cls, params, guard, ports, self.reads(transition, guard, params))
+
+    def reads(self, transition: Any, guard: Any, params: dict[str, Any]) -> tuple[str, ...] | None:
+        """The state keys the transition's guard reads, its placeholders filled in."""
+        if guard is None:
+            return None
+        declared = self.registry.guard_reads(transition.guard)
+        if declared is None:
+            return None
+        tid = transition.id
+        if _agent_of(self.net, tid) is None:
+            raise self.fail(tid, f"guard {transition.guard} reads its agent's state: put the transition in an"
+                            " agent subnet", f"{tid}/guard")
+        try:
+            return tuple(key.format(**params) for key in declared)
+        except (KeyError, IndexError, ValueError) as exc:
+            raise self.fail(tid, f"guard {transition.guard} reads {declared!r}, which needs the parameter"
+                            f" {exc} the transition does not give", f"{tid}/guard") from None
+
+    def state(self, tid: str, action: str, cls: type[Action]) -> None:
+        """An action that reads an agent state must run in a subnet declaring a state of its type."""
+        wanted = getattr(cls, "agent_state", None)
+        subnet = self.net.transitions[tid].subnet
+        declared = None if subnet is None else self.net.subnets[subnet].state
+        if declared is not None:
+            try:
+                kind = self.registry.state_type(declared)
+            except UnknownActionError as exc:
+                raise self.fail(tid, f"subnet {subnet!r}: {exc}", tid) from None
+            if wanted is not None and not issubclass(kind, wanted):
+                raise self.fail(tid, f"action {action} reads a {_type_names(wanted)} state, but subnet"
+                                f" {subnet!r} declares state {declared!r} ({kind.__name__})", f"{tid}/action")
+        elif wanted is not None:
+            raise self.fail(tid, f"action {action} reads its agent's {_type_names(wanted)} state: declare it on"
+                            f" the subnet (state: ...)" if subnet else f"action {action} reads an agent state:"
+                            " put the transition in an agent subnet", f"{tid}/action")
+
+    def ports(self, tid: str, cls: type[Action], params: dict[str, Any]) -> dict[str, str]:
+        """``{port: place}`` of the action's ports that name a place; each must exist."""
         ports = {}
+        places = self.net.places
         for name, declared in cls.params.items():
             if not isinstance(declared, Port) or params.get(name) is None:
                 continue
             place = params[name]
-            if place not in net.places:
-                raise fail(f"port {name!r} names unknown place {place!r}{did_you_mean(place, net.places)}",
-                           f"{tid}/params/{name}", f"{tid}/params")
+            if place not in places:
+                raise self.fail(tid, f"port {name!r} names unknown place {place!r}{did_you_mean(place, places)}",
+                                f"{tid}/params/{name}", f"{tid}/params")
             ports[name] = place
-        needs = cls.requirements(params)
-        agent = _agent_of(net, tid)
+        return ports
+
+    def requirements(self, tid: str, action: str, needs: frozenset[str], params: dict[str, Any]) -> None:
+        agent = _agent_of(self.net, tid)
         if "agent" in needs and agent is None:
-            raise fail(f"action {transition.action} runs as an agent: put the transition in an agent subnet",
-                       f"{tid}/action")
+            raise self.fail(tid, f"action {action} runs as an agent: put the transition in an agent subnet",
+                            f"{tid}/action")
         if "robot" in needs and params.get("robot") is None and agent is None:
-            raise fail(f"action {transition.action} moves a robot: give params.robot or put the transition in"
-                       " an agent subnet", f"{tid}/action")
-        bound[tid] = BoundTransition(tid, cls, params, guard, ports)
-    return Binding(net, registry, bound, tuple(unchecked))
+            raise self.fail(tid, f"action {action} moves a robot: give params.robot or put the transition in"
+                            " an agent subnet", f"{tid}/action")
+
+
+def _type_names(kinds: Any) -> str:
+    kinds = kinds if isinstance(kinds, tuple) else (kinds,)
+    return " or ".join(k.__name__ for k in kinds)
 
 
 def _agent_of(net: Net, tid: str) -> str | None:

@@ -322,8 +322,8 @@ class Channels:
     delivers after a delay, or loses.
 
     Args:
-        run: the scheduler (its ``kernel``, ``world``, ``faults``, ``emit`` and
-            ``deliver`` are used).
+        run: the run (:class:`~petriflow.runtime.host.RunHost`: its ``net``,
+            ``kernel``, ``world``, ``faults``, ``emit`` and ``deliver``).
         models: ``{channel name: ChannelModel}``; a channel with none is ideal.
         seed: the run seed (losses are drawn from a generator of their own).
     """

@@ -29,7 +29,7 @@ import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
@@ -171,18 +171,7 @@ class RunConfig:
         for key in data:
             if key not in _KEYS:
                 fail(f"unknown key {key!r}{did_you_mean(str(key), _KEYS)}", key=key)
-        seed = data.get("seed", 0)
-        if isinstance(seed, bool) or not isinstance(seed, int):
-            fail(f"seed must be a whole number, got {seed!r}", key="seed")
-        until = data.get("until")
-        if until is not None and not _finite(until):
-            fail(f"until must be a number of seconds from 0 to 1e12, got {until!r}", key="until")
-        dt = data.get("dt", 0.01)
-        if not _finite(dt, 1e-6) or dt > 3600:
-            fail(f"dt must be a number of seconds from 0.000001 to 3600, got {dt!r}", key="dt")
-        stall = data.get("stall", DEFAULT_STALL)
-        if stall is not None and not _finite(stall, 0.0, low_open=True):
-            fail(f"stall must be a number of seconds > 0 and at most 1e12, or null (never), got {stall!r}", key="stall")
+        seed, until, dt, stall = _times(data, fail)
         channels = data.get("channels") or {}
         if not isinstance(channels, dict) or not all(isinstance(v, dict) for v in channels.values()):
             fail("channels must map a channel name to its model, e.g. {radio: {model: range}}", key="channels")
@@ -196,25 +185,7 @@ class RunConfig:
         lines["actions"] = getattr(data, "key_lines", {}).get("actions")
         lines = {key: at or getattr(data, "key_lines", {}).get(key.split("/")[0]) or line
                  for key, at in lines.items()}
-        world = data.get("world")
-        if world is not None and not isinstance(world, str):
-            fail(f"world must be a file name, got {world!r}", key="world")
-        allowed = allowed_folders(folder)
-        if world is not None and folder is not None:
-            if not inside(folder / world, allowed):
-                fail(f"world {world!r} is outside the configuration's folder (list its folder in"
-                     f" {PATH_VARIABLE} to allow it)", "world", key="world")
-            world = str(folder / world)
-        actions = data.get("actions") or []
-        if isinstance(actions, str):
-            actions = [actions]
-        if not isinstance(actions, list) or not all(isinstance(a, str) and a.strip() for a in actions):
-            fail(f"actions must list modules (names or .py files), got {actions!r}", key="actions")
-        located = [_locate_module(a, folder) for a in actions]
-        for given, where in zip(actions, located):
-            if Path(where).is_absolute() and folder is not None and not inside(Path(where), allowed):
-                fail(f"action module {given!r} is outside the configuration's folder (list its folder in"
-                     f" {PATH_VARIABLE} to allow it)", "actions", key="actions")
+        world, located = _files(data, folder, fail)
         config = cls(seed, None if until is None else float(until), float(dt), world,
                      {str(k): dict(v) for k, v in channels.items()}, faults, path, located,
                      None if stall is None else float(stall), lines)
@@ -310,6 +281,48 @@ class RunConfig:
             faults.append(entry)
         return {"seed": self.seed, "until": self.until, "dt": self.dt, "world": self.world,
                 "channels": self.channels, "faults": faults, "actions": list(self.actions), "stall": self.stall}
+
+
+def _times(data: Any, fail: Callable[..., Any]) -> tuple[int, Any, Any, Any]:
+    """A configuration's ``seed``, ``until``, ``dt`` and ``stall``, checked."""
+    seed = data.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int):
+        fail(f"seed must be a whole number, got {seed!r}", key="seed")
+    until = data.get("until")
+    if until is not None and not _finite(until):
+        fail(f"until must be a number of seconds from 0 to 1e12, got {until!r}", key="until")
+    dt = data.get("dt", 0.01)
+    if not _finite(dt, 1e-6) or dt > 3600:
+        fail(f"dt must be a number of seconds from 0.000001 to 3600, got {dt!r}", key="dt")
+    stall = data.get("stall", DEFAULT_STALL)
+    if stall is not None and not _finite(stall, 0.0, low_open=True):
+        fail(f"stall must be a number of seconds > 0 and at most 1e12, or null (never), got {stall!r}", key="stall")
+    return seed, until, dt, stall
+
+
+def _files(data: Any, folder: Path | None, fail: Callable[..., Any]) -> tuple[str | None, list[str]]:
+    """A configuration's ``world`` file and ``actions`` modules, resolved against its
+    folder and checked to lie in the folders it may name."""
+    world = data.get("world")
+    if world is not None and not isinstance(world, str):
+        fail(f"world must be a file name, got {world!r}", key="world")
+    allowed = allowed_folders(folder)
+    if world is not None and folder is not None:
+        if not inside(folder / world, allowed):
+            fail(f"world {world!r} is outside the configuration's folder (list its folder in"
+                 f" {PATH_VARIABLE} to allow it)", "world", key="world")
+        world = str(folder / world)
+    actions = data.get("actions") or []
+    if isinstance(actions, str):
+        actions = [actions]
+    if not isinstance(actions, list) or not all(isinstance(a, str) and a.strip() for a in actions):
+        fail(f"actions must list modules (names or .py files), got {actions!r}", key="actions")
+    located = [_locate_module(a, folder) for a in actions]
+    for given, where in zip(actions, located):
+        if Path(where).is_absolute() and folder is not None and not inside(Path(where), allowed):
+            fail(f"action module {given!r} is outside the configuration's folder (list its folder in"
+                 f" {PATH_VARIABLE} to allow it)", "actions", key="actions")
+    return world, located
 
 
 def _locate_module(entry: str, folder: Path | None) -> str:

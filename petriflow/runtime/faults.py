@@ -9,10 +9,13 @@ started), so the scheduler never branches on fault kinds.
 
 from __future__ import annotations
 
-from typing import Any, Callable, Iterable
+from typing import TYPE_CHECKING, Callable, Iterable
 
 from petriflow.runtime.config import Fault, FaultKind
 from petriflow.runtime.kernel import APPLY, Scheduled
+
+if TYPE_CHECKING:
+    from petriflow.runtime.host import RunHost
 
 __all__ = ["Faults", "FaultEvent"]
 
@@ -36,13 +39,13 @@ class Faults:
     """Which agents run and which links work, changed by scheduled faults.
 
     Args:
-        run: the scheduler (its ``kernel``, ``emit``, ``agent_stopped`` and
-            ``agent_started`` are used).
+        run: the run (:class:`~petriflow.runtime.host.RunHost`: its ``kernel``,
+            ``emit``, ``agent_stopped`` and ``agent_started``).
         faults: the faults to inject.
         agents: the run's agents (all running at the start, except late joiners).
     """
 
-    def __init__(self, run: Any, faults: Iterable[Fault], agents: Iterable[str]) -> None:
+    def __init__(self, run: "RunHost", faults: Iterable[Fault], agents: Iterable[str]) -> None:
         self.run = run
         self.running = {agent: True for agent in agents}
         self.down: set[frozenset[str]] = set()

@@ -48,7 +48,9 @@ ENTRY_POINT_GROUP = "petriflow.actions"
 
 Predicate = Callable[..., bool]
 """A guard: ``f(tokens, params) -> bool`` over ``{place: [data, ...]}`` of the tokens a
-firing would take and the guarded transition's parameters."""
+firing would take and the guarded transition's parameters; or, registered with
+``reads=``, ``f(state, params) -> bool`` over the agent's state (see
+:mod:`petriflow.runtime.agents`)."""
 
 
 class UnknownActionError(PetriflowError):
@@ -121,6 +123,8 @@ class Registry:
     def __init__(self, load_plugins: bool = True) -> None:
         self._actions: dict[str, ActionSpec] = {}
         self._predicates: dict[str, Predicate] = {}
+        self._reads: dict[str, tuple[str, ...]] = {}
+        self._states: dict[str, type] = {}
         self._metrics: dict[str, MetricSpec] = {}
         self._channels: dict[str, Any] = {}
         self._plugins_pending = load_plugins
@@ -148,8 +152,12 @@ class Registry:
 
         return decorate
 
-    def predicate(self, name: str, *, replace: bool = False) -> Callable[[Predicate], Predicate]:
-        """Decorator registering a guard predicate ``f(tokens, params) -> bool``.
+    def predicate(self, name: str, *, replace: bool = False,
+                  reads: tuple[str, ...] | list[str] | None = None) -> Callable[[Predicate], Predicate]:
+        """Decorator registering a guard predicate ``f(tokens, params) -> bool``, or with
+        ``reads`` (the agent-state keys it reads, ``"{param}"`` placeholders allowed,
+        ``"*"`` for anything) a guard ``f(state, params) -> bool`` over its agent's state
+        whose answer is kept until one of those keys changes.
 
         ``tokens`` is ``{place: [data, ...]}`` of the tokens the firing would consume
         and ``params`` the guarded transition's parameters. A guard sees nothing else:
@@ -160,6 +168,12 @@ class Registry:
             if name in self._predicates and not replace:
                 raise PetriflowError(f"guard {name!r} is already registered")
             self._predicates[name] = function
+            if reads is None:
+                self._reads.pop(name, None)
+            else:
+                if isinstance(reads, str) or not all(isinstance(k, str) and k for k in reads):
+                    raise PetriflowError(f"guard {name!r}: reads is a list of state keys, got {reads!r}")
+                self._reads[name] = tuple(reads)
             return function
 
         return decorate
@@ -270,6 +284,25 @@ class Registry:
             raise self._unknown("guard", name, self._predicates)
         return self._predicates[name]
 
+    def guard_reads(self, name: str) -> tuple[str, ...] | None:
+        """The state keys the guard ``name`` declares it reads (``None``: it reads tokens)."""
+        return self._reads.get(name)
+
+    def register_state(self, name: str, cls: type, *, replace: bool = False) -> None:
+        """Register an agent-state type that subnets declare as ``state: NAME``."""
+        if name in self._states and not replace and self._states[name] is not cls:
+            raise PetriflowError(f"agent state {name!r} is already registered")
+        if not isinstance(cls, type):
+            raise PetriflowError(f"agent state {name!r} must be a class, got {cls!r}")
+        self._states[name] = cls
+
+    def state_type(self, name: str) -> type:
+        """The agent-state type registered as ``name`` (UnknownActionError with hints if none)."""
+        self._load_plugins()
+        if name not in self._states:
+            raise self._unknown("agent state", name, self._states)
+        return self._states[name]
+
     def bind(self, net: Net, path: str | None = None):
         """Bind ``net``'s transitions to this registry (:func:`petriflow.runtime.binding.bind`)."""
         from petriflow.runtime.binding import bind
@@ -329,10 +362,12 @@ def action(name: str, params: dict[str, Param] | None = None, *, needs_world: bo
     return decorate
 
 
-def guard(name: str, *, replace: bool = False, registry: Registry | None = None) -> Callable:
+def guard(name: str, *, replace: bool = False, registry: Registry | None = None,
+          reads: tuple[str, ...] | list[str] | None = None) -> Callable:
     """Decorator registering a guard ``f(tokens, params) -> bool`` under ``name``
-    (in the run registry by default); see :meth:`Registry.predicate`."""
-    return (registry or default_registry).predicate(name, replace=replace)
+    (in the run registry by default), or with ``reads`` a guard ``f(state, params)``
+    over its agent's state; see :meth:`Registry.predicate`."""
+    return (registry or default_registry).predicate(name, replace=replace, reads=reads)
 
 
 def metric(name: str, *, events: bool = False, replace: bool = False, registry: Registry | None = None) -> Callable:

@@ -330,10 +330,12 @@ def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, An
              progress: bool, max_firings: int | None, keep_events: bool = False) -> RunOutcome:
     world = _world_from(inputs, gui)
     try:
-        scheduler = Scheduler(net, world=world, config=config, seed=inputs["seed"], binding=binding)
+        from petriflow.runtime.clock import RealtimeClock, SimulatedClock
+
+        scheduler = Scheduler(net, world=world, config=config, seed=inputs["seed"], binding=binding,
+                              clock=RealtimeClock() if realtime else SimulatedClock())
         outcome = _observed_run(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
-                                keep_events=keep_events, until=inputs["until"], max_firings=max_firings,
-                                realtime=realtime)
+                                keep_events=keep_events, until=inputs["until"], max_firings=max_firings)
     finally:
         if world is not None:
             world.close()

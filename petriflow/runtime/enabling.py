@@ -1,0 +1,143 @@
+"""Which transitions may fire now, kept up to date by what changed.
+
+A transition may fire when its input places hold enough tokens (the compiled net's
+rule), its guard holds for the tokens it would take, its agent is running, and its
+action is not already running (a transition runs one firing at a time).
+
+:class:`EnabledSet` keeps the transitions that may fire in an
+:class:`~petriflow.runtime.tokens.Agenda`. Whatever changes something a transition's
+enabling reads marks it *dirty* (:meth:`EnabledSet.mark`): a firing marks the
+consumers of the places it took from or put into, a delivery the consumers of its
+channel place, a fault the transitions of its agent. Only dirty transitions are
+checked again, at the next :meth:`~EnabledSet.refresh`, so a firing's cost does not
+grow with the size of the net.
+
+Examples:
+    >>> from petriflow.io.yaml import loads_net
+    >>> from petriflow.runtime.binding import bind
+    >>> from petriflow.runtime.index import RunIndex
+    >>> from petriflow.runtime.tokens import TokenStore
+    >>> net = loads_net('''
+    ... petriflow: 1
+    ... places: [{id: a, tokens: 1}, b]
+    ... transitions: [{id: go, in: [a], out: [b]}, {id: back, in: [b], out: [a]}]
+    ... ''')
+    >>> index = RunIndex(net, bind(net))
+    >>> enabled = EnabledSet(index, TokenStore(index.compiled, net.initial_marking), {}, {})
+    >>> [index.ids[t] for t in enabled.members()]
+    ['go']
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable, Mapping
+
+from petriflow.errors import PetriflowError
+from petriflow.runtime.index import RunIndex
+from petriflow.runtime.tokens import Agenda, TokenStore
+
+__all__ = ["EnabledSet", "GuardError"]
+
+
+class GuardError(PetriflowError):
+    """A guard raised instead of answering."""
+
+
+def reason_of(exc: BaseException, hook: str | None = None) -> str:
+    """An exception as a one-line reason (``hook() failed: ...`` when it came from a hook)."""
+    text = str(exc) or type(exc).__name__
+    text = text if isinstance(exc, PetriflowError) else f"{type(exc).__name__}: {text}"
+    return f"{hook}() failed: {text}" if hook else text
+
+
+class EnabledSet:
+    """The transitions that may fire now (see the module).
+
+    Args:
+        index: the run's net index.
+        tokens: the run's tokens.
+        alive: ``{agent: running}`` (an agent missing from it is running).
+        running: the transitions whose action is running (anything with ``in``).
+    """
+
+    def __init__(self, index: RunIndex, tokens: TokenStore, alive: Mapping[str, bool], running: Any,
+                 states: Mapping[str, Any] | None = None) -> None:
+        self.index = index
+        self.tokens = tokens
+        self.alive = alive
+        self.running = running
+        self.states: Mapping[str, Any] = {} if states is None else states
+        self.agenda = Agenda(index.priority)
+        self.dirty: set[int] = set(range(len(index.ids)))
+        self.answer: list[bool | None] = [None] * len(index.ids)  # kept answers of state guards
+        #: How many times a guard was called (what "cost by what changed" saves).
+        self.evaluations = 0
+
+    def forget(self, t: int) -> None:
+        """The kept guard answer of ``t`` is out of date: ask again at the next check."""
+        self.answer[t] = None
+        self.dirty.add(t)
+
+    def mark(self, transitions: Iterable[int]) -> None:
+        """Check these transitions again at the next :meth:`refresh`."""
+        self.dirty.update(transitions)
+
+    def mark_place(self, place: int) -> None:
+        """Check again the transitions that consume from place index ``place``."""
+        self.dirty.update(self.index.consumers[place])
+
+    def can_fire(self, t: int) -> bool:
+        """Whether transition index ``t`` may fire now (checked afresh).
+
+        Raises:
+            GuardError: its guard raised (naming the transition and the guard).
+        """
+        if t in self.running:
+            return False
+        index = self.index
+        agent = index.agent[t]
+        if agent is not None and not self.alive.get(agent, True):
+            return False
+        row = index.row[t]
+        if not index.compiled.is_enabled(self.tokens.counts, row):
+            return False
+        guard = index.guard[t]
+        if guard is None:
+            return True
+        try:
+            if index.reads[t] is None:  # a guard over the tokens the firing would take
+                self.evaluations += 1
+                return bool(guard(self.tokens.offered(row), index.params[t]))
+            answer = self.answer[t]
+            if answer is None:  # a guard over its agent's state, asked again only when its keys changed
+                self.evaluations += 1
+                answer = self.answer[t] = bool(guard(self.states.get(agent), index.params[t]))
+            return answer
+        except Exception as exc:
+            raise GuardError(f"transition {index.ids[t]!r}: guard {index.guard_name[t]!r} raised"
+                             f" {reason_of(exc)}") from exc
+
+    def refresh(self) -> None:
+        """Check the dirty transitions again."""
+        dirty = self.dirty
+        if dirty:
+            agenda, can_fire = self.agenda, self.can_fire
+            for t in dirty:
+                if can_fire(t):
+                    agenda.add(t)
+                else:
+                    agenda.discard(t)
+            dirty.clear()
+
+    def pick(self, draw: Callable[[], float]) -> int | None:
+        """The transition to fire next (see :meth:`Agenda.pick`), or ``None`` when none may."""
+        if self.dirty:
+            self.refresh()
+        if not self.agenda:
+            return None
+        return self.agenda.pick(draw)
+
+    def members(self) -> list[int]:
+        """The transitions that may fire now, in the net's order."""
+        self.refresh()
+        return self.agenda.members()

@@ -1,0 +1,182 @@
+"""Firing transitions: consume, cancel a region, start the action; produce when it ends.
+
+:class:`Firer` is the part of a run that changes the marking. At an instant it fires,
+one at a time, every transition the :class:`~petriflow.runtime.enabling.EnabledSet`
+offers (highest priority first, ties broken by one draw of the run's seeded
+generator). A firing consumes its inputs and applies its cancellation region at
+once; its action runs in the :class:`~petriflow.runtime.lifecycle.ActionRunner`, and
+when it ends the firing's outcome picks the output arcs (``ok``, ``failed``,
+``timeout``, ``cancelled``) whose places receive the tokens. Tokens put into channel
+places are messages: they go to :class:`~petriflow.runtime.channels.Channels` once the
+firing's end is recorded. A failure with no ``failed`` arcs stops the run
+(:class:`Unrouted`).
+"""
+
+from __future__ import annotations
+
+import random
+from typing import Any
+
+from petriflow import limits
+from petriflow.errors import PetriflowError
+from petriflow.net import Net
+from petriflow.outcome import Outcome
+from petriflow.runtime.action import ActionContext, ActionFailure
+from petriflow.runtime.agents import Agents
+from petriflow.runtime.channels import Channels
+from petriflow.runtime.enabling import EnabledSet
+from petriflow.runtime.faults import Faults
+from petriflow.runtime.index import RunIndex
+from petriflow.runtime.kernel import Kernel
+from petriflow.runtime.lifecycle import ActionRunner
+from petriflow.runtime.recorder import Recorder
+from petriflow.runtime.tokens import TokenStore
+from petriflow.runtime.trace import EventKind, summarize
+
+__all__ = ["Firer", "Unrouted", "ZenoError"]
+
+_START, _END, _CANCEL, _CUSTOM = (EventKind.START.value, EventKind.END.value, EventKind.CANCEL.value,
+                                  EventKind.CUSTOM.value)
+
+
+class ZenoError(PetriflowError):
+    """Instant transitions keep firing without simulated time passing."""
+
+
+class Unrouted(Exception):
+    """A failure with no ``failed`` arcs: the run stops (internal)."""
+
+    def __init__(self, failure: ActionFailure) -> None:
+        super().__init__(str(failure))
+        self.failure = failure
+
+
+class Firer:
+    """Fires a run's transitions and produces their outputs (see the module).
+
+    Attributes:
+        count: transitions fired so far (a firing's number is the count when it fired).
+        progress: the tick of the last firing start or end (the stall watchdog reads it).
+        limit: stop firing at this count (``None``: no limit).
+        runner: the action runner the firings' actions run in.
+    """
+
+    def __init__(self, net: Net, index: RunIndex, kernel: Kernel, tokens: TokenStore, enabled: EnabledSet,
+                 recorder: Recorder, faults: Faults, world: Any, seed: Any) -> None:
+        self.net, self.index, self.kernel, self.tokens = net, index, kernel, tokens
+        self.enabled, self.recorder, self.faults, self.world = enabled, recorder, faults, world
+        self.agents = Agents(index, enabled)
+        enabled.states = self.agents.states
+        self.runner = ActionRunner(index, kernel, enabled, self.finish)
+        enabled.running = self.runner.running
+        self.channels: Channels | None = None  # set by the run once made (channels need the run)
+        self.count = 0
+        self.progress = 0
+        self.limit: int | None = None
+        self.now_count = 0  # firings at the current instant (the Zeno check's)
+        self._rng = random.Random(f"{seed}:conflicts")
+        self._seed_prefix = f"{seed}:"
+
+    def fire_instant(self) -> None:
+        """Fire until nothing more can fire at this instant (or the firing limit)."""
+        limit, pick, draw = self.limit, self.enabled.pick, self._rng.random
+        while limit is None or self.count < limit:
+            t = pick(draw)
+            if t is None:
+                return
+            self.fire(t)
+            self.now_count += 1
+            if self.now_count > limits.FIRINGS_PER_INSTANT:
+                raise ZenoError(f"more than {limits.FIRINGS_PER_INSTANT} firings at t={self.kernel.now:g}s"
+                                " without time passing (a cycle of instant transitions?)")
+
+    def fire(self, t: int) -> None:
+        """Fire transition index ``t`` now: consume, cancel its region, start its action."""
+        index, enabled, recorder = self.index, self.enabled, self.recorder
+        tid, agent, row = index.ids[t], index.agent[t], index.row[t]
+        self.count += 1
+        number = self.count
+        self.progress = self.kernel.tick
+        inputs, withdrawn = self.tokens.consume(row)
+        compiled = index.compiled
+        for p, _ in compiled.pre[row]:
+            enabled.mark_place(p)
+        for p in compiled.reset[row]:
+            enabled.mark_place(p)
+        enabled.dirty.add(t)
+        self.agents.acted(agent)
+        if recorder.active:
+            details: dict[str, Any] = {"firing": number, "consumed": {p: len(v) for p, v in inputs.items()}}
+            carried = {p: [summarize(d) for d in v] for p, v in inputs.items() if any(d is not None for d in v)}
+            if carried:
+                details["inputs"] = carried
+            recorder.emit(_START, tid, agent, **details)
+        else:
+            recorder.skip()
+        if index.cancels[t] or withdrawn:
+            self._cancel_region(t, number, withdrawn)
+        now = self.kernel.now
+        ctx = ActionContext(tid, agent, index.params[t], inputs, self.world, self._seed_prefix + str(number),
+                            now, now, _reader=self.tokens.read, _links=self.channels.model_for,
+                            _alive=self.faults.alive, _agents=self.agents)
+        self.runner.start(t, number, ctx)
+
+    def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:
+        cancelled = self.runner.cancel(list(self.index.cancels[t]))
+        if withdrawn or cancelled:
+            self.recorder.emit(_CANCEL, self.index.ids[t], self.index.agent[t], firing=number, withdrawn=withdrawn,
+                               actions=[self.index.ids[f.index] for f in cancelled])
+        self.runner.drive(cancelled)
+
+    def finish(self, number: int, t: int, ctx: ActionContext, outcome: Outcome) -> None:
+        """Produce the outputs of ``outcome`` and record the end of the firing.
+
+        Raises:
+            Unrouted: a failure or timeout the net gives no arcs for.
+        """
+        tid, recorder = self.index.ids[t], self.recorder
+        self.progress = self.kernel.tick
+        self.agents.acted(ctx.agent)
+        row = self.index.route[t][outcome]
+        if row is None and outcome is not Outcome.CANCELLED and outcome is not Outcome.OK:
+            reason = ctx.reason or outcome.value
+            recorder.emit(_END, tid, ctx.agent, firing=number, outcome=outcome.value, produced={}, reason=reason)
+            raise Unrouted(ActionFailure(reason, net=self.net.id, transition=tid,
+                                         action=self.net.transitions[tid].action))
+        if ctx.emitted:
+            for kind, data in ctx.emitted:
+                recorder.emit(_CUSTOM, tid, ctx.agent, firing=number, name=kind, data=summarize(data))
+            ctx.emitted.clear()
+        produced: dict[str, int] = {}
+        sent: list[tuple[str, Any]] = []
+        if row is not None:
+            produced, sent = self._produce(row, ctx)
+        if recorder.active:
+            details: dict[str, Any] = {"firing": number, "outcome": outcome.value, "produced": produced}
+            if ctx.result is not None:
+                details["result"] = summarize(ctx.result)
+            if ctx.reason:
+                details["reason"] = ctx.reason
+            recorder.emit(_END, tid, ctx.agent, **details)
+        else:
+            recorder.skip()
+        for place, data in sent:
+            self.channels.send(place, data, ctx.agent)
+
+    def _produce(self, row: int, ctx: ActionContext) -> tuple[dict[str, int], list[tuple[str, Any]]]:
+        """Put a firing's outputs into the places of ``row``; returns the counts produced
+        and the messages for channel places (sent once the end is recorded)."""
+        result, outputs = ctx.result, ctx.outputs
+        if ctx.per_place and isinstance(result, dict):
+            result, outputs = None, result
+        channel = self.index.channel
+        produced = self.tokens.produce(row, result, outputs, channel)
+        compiled = self.index.compiled
+        places = compiled.places
+        sent: list[tuple[str, Any]] = []
+        for p, w in compiled.post[row]:
+            if channel[p]:
+                sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
+            else:
+                self.enabled.mark_place(p)
+        return produced, sent

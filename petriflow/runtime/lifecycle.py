@@ -1,0 +1,219 @@
+"""The actions of a run, from setup to teardown, and each firing's lifecycle.
+
+When a transition fires, :class:`ActionRunner` starts its action and then polls it on
+the kernel: at the time it asked for (``wake_at``), at every tick while it steps with
+the world (``needs_world``), and at its transition's timeout. A cancellation (a
+cancellation region, a fault killing its agent) or a timeout calls
+:meth:`~petriflow.runtime.action.Action.cancel` instead of ``poll`` until it says it
+is done. When the action ends, the runner hands its outcome to the run
+(:class:`Finisher`), which produces the outputs.
+
+An exception in any hook is that firing's ``failed`` outcome with the exception as
+reason, never a lost token; an exception in ``setup`` makes every firing of the
+transition fail with it.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Protocol
+
+from petriflow.outcome import Outcome
+from petriflow.runtime.action import Action, ActionContext, Status
+from petriflow.runtime.enabling import EnabledSet, reason_of
+from petriflow.runtime.index import RunIndex
+from petriflow.runtime.kernel import POLL, Deadline, Kernel, Scheduled
+
+__all__ = ["Firing", "ActionRunner", "Finisher"]
+
+
+class Finisher(Protocol):
+    """What the runner tells when a firing ends (the run produces its outputs)."""
+
+    def __call__(self, number: int, t: int, ctx: ActionContext, outcome: Outcome) -> None: ...
+
+
+class Firing(Scheduled):
+    """The running firing of one transition (a transition runs one at a time, so one
+    record per transition serves all its firings); scheduled on the kernel, it is its
+    own wake-up (the poll it asked for last)."""
+
+    __slots__ = ("runner", "number", "index", "action", "ctx", "deadline", "cancelling", "wake", "polled",
+                 "running")
+    phase = POLL
+
+    def __init__(self, runner: "ActionRunner", index: int, action: Action) -> None:
+        self.runner = runner
+        self.index = index
+        self.action = action
+        self.number = 0
+        self.ctx: ActionContext | None = None
+        self.deadline: float | None = None
+        self.cancelling: Outcome | None = None
+        self.wake = -1
+        self.polled = -1
+        self.running = False
+
+    def begin(self, number: int, ctx: ActionContext, deadline: float | None) -> None:
+        """Begin firing ``number`` (the transition's previous firing has ended)."""
+        self.number = number
+        self.ctx = ctx
+        self.deadline = deadline
+        self.cancelling = None
+        self.wake = -1
+        self.polled = -1
+        self.running = True
+
+    def live(self, tick: int) -> bool:
+        return self.running and self.wake == tick
+
+    def apply(self, tick: int) -> None:
+        if self.polled != self.runner.kernel.tick:  # once per tick, whichever entry comes first
+            self.runner.poll(self)
+
+
+class ActionRunner:
+    """Starts, polls, cancels and ends the actions of a run (see the module).
+
+    Args:
+        index: the run's net index.
+        kernel: the run's event kernel.
+        enabled: the run's enabled set (a transition whose action stops may fire again).
+        finish: called when a firing ends, with its outcome.
+
+    Attributes:
+        running: ``{transition index: Firing}`` of the actions running now.
+    """
+
+    def __init__(self, index: RunIndex, kernel: Kernel, enabled: EnabledSet, finish: Finisher) -> None:
+        self.index = index
+        self.kernel = kernel
+        self.enabled = enabled
+        self.finish = finish
+        self.running: dict[int, Firing] = {}
+        self.actions: list[Action | None] = [None] * len(index.ids)
+        self._slot: list[Firing | None] = [None] * len(index.ids)
+        self._setup_error: list[str | None] = [None] * len(index.ids)
+
+    def setup(self, world: Any) -> None:
+        """Make every bound transition's action and set it up (once, at the run's start)."""
+        for t, cls in enumerate(self.index.action_class):
+            if cls is None:
+                continue
+            action = self.actions[t] = cls(self.index.params[t])
+            self._slot[t] = Firing(self, t, action)
+            try:
+                action.setup(world)
+            except Exception as exc:  # every firing of t then fails with this reason
+                self._setup_error[t] = reason_of(exc, "setup")
+
+    def start(self, t: int, number: int, ctx: ActionContext) -> None:
+        """Start firing ``number`` of transition ``t`` (its inputs are consumed)."""
+        action = self.actions[t]
+        if action is None:  # no action: the firing ends at once, passing its input data on
+            ctx.result = ctx.token()
+            self.finish(number, t, ctx, Outcome.OK)
+            return
+        if self._setup_error[t] is not None:
+            ctx.reason = self._setup_error[t]
+            self.finish(number, t, ctx, Outcome.FAILED)
+            return
+        now = self.kernel.now
+        timeout = self.index.timeout[t]
+        firing = self._slot[t]
+        firing.begin(number, ctx, None if timeout is None else now + timeout)
+        self.running[t] = firing
+        try:
+            action.start(ctx)
+        except Exception as exc:  # an action's error is a failed outcome, never lost
+            ctx.reason = reason_of(exc)
+            self._stop(firing)
+            self.finish(number, t, ctx, Outcome.FAILED)
+            return
+        kernel = self.kernel
+        if timeout is not None:
+            tick = max(kernel.tick + 1, kernel.ticks_at(firing.deadline))
+            kernel.schedule(tick, Deadline(firing, number), key=number)
+        wake = action.wake_at
+        if wake is not None and not action.needs_world and wake > now + 1e-12:
+            self._wake(firing, max(kernel.tick + 1, kernel.ticks_at(wake)))  # first poll when it asked
+        else:
+            self.poll(firing)
+
+    def cancel(self, transitions: list[int], outcome: Outcome = Outcome.CANCELLED) -> list[Firing]:
+        """Cancel the running firings of ``transitions`` (in firing order); returns them."""
+        firings = sorted((self.running[t] for t in transitions if t in self.running), key=lambda f: f.number)
+        for firing in firings:
+            firing.cancelling = outcome
+        return firings
+
+    def drive(self, firings: list[Firing]) -> None:
+        """Poll firings being cancelled at once (they may finish in this instant)."""
+        for firing in firings:
+            if firing.running:
+                self.poll(firing)
+
+    def poll(self, firing: Firing) -> None:
+        """Poll one running action (or drive its cancellation); end it if it ended."""
+        kernel = self.kernel
+        firing.polled = tick = kernel.tick
+        ctx, action = firing.ctx, firing.action
+        ctx.now = now = kernel.now
+        if firing.cancelling is None and firing.deadline is not None and now >= firing.deadline - 1e-9:
+            firing.cancelling = Outcome.TIMEOUT
+        if firing.cancelling is not None:
+            self._drive_cancel(firing, ctx, action, tick)
+            return
+        try:
+            status = action.poll(ctx)
+        except Exception as exc:
+            ctx.reason = reason_of(exc)
+            status = Status.FAILED
+        if status is Status.RUNNING:
+            if action.needs_world:
+                self._wake(firing, tick + 1)
+            else:
+                wake = action.wake_at
+                self._wake(firing, tick + 1 if wake is None else max(tick + 1, kernel.ticks_at(wake)))
+            return
+        if not isinstance(status, Status):
+            ctx.reason = f"poll() returned {status!r}, not a Status"
+            status = Status.FAILED
+        self._stop(firing)
+        self.finish(firing.number, firing.index, ctx, Outcome.OK if status is Status.OK else Outcome.FAILED)
+
+    def _drive_cancel(self, firing: Firing, ctx: ActionContext, action: Action, tick: int) -> None:
+        outcome = firing.cancelling
+        try:
+            done = action.cancel(ctx)
+        except Exception as exc:
+            ctx.reason = reason_of(exc, "cancel")
+            done, outcome = True, Outcome.FAILED
+        if not done:
+            self._wake(firing, tick + 1)
+            return
+        self._stop(firing)
+        self.finish(firing.number, firing.index, ctx, outcome)
+
+    def _stop(self, firing: Firing) -> None:
+        firing.running = False
+        del self.running[firing.index]
+        self.enabled.dirty.add(firing.index)
+
+    def _wake(self, firing: Firing, tick: int) -> None:
+        firing.wake = tick
+        self.kernel.schedule(tick, firing, key=firing.number)
+
+    def in_firing_order(self) -> list[Firing]:
+        """The firings running now, oldest first."""
+        return sorted(self.running.values(), key=lambda f: f.number)
+
+    def teardown(self, name: Callable[[int], str]) -> dict[str, str]:
+        """Tear every action down; ``{transition: reason}`` of those whose teardown raised."""
+        problems: dict[str, str] = {}
+        for t, action in enumerate(self.actions):
+            if action is not None:
+                try:
+                    action.teardown()
+                except Exception as exc:
+                    problems[name(t)] = reason_of(exc, "teardown")
+        return problems
