@@ -33,17 +33,25 @@ from petriflow.io import load_net, save_net
 from petriflow.marking import Marking
 from petriflow.net import Arc, Net, Operator, Place, Subnet, Transition
 from petriflow.outcome import Outcome, StopReason
-from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Port, Status
-from petriflow.runtime.registry import action, guard, metric
-from petriflow.runtime.session import run
+from petriflow.netbuild import AgentBuilder, Mailbox, NetBuilder
+from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Port, Status
+from petriflow.runtime.agents import AgentState
+from petriflow.runtime.clock import RealtimeClock, SimulatedClock
+from petriflow.runtime.config import RunConfig
+from petriflow.runtime.registry import Registry, action, default_registry, guard, metric
+from petriflow.runtime.resources import Liveness, ResourceContext
+from petriflow.runtime.scheduler import RunResult, Scheduler
+from petriflow.runtime.session import RunOutcome, run
 from petriflow.workflow import add_operator
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "Action", "ActionContext", "ActionFailure", "Arc", "CompiledNet", "Deadlock", "Marking",
-    "MarkingError", "Net", "NetFormatError", "NetStructureError", "NotEnabledError", "Operator",
-    "Outcome", "Param", "PetriflowError", "Place", "Port", "Simulation", "Status", "StopReason",
-    "Subnet", "Transition", "UnknownElementError", "action", "add_operator", "enabled", "fire",
-    "fire_sequence", "guard", "load_net", "metric", "run", "save_net",
+    "Action", "ActionContext", "ActionFailure", "AgentBuilder", "AgentState", "Arc", "CompiledNet", "Deadlock",
+    "InstantAction", "Liveness", "Mailbox", "Marking", "MarkingError", "Net", "NetBuilder", "NetFormatError",
+    "NetStructureError", "NotEnabledError", "Operator", "Outcome", "Param", "PetriflowError", "Place", "Port",
+    "RealtimeClock", "Registry", "ResourceContext", "RunConfig", "RunOutcome", "RunResult", "Scheduler",
+    "Simulation", "SimulatedClock", "Status", "StopReason", "Subnet", "Transition", "UnknownElementError",
+    "action", "add_operator", "default_registry", "enabled", "fire", "fire_sequence", "guard", "load_net",
+    "metric", "run", "save_net",
 ]

@@ -35,7 +35,7 @@ def test_a_generator_function_registered_with_action_runs_from_python():
         yield ctx.params["minutes"] * 60
         return {"battery": 1.0}
 
-    outcome = run(charging_net("demo.charge"), registry=registry)
+    outcome = run(charging_net("demo.charge"), registry=registry, keep_events=True)
     assert outcome.result.reason == StopReason.DEAD and outcome.result.time == 120.0
     assert outcome.result.tokens == {"full": [{"battery": 1.0}]}
     assert [e.kind for e in outcome.events] == ["run", "start", "end", "stop"]
@@ -55,7 +55,7 @@ def test_an_action_class_raising_action_failure_is_routed():
         def poll(self, ctx):
             return Status.OK
 
-    outcome = run(charging_net("demo.charge"), registry=registry)
+    outcome = run(charging_net("demo.charge"), registry=registry, keep_events=True)
     end = outcome.events[2]
     assert (end.data["outcome"], end.data["reason"]) == (Outcome.FAILED, "charger fault")
     assert outcome.result.marking == {"faulty": 1}

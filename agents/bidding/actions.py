@@ -205,7 +205,7 @@ class MakeRobot(InstantAction):
 class Receive(InstantAction):
     """One message from the agent's mailbox into its state."""
 
-    params = {"box": Param(str, doc="the mailbox (channel place)"), "state": Param(str, doc="the listening place")}
+    params = {"box": Param(str, doc="the mailbox (channel place)", places=""), "state": Param(str, doc="the listening place", places="")}
 
     def run(self, ctx: ActionContext) -> None:
         state = ctx.inputs[self.params["state"]][0]
@@ -677,8 +677,8 @@ class Explore(Action):
 class Send(InstantAction):
     """Any agent: the next message waiting for ``peer`` into its mailbox."""
 
-    params = {"peer": Param(str, doc="the receiving agent"), "box": Param(str, doc="its mailbox (channel place)"),
-              "state": Param(str, doc="the work place the state goes back to")}
+    params = {"peer": Param(str, doc="the receiving agent"), "box": Param(str, doc="its mailbox (channel place)", places=""),
+              "state": Param(str, doc="the work place the state goes back to", places="")}
 
     def run(self, ctx: ActionContext) -> Any:
         state = ctx.inputs[self.params["state"]][0]

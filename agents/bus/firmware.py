@@ -166,7 +166,7 @@ class Boot(_Timed):
                              low=0),
         "lag": Param(float, 2 * math.pi / 3, "the phase lag between neighbours (rad)"),
         "spread": Param(float, 0.1, "start-up times are U[0, spread] s", low=0),
-        "mailboxes": Param(list, [], "this module's channel places (to tell the bus its read period)"),
+        "mailboxes": Param(list, [], "this module's channel places (to tell the bus its read period)", places="*"),
     }
 
     def duration(self, ctx: ActionContext) -> float:
@@ -265,8 +265,8 @@ class Send(InstantAction):
     token in each addressee's channel place (``boxes``: address offset -> place)."""
 
     params = {"boxes": Param(dict, doc="{'+1': place, '-1': place} (an offset with no module: its frame"
-                              " goes to nobody)"),
-              "state": Param(str, doc="the place the module's state goes back to")}
+                              " goes to nobody)", places="*"),
+              "state": Param(str, doc="the place the module's state goes back to", places="")}
 
     def run(self, ctx: ActionContext) -> Module:
         module = _module(ctx)
@@ -304,7 +304,7 @@ class Available(Action):
     been quiet for this module's random ``U[0, idle_window]`` s and is free; a busy
     spell in between draws a new time for the next quiet one."""
 
-    params = {"box": Param(str, doc="a channel place on the bus (to watch it)")}
+    params = {"box": Param(str, doc="a channel place on the bus (to watch it)", places="")}
 
     def start(self, ctx: ActionContext) -> None:
         self.module = _module(ctx)
@@ -340,7 +340,7 @@ class Receive(InstantAction):
     """The reception routine: a frame from ``box`` (or the notice that it was lost);
     keep the neighbour's phase when the scheme accepts the message."""
 
-    params = {"box": Param(str, doc="the channel place"), "state": Param(str, doc="the listening place")}
+    params = {"box": Param(str, doc="the channel place", places=""), "state": Param(str, doc="the listening place", places="")}
 
     def run(self, ctx: ActionContext) -> None:
         module = ctx.inputs[self.params["state"]][0]
@@ -367,7 +367,7 @@ class Receive(InstantAction):
 class Drain(InstantAction):
     """A frame addressed to no module left the bus (or was lost on it)."""
 
-    params = {"box": Param(str, doc="the channel place")}
+    params = {"box": Param(str, doc="the channel place", places="")}
 
     def run(self, ctx: ActionContext) -> None:
         data = ctx.inputs[self.params["box"]][0]

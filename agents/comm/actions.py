@@ -103,7 +103,7 @@ class Analyse(InstantAction):
     """Process 2: sweep the link of a channel place behind a wall (Fig. 5); keep the threshold."""
 
     params = {
-        "channel_place": Param(str, doc="a channel place of this agent whose radio to analyse"),
+        "channel_place": Param(str, doc="a channel place of this agent whose radio to analyse", places=""),
         "distances": Param(int, 10, "distances 1..N m", low=1),
         "trials": Param(int, 100, "frames per distance", low=1),
     }
@@ -129,7 +129,7 @@ class Initialise(InstantAction):
         "available": Param(int, 253, "A, the addresses available", low=2),
         "pool_of": Param((int, type(None)), None, "a late joiner: take the first free address of agent i's pool"),
         "address": Param((int, type(None)), None, "a fixed address instead (the central unit)"),
-        "peers": Param(dict, {}, "peer agent -> {address: A, box: channel place towards it}"),
+        "peers": Param(dict, {}, "peer agent -> {address: A, box: channel place towards it}", places="*.box"),
     }
 
     def run(self, ctx: ActionContext) -> CommAgent:
@@ -407,8 +407,8 @@ class Listen(InstantAction):
 class Send(InstantAction):
     """Process 5: the next message waiting for ``peer`` into the channel place towards it."""
 
-    params = {"peer": Param(str, doc="the peer agent"), "box": Param(str, doc="the channel place towards it"),
-              "loop": Param(str, doc="the place the state goes back to")}
+    params = {"peer": Param(str, doc="the peer agent"), "box": Param(str, doc="the channel place towards it", places=""),
+              "loop": Param(str, doc="the place the state goes back to", places="")}
 
     def run(self, ctx: ActionContext) -> CommAgent:
         state = _state(ctx)
@@ -426,7 +426,7 @@ class Send(InstantAction):
 class Receive(InstantAction):
     """Take one message from a channel place into this agent's history and map."""
 
-    params = {"box": Param(str, doc="the channel place"), "state": Param(str, doc="the listening place")}
+    params = {"box": Param(str, doc="the channel place", places=""), "state": Param(str, doc="the listening place", places="")}
 
     def run(self, ctx: ActionContext) -> CommAgent:
         state = ctx.inputs[self.params["state"]][0]

@@ -84,6 +84,11 @@ class Param:
         choices: allowed values, if limited.
         low: the smallest value a number may take (``None``: no bound).
         high: the largest value a number may take (``None``: no bound).
+        places: where the value names places of the net, checked when the net is bound
+            (a misspelt place fails at load with its line and a close match):
+            ``""`` the value itself, ``"*"`` every item of a list or value of a
+            mapping, ``"key"`` the mapping's ``key``, ``"*.key"`` the ``key`` of every
+            item (``None``: it names no place). A ``None`` found there names nothing.
 
     Examples:
         >>> Param(float, 0.5, low=0, high=1).check("probability", 2, where="t")
@@ -98,6 +103,29 @@ class Param:
     choices: tuple = ()
     low: float | None = None
     high: float | None = None
+    places: str | None = None
+
+    def place_names(self, value: Any) -> list[str]:
+        """The place names ``value`` holds where :attr:`places` says (see the class).
+
+        Examples:
+            >>> Param(dict, places="*.box").place_names({"r2": {"box": "b2"}, "r3": {"box": "b3"}})
+            ['b2', 'b3']
+            >>> Param(list, places="*").place_names(["a", None, "c"])
+            ['a', 'c']
+        """
+        if self.places is None or value is None:
+            return []
+        found = [value]
+        for step in [s for s in self.places.split(".") if s]:
+            nxt: list[Any] = []
+            for item in found:
+                if step == "*":
+                    nxt.extend(item.values() if isinstance(item, dict) else item if isinstance(item, list) else [])
+                elif isinstance(item, dict) and step in item:
+                    nxt.append(item[step])
+            found = nxt
+        return [f for f in found if f is not None]
 
     def check(self, name: str, value: Any, where: str) -> Any:
         types = self.type if isinstance(self.type, tuple) else (self.type,)
@@ -213,6 +241,8 @@ class ActionContext:
     _links: Callable[[str], tuple[Any, str | None]] | None = field(default=None, repr=False)
     _alive: Callable[[str | None], bool] | None = field(default=None, repr=False)
     _agents: Any = field(default=None, repr=False)
+    _resources: Any = field(default=None, repr=False)
+    _declared: dict[str, str] | None = field(default=None, repr=False)
 
     @property
     def rng(self) -> random.Random:
@@ -238,6 +268,20 @@ class ActionContext:
         if self._agents is None:
             raise PetriflowError(f"{self.transition!r}: no run to keep an agent state in")
         self._agents.set_state(self.agent, value, self._agents.index.state_type.get(self.agent))
+
+    def resource(self, name: str) -> Any:
+        """The run's resource the action declares as ``name`` (its ``resources``).
+
+        Raises:
+            PetriflowError: the action declares no resource of that name, or no run.
+        """
+        kind = (self._declared or {}).get(name)
+        if kind is None:
+            raise PetriflowError(f"{self.transition!r}: the action declares no resource {name!r}"
+                                 f"{did_you_mean(name, self._declared or {})}")
+        if self._resources is None:
+            raise PetriflowError(f"{self.transition!r}: no run to take resource {name!r} from")
+        return self._resources.get(kind)
 
     @property
     def elapsed(self) -> float:
@@ -331,6 +375,10 @@ class Action:
     #: or a tuple of classes), or ``None``. Binding checks that the transition's subnet
     #: declares a state of that type (``state:`` in the net).
     agent_state: ClassVar[Any] = None
+    #: The run resources the action uses: ``{local name: registered resource type}``
+    #: (``{"office": "bidding.office"}``), checked when the net is bound, made once per
+    #: run, read with ``ctx.resource(local name)`` (see :mod:`petriflow.runtime.resources`).
+    resources: ClassVar[dict[str, str]] = {}
 
     @classmethod
     def requirements(cls, params: dict[str, Any]) -> frozenset[str]:
@@ -483,6 +531,7 @@ def generator_action(
     name = getattr(function, "__name__", "action")
     return type(name, (_FunctionAction,), {
         "__doc__": function.__doc__, "__qualname__": name, "params": dict(params or {}),
+        "__module__": getattr(function, "__module__", __name__),
         "needs_world": needs_world, "function": staticmethod(function),
         "is_generator": inspect.isgeneratorfunction(function)})
 

@@ -206,6 +206,12 @@ class _Binder:
         ports = self.ports(tid, cls, params)
         self.requirements(tid, transition.action, cls.requirements(params), params)
         self.state(tid, transition.action, cls)
+        for name, kind in getattr(cls, "resources", {}).items():
+            try:
+                self.registry.resource_factory(kind)
+            except UnknownActionError as exc:
+                raise self.fail(tid, f"action {transition.action} uses resource {name!r}: {exc}",
+                                f"{tid}/action") from None
         return BoundTransition(tid, cls, params, guard, ports, self.reads(transition, guard, params))
 
     def reads(self, transition: Any, guard: Any, params: dict[str, Any]) -> tuple[str, ...] | None:
@@ -248,13 +254,18 @@ class _Binder:
         ports = {}
         places = self.net.places
         for name, declared in cls.params.items():
-            if not isinstance(declared, Port) or params.get(name) is None:
-                continue
-            place = params[name]
-            if place not in places:
-                raise self.fail(tid, f"port {name!r} names unknown place {place!r}{did_you_mean(place, places)}",
-                                f"{tid}/params/{name}", f"{tid}/params")
-            ports[name] = place
+            if isinstance(declared, Port) and params.get(name) is not None:
+                named = [params[name]]
+            else:
+                named = declared.place_names(params.get(name))
+            for place in named:
+                if not isinstance(place, str) or place not in places:
+                    hint = did_you_mean(place, places) if isinstance(place, str) else ""
+                    what = "port" if isinstance(declared, Port) else "parameter"
+                    raise self.fail(tid, f"{what} {name!r} names unknown place {place!r}{hint}",
+                                    f"{tid}/params/{name}", f"{tid}/params")
+            if isinstance(declared, Port) and named:
+                ports[name] = named[0]
         return ports
 
     def requirements(self, tid: str, action: str, needs: frozenset[str], params: dict[str, Any]) -> None:

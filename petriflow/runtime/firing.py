@@ -70,6 +70,8 @@ class Firer:
         self.runner = ActionRunner(index, kernel, enabled, self.finish)
         enabled.running = self.runner.running
         self.channels: Channels | None = None  # set by the run once made (channels need the run)
+        self.resources: Any = None  # set by the run (petriflow.runtime.resources.Resources)
+        self._declared = [getattr(cls, "resources", None) or None for cls in index.action_class]
         self.count = 0
         self.progress = 0
         self.limit: int | None = None
@@ -118,7 +120,8 @@ class Firer:
         now = self.kernel.now
         ctx = ActionContext(tid, agent, index.params[t], inputs, self.world, self._seed_prefix + str(number),
                             now, now, _reader=self.tokens.read, _links=self.channels.model_for,
-                            _alive=self.faults.alive, _agents=self.agents)
+                            _alive=self.faults.alive, _agents=self.agents, _resources=self.resources,
+                            _declared=self._declared[t])
         self.runner.start(t, number, ctx)
 
     def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:

@@ -113,6 +113,15 @@ class MetricSpec:
         return self.target
 
 
+def _identity(target: Any) -> str:
+    """Where code comes from: ``module.qualname`` of a class or function (a function
+    action: of its function), or a lazy ``"module:Class"`` string as it is."""
+    if isinstance(target, str):
+        return target.replace(":", ".")
+    target = getattr(target, "function", target)
+    return f"{getattr(target, '__module__', '?')}.{getattr(target, '__qualname__', repr(target))}"
+
+
 class Registry:
     """Maps action, guard and metric names to code.
 
@@ -125,6 +134,7 @@ class Registry:
         self._predicates: dict[str, Predicate] = {}
         self._reads: dict[str, tuple[str, ...]] = {}
         self._states: dict[str, type] = {}
+        self._resources: dict[str, Callable[..., Any]] = {}
         self._metrics: dict[str, MetricSpec] = {}
         self._channels: dict[str, Any] = {}
         self._plugins_pending = load_plugins
@@ -134,9 +144,15 @@ class Registry:
     # Registering --------------------------------------------------------------------
     def register(self, name: str, target: type[Action] | str, *, doc: str = "",
                  replace: bool = False) -> None:
-        """Register an Action class (or a lazy ``"module:Class"`` string) under ``name``."""
-        if name in self._actions and not replace:
-            raise PetriflowError(f"action {name!r} is already registered")
+        """Register an Action class (or a lazy ``"module:Class"`` string) under ``name``.
+
+        Registering the same code again (the same module and name: a notebook cell run
+        twice, a module reloaded) replaces the old registration; other code under a
+        taken name needs ``replace=True``.
+        """
+        old = self._actions.get(name)
+        if old is not None and not replace and _identity(old.target) != _identity(target):
+            raise PetriflowError(f"action {name!r} is already registered (by {_identity(old.target)})")
         if not doc and not isinstance(target, str):
             doc = (target.__doc__ or "").strip().splitlines()[0] if target.__doc__ else ""
         self._actions[name] = ActionSpec(name, target, doc)
@@ -165,8 +181,9 @@ class Registry:
         """
 
         def decorate(function: Predicate) -> Predicate:
-            if name in self._predicates and not replace:
-                raise PetriflowError(f"guard {name!r} is already registered")
+            old = self._predicates.get(name)
+            if old is not None and not replace and _identity(old) != _identity(function):
+                raise PetriflowError(f"guard {name!r} is already registered (by {_identity(old)})")
             self._predicates[name] = function
             if reads is None:
                 self._reads.pop(name, None)
@@ -287,6 +304,26 @@ class Registry:
     def guard_reads(self, name: str) -> tuple[str, ...] | None:
         """The state keys the guard ``name`` declares it reads (``None``: it reads tokens)."""
         return self._reads.get(name)
+
+    def register_resource(self, name: str, factory: Callable[..., Any], *, replace: bool = False) -> None:
+        """Register a resource type: ``factory(context) -> object`` makes the run's one
+        instance (see :mod:`petriflow.runtime.resources`)."""
+        if name in self._resources and not replace and self._resources[name] is not factory:
+            raise PetriflowError(f"resource {name!r} is already registered")
+        if not callable(factory):
+            raise PetriflowError(f"resource {name!r}: the factory must be callable, got {factory!r}")
+        self._resources[name] = factory
+
+    def resource_factory(self, name: str) -> Callable[..., Any]:
+        """The factory of the resource type ``name`` (UnknownActionError with hints if none)."""
+        self._load_plugins()
+        if name not in self._resources:
+            from petriflow.runtime.resources import LIVENESS
+
+            if name == LIVENESS:  # made by the run itself
+                return lambda context: context.liveness
+            raise self._unknown("resource", name, [*self._resources, LIVENESS])
+        return self._resources[name]
 
     def register_state(self, name: str, cls: type, *, replace: bool = False) -> None:
         """Register an agent-state type that subnets declare as ``state: NAME``."""

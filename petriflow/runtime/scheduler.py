@@ -81,6 +81,7 @@ from petriflow.runtime.index import RunIndex
 from petriflow.runtime.kernel import Kernel
 from petriflow.runtime.recorder import EventHandler, Recorder
 from petriflow.runtime.registry import Registry
+from petriflow.runtime.resources import Liveness, ResourceContext, Resources
 from petriflow.runtime.tokens import TokenStore
 from petriflow.runtime.trace import EventKind
 
@@ -166,6 +167,8 @@ class Scheduler:
                            self.seed)
         self.runner = self.firer.runner
         self.channels = self.firer.channels = Channels(self, self.config.channel_models(), self.seed)
+        self.resources = self.firer.resources = Resources(
+            self.registry, ResourceContext(world, Liveness(self.faults.alive, index.agents), self.config))
         self._started = self._closed = False
         self._opened = False  # whether the instant at tick 0 was processed
         self._finished: RunResult | None = None
@@ -261,6 +264,8 @@ class Scheduler:
         if self._started:
             return
         self._started = True
+        self.resources.need(sorted({kind for cls in self.index.action_class if cls is not None
+                                    for kind in getattr(cls, "resources", {}).values()}))
         self.clock.start()
         self.emit(_RUN, None, None, net=self.net.id, seed=self.seed, dt=self.kernel.dt,
                   marking=self.marking().to_dict(), agents=self.agents())

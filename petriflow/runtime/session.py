@@ -456,7 +456,7 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
 def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | str | Path | None = None,
         seed: int | None = None, until: float | None = None, max_firings: int | None = None,
         trace: str | Path | None = None, xes: str | Path | None = None, registry: Registry | None = None,
-        keep_events: bool = True) -> RunOutcome:
+        keep_events: bool = False) -> RunOutcome:
     """Run a net from Python: a file (as ``petriflow run`` does) or a :class:`Net`.
 
     Args:
@@ -471,7 +471,8 @@ def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | 
         xes: write the firings as an XES log to this file.
         registry: where actions are looked up (default: the run registry).
         keep_events: keep every event in the outcome's ``events`` (memory grows with
-            the run; turn off for long runs).
+            the run, so it is off by default: a run's memory does not grow with its
+            length; write a ``trace`` for long runs).
 
     Returns:
         The :class:`RunOutcome`; ``outcome.result.reason`` says how the run ended.
@@ -482,17 +483,19 @@ def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | 
         >>> _ = net.add_place("i", tokens=1); _ = net.add_place("o")
         >>> _ = net.add_transition("rest", action="core.wait", params={"seconds": 3})
         >>> _ = net.add_arc("i", "rest"); _ = net.add_arc("rest", "o")
-        >>> outcome = run(net)
+        >>> outcome = run(net, keep_events=True)
         >>> outcome.result.time, [e.kind for e in outcome.events]
         (3.0, ['run', 'start', 'end', 'stop'])
     """
+    binding = None
     if not isinstance(net, Net):
         if isinstance(config, (RunConfig, dict)):
             config = config if isinstance(config, RunConfig) else RunConfig.from_dict(config)
-        if world is not None and not isinstance(world, (str, Path)):
-            raise TypeError("with a net file, give the world as a file too")
-        return run_files(net, world=world, config=config, seed=seed, until=until, trace=trace, xes=xes,
-                         registry=registry, max_firings=max_firings, keep_events=keep_events)
+        if world is None or isinstance(world, (str, Path)):
+            return run_files(net, world=world, config=config, seed=seed, until=until, trace=trace, xes=xes,
+                             registry=registry, max_firings=max_firings, keep_events=keep_events)
+        prepared = prepare(net, config=config, registry=registry)  # a file run over a World made in code
+        net, config, binding = prepared.net, prepared.config, prepared.binding
     if isinstance(config, dict):
         config = RunConfig.from_dict(config)
     elif isinstance(config, (str, Path)):
@@ -505,7 +508,7 @@ def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | 
 
         world, close = load_world(world), True
     try:
-        scheduler = Scheduler(net, world=world, config=config, seed=seed, registry=registry)
+        scheduler = Scheduler(net, world=world, config=config, seed=seed, registry=registry, binding=binding)
         return _observed_run(scheduler, net, journal=None, trace=None if trace is None else Path(trace),
                              xes=None if xes is None else Path(xes), progress=False, keep_events=keep_events,
                              until=until, max_firings=max_firings)
