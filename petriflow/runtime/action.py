@@ -242,6 +242,7 @@ class ActionContext:
     _alive: Callable[[str | None], bool] | None = field(default=None, repr=False)
     _agents: Any = field(default=None, repr=False)
     _resources: Any = field(default=None, repr=False)
+    _media: Callable[[str, str | None], Any] | None = field(default=None, repr=False)
     _declared: dict[str, str] | None = field(default=None, repr=False)
 
     @property
@@ -327,6 +328,19 @@ class ActionContext:
         if self._links is None:
             raise PetriflowError(f"{self.transition!r}: no run to look up channel place {place!r} in")
         return self._links(place)
+
+    def medium(self, place: str) -> Any:
+        """What the medium carrying the channel place ``place`` lets this firing's agent
+        ask about it: the view it declares (:meth:`petriflow.runtime.media.Medium.view`:
+        is it quiet, how often this agent reads its buffer...).
+
+        Raises:
+            PetriflowError: no run, ``place`` is not a channel place, or its model offers
+                no view.
+        """
+        if self._media is None:
+            raise PetriflowError(f"{self.transition!r}: no run to look up channel place {place!r} in")
+        return self._media(place, self.agent)
 
     def running(self, agent: str | None) -> bool:
         """Whether ``agent`` runs now: not killed, not waiting to join (what a radio

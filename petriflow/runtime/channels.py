@@ -195,7 +195,7 @@ CHANNEL_MODELS: dict[str, Callable[..., ChannelModel]] = {
 }
 
 
-def build_channel(name: str, spec: dict[str, Any], where: str = "channels") -> ChannelModel:
+def build_channel(name: str, spec: dict[str, Any], where: str = "channels", registry: Any = None) -> ChannelModel:
     """Make a channel model from its run-configuration entry.
 
     Raises:
@@ -206,15 +206,14 @@ def build_channel(name: str, spec: dict[str, Any], where: str = "channels") -> C
     on_loss = spec.pop("on_loss", "drop")
     if on_loss not in ("drop", "notify"):
         raise NetFormatError(f"on_loss is drop or notify, not {on_loss!r}", element=f"{where}.{name}")
+    from petriflow.runtime.registry import default_registry
+
+    registry = registry or default_registry
     cls = CHANNEL_MODELS.get(model) if isinstance(model, str) else None
     if cls is None and isinstance(model, str):
-        from petriflow.runtime.registry import default_registry
-
-        cls = default_registry.channel_model(model)
+        cls = registry.channel_model(model)
     if cls is None:
-        from petriflow.runtime.registry import default_registry
-
-        known = [*CHANNEL_MODELS, *default_registry.channel_names()]
+        known = [*CHANNEL_MODELS, *registry.channel_names()]
         raise NetFormatError(
             f"unknown channel model {model!r}{did_you_mean(str(model), known)}"
             f" (one of {', '.join(known)})",
@@ -287,6 +286,10 @@ def receivers(net: Net) -> dict[str, str | None]:
     return found
 
 
+#: What :meth:`Channels.send` uses for "a medium process decides" (not a delay).
+_PROCESS = object()
+
+
 class Delivery(Scheduled):
     """A message arrives in its channel place (scheduled by :meth:`Channels.send`)."""
 
@@ -334,10 +337,15 @@ class Channels:
         self.rng = random.Random(f"{seed}:channels")
         self.receiver = receivers(run.net)
         self.channel = {p.id: p.channel for p in run.net.places.values() if p.channel is not None}
-        for model in self.models.values():
+        from petriflow.runtime.media import Medium, MediumPort, ProcessClock
+
+        for name, model in self.models.items():
             bind = getattr(model, "bind", None)
             if callable(bind):  # a model that measures the world (walls between agents...)
                 bind(getattr(run, "world", None))
+            if isinstance(model, Medium):  # a process on the run's kernel
+                model.attach(MediumPort(ProcessClock(run.kernel), self._delivered, self._lost,
+                                        random.Random(f"{seed}:medium:{name}"), getattr(run, "world", None)))
 
     def model_for(self, place: str) -> tuple[ChannelModel, str | None]:
         """The model carrying the channel place ``place`` and the agent receiving from it.
@@ -370,10 +378,12 @@ class Channels:
             delay, why = None, "link down"
         elif receiver is not None and not faults.alive(receiver):
             delay, why = None, "receiver not running"
+        elif getattr(model, "process", False):
+            delay, why = _PROCESS, ""
         else:
             delay = model.deliver(message, self.rng)
             why = str(getattr(model, "loss_reason", None) or "channel model") if delay is None else "channel model"
-            if delay is not None and (isinstance(delay, bool) or not isinstance(delay, (int, float))
+            if delay is not None and delay is not _PROCESS and (isinstance(delay, bool) or not isinstance(delay, (int, float))
                                       or not 0 <= delay < math.inf):
                 raise PetriflowError(f"channel {channel!r}: model {type(model).__name__} gave a delay of {delay!r}"
                                      " (a finite number of seconds >= 0, or None for lost)")
@@ -383,6 +393,10 @@ class Channels:
         if delay is None:
             run.emit("message", None, sender, fate=Fate.LOST.value, why=why, **info)
             self._notice(model, place, data, sender, receiver, why, now)
+            return
+        if delay is _PROCESS:  # a medium decides the fate when it happens
+            run.emit("message", None, sender, fate=Fate.SENT.value, **info)
+            model.send(message)
             return
         kernel = run.kernel
         arrival = kernel.ticks_at(now + delay)
@@ -395,6 +409,33 @@ class Channels:
         if getattr(model, "on_loss", "drop") == "notify" and (receiver is None or self.run.faults.alive(receiver)):
             notice = {"lost": True, "why": why, "data": data}
             self.run.kernel.schedule(self.run.kernel.ticks_at(now), Delivery(self, place, notice, sender, notice=True))
+
+    def _delivered(self, message: Message) -> None:
+        """A medium delivers ``message`` now: its token appears in its channel place."""
+        self.run.deliver(message.place, message.data)
+        self.run.emit("message", None, message.sender, fate=Fate.DELIVERED.value, place=message.place,
+                      channel=self.channel[message.place])
+
+    def _lost(self, message: Message, why: str) -> None:
+        """A medium lost ``message`` now (``why``: the reason it gives)."""
+        model, receiver = self.model_for(message.place)
+        self.run.emit("message", None, message.sender, fate=Fate.LOST.value, why=str(why), place=message.place,
+                      channel=self.channel[message.place], receiver=receiver, size=message.size)
+        self._notice(model, message.place, message.data, message.sender, receiver, str(why), self.run.kernel.now)
+
+    def view(self, place: str, agent: str | None) -> Any:
+        """What the medium carrying ``place`` lets ``agent`` ask about it (see
+        :meth:`petriflow.runtime.media.Medium.view`).
+
+        Raises:
+            PetriflowError: ``place`` is not a channel place, or its model is not a
+                medium that offers a view.
+        """
+        model, _ = self.model_for(place)
+        view = getattr(model, "view", None)
+        if view is None:
+            raise PetriflowError(f"channel place {place!r}: its {type(model).__name__} model offers nothing to ask")
+        return view(agent)
 
     def arrive(self, delivery: Delivery) -> None:
         """A message reaches its place: the token appears there (or, if its model

@@ -244,9 +244,10 @@ class RunConfig:
             fail(f"fault {kind}: name one agent, got {entry[kind]!r}")
         return Fault(kind, float(at), entry[kind])
 
-    def channel_models(self) -> dict[str, ChannelModel]:
-        """Fresh channel models for a run (models keep per-run state such as a bus)."""
-        return {name: build_channel(name, spec) for name, spec in self.channels.items()}
+    def channel_models(self, registry: Any = None) -> dict[str, ChannelModel]:
+        """Fresh channel models for a run (models keep per-run state such as a bus);
+        model names not built in are looked up in ``registry`` (default: the run registry)."""
+        return {name: build_channel(name, spec, registry=registry) for name, spec in self.channels.items()}
 
     def check(self, net: Net) -> None:
         """Check that faults name agents and channels name channels of ``net``.

@@ -121,7 +121,7 @@ class Firer:
         ctx = ActionContext(tid, agent, index.params[t], inputs, self.world, self._seed_prefix + str(number),
                             now, now, _reader=self.tokens.read, _links=self.channels.model_for,
                             _alive=self.faults.alive, _agents=self.agents, _resources=self.resources,
-                            _declared=self._declared[t])
+                            _declared=self._declared[t], _media=self.channels.view)
         self.runner.start(t, number, ctx)
 
     def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:

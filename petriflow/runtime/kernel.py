@@ -11,6 +11,12 @@ event, ordered by ``(tick, phase, key)``:
 * phase :data:`APPLY`: something from outside the net's firings: a message delivered
   by a channel, a fault, a link restored. They apply in the order they were
   scheduled.
+* timed events (:meth:`Kernel.schedule_at`): a process of the run (a contended
+  medium, see :mod:`petriflow.runtime.media`) that keeps time finer than a tick. An
+  event at ``seconds`` runs at the first tick at or after it, *before* that tick's
+  polls (it happened before the instant the actions see), ordered among the timed
+  events of the tick by ``(seconds, rank, order)``; one scheduled for the current tick
+  while the tick is processed runs in the same instant.
 
 Components (channels, faults, the scheduler's firings) schedule events; an event
 knows what to do when its time comes (:meth:`Scheduled.apply`); the kernel only
@@ -39,12 +45,14 @@ import heapq
 import math
 from typing import Iterator
 
-__all__ = ["Kernel", "Scheduled", "Deadline", "POLL", "APPLY"]
+__all__ = ["Kernel", "Scheduled", "Deadline", "POLL", "APPLY", "TIMED"]
 
 #: Phase of events that poll running firings (first at a tick, in firing order).
 POLL = 0
 #: Phase of events that change the marking or the agents from outside (after the polls).
 APPLY = 1
+#: Phase of events with an exact time of their own (before the polls of their tick).
+TIMED = -1
 
 
 class Scheduled:
@@ -111,7 +119,8 @@ class Kernel:
         self.tick = 0
         self.pending = 0
         self._ticks: list[int] = []
-        self._buckets: dict[int, tuple[list[tuple[int, int, Scheduled]], list[Scheduled]]] = {}
+        self._buckets: dict[int, tuple[list[tuple[int, int, Scheduled]], list[Scheduled],
+                                       list[tuple[float, int, int, Scheduled]]]] = {}
         self._order = 0
 
     @property
@@ -129,12 +138,7 @@ class Kernel:
         ``key`` orders the polls of one tick (default: scheduling order); applies keep
         the order they were scheduled in.
         """
-        if tick < self.tick:
-            tick = self.tick
-        bucket = self._buckets.get(tick)
-        if bucket is None:
-            bucket = self._buckets[tick] = ([], [])
-            heapq.heappush(self._ticks, tick)
+        bucket = self._bucket(max(tick, self.tick))
         self._order += 1
         if event.phase == POLL:
             bucket[0].append((self._order if key is None else key, self._order, event))
@@ -142,13 +146,40 @@ class Kernel:
             self.pending += 1
             bucket[1].append(event)
 
+    def _bucket(self, tick: int) -> tuple[list, list, list]:
+        bucket = self._buckets.get(tick)
+        if bucket is None:
+            bucket = self._buckets[tick] = ([], [], [])
+            heapq.heappush(self._ticks, tick)
+        return bucket
+
+    def schedule_at(self, seconds: float, event: Scheduled, rank: int = 0) -> None:
+        """Schedule a timed ``event`` at the exact time ``seconds`` (see the module).
+
+        It counts as pending until it runs; whoever makes it not live (cancels it)
+        must count it off (``pending -= 1``), as
+        :class:`~petriflow.runtime.media.ProcessClock` does. ``rank`` orders timed events
+        of equal time (lower first).
+
+        Raises:
+            ValueError: ``seconds`` is not a finite time.
+        """
+        if not math.isfinite(seconds):
+            raise ValueError(f"cannot schedule at {seconds!r}")
+        bucket = self._bucket(max(self.ticks_at(seconds), self.tick))
+        self._order += 1
+        self.pending += 1
+        heapq.heappush(bucket[2], (float(seconds), rank, self._order, event))
+
     def peek(self) -> int | None:
         """The tick of the next live event, or ``None`` when nothing is scheduled."""
         ticks, buckets = self._ticks, self._buckets
         while ticks:
             tick = ticks[0]
-            polls, applies = buckets[tick]
-            if applies:
+            polls, applies, timed = buckets[tick]
+            while timed and not timed[0][3].live(tick):  # cancelled (its canceller counted it off)
+                heapq.heappop(timed)
+            if applies or timed:
                 return tick
             while polls and not polls[-1][2].live(tick):
                 polls.pop()
@@ -161,17 +192,22 @@ class Kernel:
     def due(self) -> bool:
         """Whether events are scheduled at the current tick (and not yet taken)."""
         bucket = self._buckets.get(self.tick)
-        return bucket is not None and bool(bucket[0] or bucket[1])
+        return bucket is not None and bool(bucket[0] or bucket[1] or bucket[2])
 
     def pop_due(self) -> Iterator[tuple[int, Scheduled]]:
-        """Take the live events due at the current tick, in order (polls by key, then
-        applies), as ``(tick, event)``. Applies scheduled for the current tick while
-        iterating are taken too."""
+        """Take the live events due at the current tick, in order (timed events by
+        time, polls by key, then applies), as ``(tick, event)``. Timed events and
+        applies scheduled for the current tick while iterating are taken too."""
         tick = self.tick
         bucket = self._buckets.get(tick)
         if bucket is None:
             return
-        polls, applies = bucket
+        polls, applies, timed = bucket
+        while timed:
+            event = heapq.heappop(timed)[3]
+            if event.live(tick):  # a cancelled one was counted off by its canceller
+                self.pending -= 1
+                yield tick, event
         if polls:
             polls.sort()
             for _, _, event in polls:
@@ -189,4 +225,4 @@ class Kernel:
 
     def __len__(self) -> int:
         """Events scheduled (live or not)."""
-        return sum(len(polls) + len(applies) for polls, applies in self._buckets.values())
+        return sum(len(polls) + len(applies) + len(timed) for polls, applies, timed in self._buckets.values())

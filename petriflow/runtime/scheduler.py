@@ -166,7 +166,8 @@ class Scheduler:
         self.firer = Firer(net, index, kernel, self.tokens, self.enabled_set, self.recorder, self.faults, world,
                            self.seed)
         self.runner = self.firer.runner
-        self.channels = self.firer.channels = Channels(self, self.config.channel_models(), self.seed)
+        self.channels = self.firer.channels = Channels(self, self.config.channel_models(self.registry),
+                                                        self.seed)
         self.resources = self.firer.resources = Resources(
             self.registry, ResourceContext(world, Liveness(self.faults.alive, index.agents), self.config))
         self._started = self._closed = False
