@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from petriflow.runtime.channels import ChannelModel, Message
+from petriflow.runtime.radio import LogDistance, WallCounter
 
 __all__ = ["CALIBRATED_TX_DBM", "RadioChannel", "pick_threshold", "threshold_sweep"]
 
@@ -64,7 +65,8 @@ class RadioChannel(ChannelModel):
 
     def __post_init__(self) -> None:
         self.world: Any = None
-        self._walls: dict[tuple, int] = {}
+        self._walls: Any = None
+        self.path = LogDistance(self.tx_power_dbm, 0.0, self.exponent, min_distance=0.05)
 
     @property
     def sensitivity_dbm(self) -> float:
@@ -75,33 +77,19 @@ class RadioChannel(ChannelModel):
         """The run's world: positions and walls between agents come from it (walls do
         not move, so each pair of places, to the centimetre, is ray-tested once)."""
         self.world = world
-        self._walls = {}
+        self._walls = WallCounter(world, z=self.antenna_z)
 
     def rssi(self, distance: float, walls: int = 0) -> float:
         """Received signal strength (dBm) at ``distance`` m through ``walls`` walls."""
-        return self.tx_power_dbm - 10.0 * self.exponent * math.log10(max(distance, 0.05)) - walls * self.wall_db
+        return self.path.rssi(distance, walls * self.wall_db)
 
     def range(self, walls: int = 0) -> float:
         """Distance (m) at which the RSSI reaches the framework's threshold."""
-        margin = self.tx_power_dbm - walls * self.wall_db - self.threshold_dbm
-        return 10 ** (margin / (10.0 * self.exponent))
+        return self.path.range(self.threshold_dbm, walls * self.wall_db)
 
     def between(self, a: str, b: str) -> tuple[float, int] | None:
         """``(distance, walls)`` between two agents of the bound world, or ``None``."""
-        world = self.world
-        if world is None or not hasattr(world, "position"):
-            return None
-        pa, pb = world.position(a), world.position(b)
-        if pa is None or pb is None:
-            return None
-        from petriflow.agents.mobile.sensors import walls_between
-
-        key = tuple(sorted(((round(pa[0], 2), round(pa[1], 2)), (round(pb[0], 2), round(pb[1], 2)))))
-        walls = self._walls.get(key)
-        if walls is None:
-            ignore = [world.body(name) for name in getattr(world, "agents", {})] or [world.body(a), world.body(b)]
-            walls = self._walls[key] = walls_between(world, pa, pb, z=self.antenna_z, ignore=ignore)
-        return math.dist(pa, pb), walls
+        return None if self._walls is None else self._walls.between(a, b)
 
     def link_rssi(self, a: str, b: str) -> float | None:
         """The RSSI between two agents now, their antennas' gains included (``None``
@@ -146,7 +134,7 @@ def threshold_sweep(model: RadioChannel, distances: Iterable[float], *, walls: i
     rows = []
     for distance in distances:
         loss = (model.concrete_db if concrete else model.wall_db) * walls
-        level = model.tx_power_dbm - 10.0 * model.exponent * math.log10(max(distance, 0.05)) - loss
+        level = model.path.rssi(distance, loss)
         chance = model.loss_probability(level)
         delivered = sum(1 for _ in range(trials) if not (chance >= 1.0 or rng.random() < chance))
         rows.append((distance, delivered / trials, round(level, 4)))

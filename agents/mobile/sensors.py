@@ -16,6 +16,8 @@ import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
+from petriflow.runtime.radio import walls_between  # the one ray-test wall count, in the core
+
 __all__ = ["cast", "laser_angles", "walls_between"]
 
 
@@ -74,28 +76,3 @@ def cast(world: Any, origin: tuple[float, float], heading: float, angles: Sequen
     return ranges
 
 
-def walls_between(world: Any, a: tuple[float, float], b: tuple[float, float], *, z: float = 0.1,
-                  ignore: Iterable[int] = (), most: int = 16) -> int:
-    """How many solid bodies (walls) a straight line from ``a`` to ``b`` crosses, not
-    counting the ``ignore`` bodies (the two robots), at most ``most``."""
-    p = world.p
-    ignored = set(ignore)
-    count = 0
-    start = (a[0], a[1], z)
-    end = (b[0], b[1], z)
-    total = math.dist(start, end)
-    travelled = 0.0
-    while count < most and travelled < total:
-        hit = p.rayTest(start, end, physicsClientId=world.client)[0]
-        if hit[0] < 0:
-            break
-        if hit[0] not in ignored:
-            count += 1
-        step = hit[2] * math.dist(start, end)
-        # continue from just beyond the body's far side: march until out of it
-        direction = ((end[0] - start[0]) / max(math.dist(start, end), 1e-9),
-                     (end[1] - start[1]) / max(math.dist(start, end), 1e-9))
-        advance = step + 0.05
-        travelled += advance
-        start = (start[0] + direction[0] * advance, start[1] + direction[1] * advance, z)
-    return count

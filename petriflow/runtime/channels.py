@@ -136,13 +136,18 @@ class RangeChannel(ChannelModel):
     latency: float = field(default=0.005, metadata={"range": (0.0, 3600.0)})
     bitrate: float = field(default=1e6, metadata={"range": (1e-3, 1e15)})
 
+    def _path(self) -> Any:
+        from petriflow.runtime.radio import LogDistance
+
+        return LogDistance(self.tx_power_dbm, 0.0, self.exponent, min_distance=0.01)
+
     def rssi(self, distance: float) -> float:
         """Received signal strength at ``distance`` metres (dBm)."""
-        return self.tx_power_dbm - 10.0 * self.exponent * math.log10(max(distance, 0.01))
+        return self._path().rssi(distance)
 
     def range(self) -> float:
         """Distance in metres at which the RSSI reaches the threshold."""
-        return round(10 ** ((self.tx_power_dbm - self.threshold_dbm) / (10.0 * self.exponent)), 6)
+        return self._path().range(self.threshold_dbm)
 
     def deliver(self, message: Message, rng: Any) -> float | None:
         if message.distance is not None and self.rssi(message.distance) < self.threshold_dbm:
