@@ -123,18 +123,21 @@ class NetBuilder:
         """``{channel place id: Mailbox}`` in the order the mailboxes were added."""
         return dict(self._mailboxes)
 
-    def agent(self, name: str, *, label: str | None = None, runner: str | None = None) -> AgentBuilder:
+    def agent(self, name: str, *, label: str | None = None, runner: str | None = None,
+              state: str | None = None) -> AgentBuilder:
         """Add an agent: a subnet ``name`` whose elements are named ``f"{name}_{local}"``.
 
         Args:
             name: the subnet's id.
             label: its readable title.
             runner: the agent that runs it (``Subnet.agent``); default ``name``.
+            state: the registered type of the agent's state (``Subnet.state``), if any.
         """
         _check_local(name, "an agent's name")
         _check_text(label, f"agent {name!r}: label")
         _check_text(runner, f"agent {name!r}: runner")
-        self._net.add_subnet(name, label, name if runner is None else runner)
+        _check_text(state, f"agent {name!r}: state")
+        self._net.add_subnet(name, label, name if runner is None else runner, state)
         self._agents[name] = AgentBuilder(self, name)
         return self._agents[name]
 
