@@ -31,3 +31,4 @@ def register(registry) -> None:
         registry.register(name, target, doc=doc)
     for name, function in GUARDS.items():
         registry.predicate(name)(function)
+    registry.register_resource("smart.arena", "petriflow.agents.smart.arena:arena_resource")

@@ -36,6 +36,8 @@ Examples:
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
@@ -47,6 +49,7 @@ __all__ = [
     "add_marker_robot",
     "move_marker_robot",
     "attach_markers",
+    "markers_on",
     "MarkerHat",
     "white_floor",
     "MarkerScene",
@@ -326,7 +329,33 @@ def attach_markers(world: Any, body: int | str, link: int = -1, *, colour: Any =
     p.changeConstraint(constraint, maxForce=1000.0, physicsClientId=client)
     marker = MarkerHat(world, hat, parent, link, offset, float(yaw), constraint, geometry)
     marker.sync()
+    record = {"parent": parent, "link": link, "offset": list(offset), "yaw": float(yaw), "constraint": constraint,
+              "geometry": dataclasses.asdict(geometry)}
+    p.addUserData(hat, _HAT_KEY, json.dumps(record), physicsClientId=client)
     return marker
+
+
+#: The user-data key under which a hat's pybullet body records what it is.
+_HAT_KEY = "petriflow.marker_hat"
+
+
+def markers_on(world: Any, body: int | str) -> list[MarkerHat]:
+    """The marker hats fixed on ``body`` (a name or pybullet id), as
+    :func:`attach_markers` put them: each hat records itself on its own pybullet body,
+    so they are found in the scene, never in attributes kept beside it."""
+    p, client = world.p, world.client
+    parent = world.body(body) if isinstance(body, str) else int(body)
+    found = []
+    for index in range(p.getNumBodies(physicsClientId=client)):
+        hat = p.getBodyUniqueId(index, physicsClientId=client)
+        key = p.getUserDataId(hat, _HAT_KEY, physicsClientId=client)
+        if key < 0:
+            continue
+        record = json.loads(p.getUserData(key, physicsClientId=client))
+        if record["parent"] == parent:
+            found.append(MarkerHat(world, hat, parent, record["link"], tuple(record["offset"]), record["yaw"],
+                                   record["constraint"], MarkerGeometry(**record["geometry"])))
+    return found
 
 
 def white_floor(world: Any) -> None:

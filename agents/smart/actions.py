@@ -96,18 +96,10 @@ def _world(ctx: ActionContext, action: Action) -> Any:
 
 
 class Capture(_VisionCapture):
-    """``vision.capture`` that first dresses its world (white floor, marker hats) once."""
+    """``vision.capture`` of the dressed arena (white floor, marker hats): the
+    ``smart.arena`` resource, which the run makes once before the first firing."""
 
-    def start(self, ctx: ActionContext) -> None:
-        world = _world(ctx, self)
-        if world is not None and hasattr(world, "p"):
-            from petriflow.agents.smart.arena import dress
-
-            try:
-                dress(world)
-            except Exception as exc:  # a malformed meta.smart: a failed outcome with the reason
-                raise ActionFailure(f"smart.capture: {getattr(exc, 'message', None) or exc}") from None
-        super().start(ctx)
+    resources = {"arena": "smart.arena"}
 
 
 def _is_scene(data: Any) -> bool:

@@ -35,7 +35,7 @@ Examples:
     ...                "meta": {"smart": {"markers": [{"robot": "cat", "colour": "yellow"}]}}})
     >>> sorted(dress(world).hats)
     ['cat']
-    >>> dress(world) is dress(world)                 # once per world
+    >>> dress(world).hats["cat"].body == dress(world).hats["cat"].body   # once per world
     True
     >>> robot_colours(world)
     {'cat': 'yellow'}
@@ -50,10 +50,8 @@ from typing import Any
 
 from petriflow.errors import NetFormatError
 
-__all__ = ["Arena", "colour_robots", "dress", "hat_offset", "load_arena", "robot_colours", "unrendered_ground"]
-
-#: Attribute of a world holding its :class:`Arena` once dressed.
-_ATTRIBUTE = "smart_arena"
+__all__ = ["Arena", "arena_resource", "colour_robots", "dress", "hat_offset", "load_arena", "robot_colours",
+           "unrendered_ground"]
 
 
 @dataclass
@@ -138,13 +136,16 @@ def unrendered_ground(world: Any) -> int:
 
 def dress(world: Any) -> Arena:
     """Whiten the floor and put a marker hat on every robot named in the world's
-    ``meta.smart`` (once per world: later calls return the same :class:`Arena`)."""
-    arena = getattr(world, _ATTRIBUTE, None)
-    if arena is not None:
-        return arena
-    from petriflow.vision.markers import attach_markers, white_floor
+    ``meta.smart``, once per world: a world already dressed (its hats are found in the
+    pybullet scene, where each records itself) is not dressed again, and the same
+    :class:`Arena` is described again."""
+    from petriflow.vision.markers import attach_markers, markers_on, white_floor
 
     spec = _spec(world)
+    colours = robot_colours(world)
+    worn = {robot: markers_on(world, world.body(robot)) for robot in colours}
+    if colours and all(worn.values()):
+        return Arena({robot: hats[0] for robot, hats in worn.items()}, dict(colours), spec.get("floor"))
     arena = Arena()
     floor = spec.get("floor")
     if floor is not None:
@@ -156,12 +157,20 @@ def dress(world: Any) -> Arena:
             raise NetFormatError(f"meta.smart.floor: 'white' or 'painted', got {floor!r}",
                                  path=getattr(world, "path", None))
         arena.floor = floor
-    for robot, colour in robot_colours(world).items():
+    for robot, colour in colours.items():
         body = world.body(robot)
         arena.hats[robot] = attach_markers(world, body, colour=colour, offset=hat_offset(world, body))
         arena.colours[robot] = colour
-    setattr(world, _ATTRIBUTE, arena)
     return arena
+
+
+def arena_resource(context: Any) -> Arena | None:
+    """The ``smart.arena`` resource: the run's world dressed once (``None`` without a
+    pybullet world)."""
+    world = context.world
+    if world is None or not hasattr(world, "p"):
+        return None
+    return dress(world)
 
 
 def load_arena(path: str | Path, gui: bool = False, camera_size: tuple[int, int] | None = None) -> Any:

@@ -305,13 +305,16 @@ class Registry:
         """The state keys the guard ``name`` declares it reads (``None``: it reads tokens)."""
         return self._reads.get(name)
 
-    def register_resource(self, name: str, factory: Callable[..., Any], *, replace: bool = False) -> None:
-        """Register a resource type: ``factory(context) -> object`` makes the run's one
-        instance (see :mod:`petriflow.runtime.resources`)."""
-        if name in self._resources and not replace and self._resources[name] is not factory:
+    def register_resource(self, name: str, factory: Callable[..., Any] | str, *, replace: bool = False) -> None:
+        """Register a resource type: ``factory(context) -> object`` (or a lazy
+        ``"module:function"``) makes the run's one instance (see
+        :mod:`petriflow.runtime.resources`)."""
+        old = self._resources.get(name)
+        if old is not None and not replace and _identity(old) != _identity(factory):
             raise PetriflowError(f"resource {name!r} is already registered")
-        if not callable(factory):
-            raise PetriflowError(f"resource {name!r}: the factory must be callable, got {factory!r}")
+        if not callable(factory) and not (isinstance(factory, str) and ":" in factory):
+            raise PetriflowError(f"resource {name!r}: the factory must be callable or 'module:function',"
+                                 f" got {factory!r}")
         self._resources[name] = factory
 
     def resource_factory(self, name: str) -> Callable[..., Any]:
@@ -323,7 +326,14 @@ class Registry:
             if name == LIVENESS:  # made by the run itself
                 return lambda context: context.liveness
             raise self._unknown("resource", name, [*self._resources, LIVENESS])
-        return self._resources[name]
+        factory = self._resources[name]
+        if isinstance(factory, str):
+            module_name, _, attribute = factory.partition(":")
+            try:
+                factory = self._resources[name] = getattr(importlib.import_module(module_name), attribute)
+            except (ImportError, AttributeError) as exc:
+                raise UnknownActionError(f"resource {name!r}: cannot load {factory!r}: {exc}") from None
+        return factory
 
     def register_state(self, name: str, cls: type, *, replace: bool = False) -> None:
         """Register an agent-state type that subnets declare as ``state: NAME``."""

@@ -7,7 +7,7 @@ import pytest
 from petriflow.agents.legged.control import LeggedRobot
 from petriflow.agents.smart.arena import colour_robots, dress, robot_colours
 
-from petriflow.errors import NetFormatError
+from petriflow.errors import NetFormatError, PetriflowError
 from petriflow.io.yaml import loads_net
 from petriflow.testing import fire_one
 from petriflow.world import World
@@ -26,7 +26,7 @@ def hat_error(world, name: str) -> float:
     position, rotation = robot.frame()
     plate = robot.design.plate
     expected = position + rotation @ np.array([0.0, 0.0, plate.centre[2] + plate.size[2] / 2 + 0.001])
-    hat = world.smart_arena.hats[name]
+    hat = dress(world).hats[name]
     actual, _ = world.p.getBasePositionAndOrientation(hat.body, physicsClientId=world.client)
     return float(np.linalg.norm(np.asarray(actual) - expected))
 
@@ -34,7 +34,8 @@ def hat_error(world, name: str) -> float:
 def test_dress_puts_one_hat_per_declared_robot_once(arena):
     world = arena(settle=0.0)
     first = dress(world)
-    assert dress(world) is first
+    again = dress(world)  # found in the scene, not dressed twice
+    assert {r: h.body for r, h in again.hats.items()} == {r: h.body for r, h in first.hats.items()}
     assert first.colours == {"robot3l": "yellow", "robot4l": "red"}
     assert robot_colours(world) == first.colours
     assert colour_robots(world) == {"yellow": "robot3l", "red": "robot4l"}
@@ -65,7 +66,7 @@ def test_hats_sit_on_the_robots_whatever_their_pose(arena):
     assert hat_error(world, "robot3l") < 0.001
     assert hat_error(world, "robot4l") < 0.002
     _, rotation = LeggedRobot(world, "robot4l").frame()
-    hat = world.smart_arena.hats["robot4l"]
+    hat = dress(world).hats["robot4l"]
     _, orientation = world.p.getBasePositionAndOrientation(hat.body, physicsClientId=world.client)
     hat_up = np.array(world.p.getMatrixFromQuaternion(orientation)).reshape(3, 3)[:, 2]
     assert hat_up @ rotation[:, 2] > 0.999          # the fallen robot's hat faces sideways with its plate
@@ -94,8 +95,9 @@ def test_malformed_arena_data_is_an_error(meta, match):
         world.close()
 
 
-def test_smart_capture_fails_with_the_reason_on_bad_arena_data():
-    """smart.capture (T0) reports a malformed meta.smart as a failed outcome."""
+def test_bad_arena_data_stops_the_run_before_it_starts():
+    """smart.capture uses the smart.arena resource, which the run makes before the first
+    firing: a malformed meta.smart is bad input, one error naming the field."""
     net = loads_net("""
 petriflow: 1
 places: [{id: a, tokens: 1}, b, bad]
@@ -103,7 +105,7 @@ transitions: [{id: t, action: smart.capture, in: [a], out: [b], outcomes: {faile
 """)
     world = World({"meta": {"smart": {"floor": "blue"}}, "cameras": [{"id": "top", "width": 32, "height": 24}]})
     try:
-        fired = fire_one(net, "t", world=world)
+        with pytest.raises(PetriflowError, match="resource smart.arena: meta.smart.floor: 'white' or 'painted'"):
+            fire_one(net, "t", world=world)
     finally:
         world.close()
-    assert fired.outcome == "failed" and "floor" in fired.reason

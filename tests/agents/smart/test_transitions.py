@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from petriflow.agents.smart.arena import dress
+
 import math
 
 import numpy as np
@@ -37,7 +39,7 @@ def test_t0_dresses_the_arena_and_takes_the_first_image(net, arena):
     frame = fired.tokens["P1"][0]
     assert frame.shape == (240, 320, 3) and frame.dtype == np.uint8
     assert (frame[5, 5] == 255).all()                      # the floor is white
-    assert set(world.smart_arena.hats) == {"robot3l", "robot4l"}
+    assert set(dress(world).hats) == {"robot3l", "robot4l"}
 
 
 def test_t1_sends_the_image_in_a_frame_time(net):
