@@ -140,6 +140,7 @@ class Registry:
         self._plugins_pending = load_plugins
         #: ``{entry point: error}`` of the plugins that failed to load.
         self.broken: dict[str, str] = {}
+        _register_core(self)  # core.wait, core.fail, ... and the core metrics: in every registry
 
     # Registering --------------------------------------------------------------------
     def register(self, name: str, target: type[Action] | str, *, doc: str = "",
@@ -357,18 +358,19 @@ class Registry:
         return bind(net, self, path=path)
 
 
-default_registry = Registry()
-"""The registry ``petriflow run`` uses: built-in core actions plus installed plugins."""
-
-
-def _register_core(registry: Registry) -> None:
+def _register_core(registry: "Registry") -> None:
+    """Register the core actions and metrics (every registry has them)."""
     from petriflow.runtime import builtin, metrics
 
     builtin.register(registry)
     metrics.register(registry)
 
 
-_register_core(default_registry)
+default_registry = Registry()
+"""The registry ``petriflow run`` uses: built-in core actions plus installed plugins."""
+
+
+
 
 
 def action(name: str, params: dict[str, Param] | None = None, *, needs_world: bool = False,

@@ -130,7 +130,7 @@ class Scheduler:
         net: the net to run.
         world: a :class:`petriflow.world.World` or any object with ``dt``,
             ``step()`` and optionally ``distance(a, b)``; ``None`` for a world-less run.
-        config: faults, channel models, limits (:class:`RunConfig`).
+        config: faults, channel models, limits (:class:`RunConfig`, or its mapping).
         seed: seed of conflict resolution, action randomness and channel losses
             (overrides ``config.seed`` when given).
         registry: where action and guard names are looked up (when no ``binding``).
@@ -144,12 +144,12 @@ class Scheduler:
             channel of the configuration names nothing in the net.
     """
 
-    def __init__(self, net: Net, *, world: Any = None, config: RunConfig | None = None, seed: int | None = None,
+    def __init__(self, net: Net, *, world: Any = None, config: RunConfig | dict | None = None, seed: int | None = None,
                  registry: Registry | None = None, path: str | None = None, binding: Binding | None = None,
                  clock: Clock | None = None) -> None:
         self.net = net
         self.world = world
-        self.config = config or RunConfig()
+        self.config = RunConfig.from_dict(config) if isinstance(config, dict) else config or RunConfig()
         self.seed = self.config.seed if seed is None else seed
         self.binding = binding if binding is not None else bind(net, registry, path=path)
         self.registry = self.binding.registry
