@@ -108,6 +108,9 @@ class Binding:
     registry: Registry
     transitions: dict[str, BoundTransition]
     unchecked: tuple["Unchecked", ...] = ()
+    #: Whether :func:`petriflow.runtime.assembly.validate` checked the run's inputs
+    #: against this binding (so nothing checks them again).
+    checked: bool = False
 
     def actions(self) -> dict[str, type[Action]]:
         """``{transition id: Action class}`` of the bound transitions."""

@@ -18,8 +18,8 @@ Examples:
     >>> @registry.action("demo.hello", params={"name": Param(str, "robot")})
     ... def hello(ctx):
     ...     return "hello " + ctx.params["name"]
-    >>> registry.names()
-    ['demo.hello']
+    >>> registry.names()   # the core actions are in every registry
+    ['core.fail', 'core.noop', 'core.set', 'core.wait', 'demo.hello']
     >>> registry.resolve("demo.helo")
     Traceback (most recent call last):
     ...

@@ -70,7 +70,8 @@ from petriflow.marking import Marking
 from petriflow.net import Net
 from petriflow.outcome import StopReason
 from petriflow.runtime.action import Action
-from petriflow.runtime.binding import Binding, bind, check_sizes
+from petriflow.runtime.assembly import validate
+from petriflow.runtime.binding import Binding
 from petriflow.runtime.channels import Channels
 from petriflow.runtime.clock import Clock, SimulatedClock
 from petriflow.runtime.config import RunConfig
@@ -151,10 +152,8 @@ class Scheduler:
         self.world = world
         self.config = RunConfig.from_dict(config) if isinstance(config, dict) else config or RunConfig()
         self.seed = self.config.seed if seed is None else seed
-        self.binding = binding if binding is not None else bind(net, registry, path=path)
+        self.binding = validate(net, self.config, binding=binding, registry=registry, path=path)
         self.registry = self.binding.registry
-        self.config.check(net)
-        check_sizes(net, path)
         self.clock = clock or SimulatedClock()
         kernel = self.kernel = Kernel(float(getattr(world, "dt", None) or self.config.dt))
         index = self.index = RunIndex(net, self.binding)

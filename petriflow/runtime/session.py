@@ -41,7 +41,8 @@ from typing import Any, TextIO
 
 from petriflow.errors import NetFormatError
 from petriflow.net import Net
-from petriflow.runtime.binding import Binding, bind, check_sizes, check_world
+from petriflow.runtime.assembly import open_run, validate
+from petriflow.runtime.binding import Binding, bind
 from petriflow.runtime.config import RunConfig, load_config
 from petriflow.runtime.journal import Journal, JournalError
 from petriflow.runtime.registry import Registry
@@ -229,15 +230,6 @@ def _world_data(inputs: dict[str, Any]) -> dict[str, Any] | None:
     return check_world(data, inputs["world_file"])
 
 
-def _world_from(inputs: dict[str, Any], gui: bool):
-    data = _world_data(inputs)
-    if data is None:
-        return None
-    from petriflow.world import World
-
-    return World(data, base=inputs["world_base"], gui=gui, path=inputs["world_file"])
-
-
 def _check_outputs(outputs: dict[str, str | Path | None], read: list[Path | str | None]) -> None:
     """Refuse two outputs on one file, an output that is one of the run's inputs, and an
     output whose folder cannot be made or written (before anything is created).
@@ -328,17 +320,11 @@ def _observed_run(scheduler: Scheduler, net: Net, *, journal: Journal | None, tr
 def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, Any], *,
              journal: Journal | None, trace: Path | None, xes: Path | None, realtime: bool, gui: bool,
              progress: bool, max_firings: int | None, keep_events: bool = False) -> RunOutcome:
-    world = _world_from(inputs, gui)
-    try:
-        from petriflow.runtime.clock import RealtimeClock, SimulatedClock
-
-        scheduler = Scheduler(net, world=world, config=config, seed=inputs["seed"], binding=binding,
-                              clock=RealtimeClock() if realtime else SimulatedClock())
+    with open_run(net, binding, config, seed=inputs["seed"], world_data=_world_data(inputs),
+                  world_file=inputs.get("world_file"), world_base=inputs.get("world_base"), gui=gui,
+                  realtime=realtime) as scheduler:
         outcome = _observed_run(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
                                 keep_events=keep_events, until=inputs["until"], max_firings=max_firings)
-    finally:
-        if world is not None:
-            world.close()
     if journal is not None:
         journal.finish()
         outcome.written.append(str(journal.path))
@@ -387,7 +373,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     """
     net_path = Path(net_path)
     prepared = prepare(net_path, config=config, world=world, registry=registry)
-    check_world(prepared.binding, prepared.world is not None, str(net_path))
+    binding = validate(prepared.net, prepared.config, binding=prepared.binding, path=str(net_path),
+                       has_world=prepared.world is not None)
     inputs = _inputs(prepared, net_path, seed, until)
     inputs["max_firings"] = max_firings
     inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())
@@ -396,12 +383,11 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     # must never hold a run that cannot start)
     _check_outputs({"--trace": trace, "--xes": xes, "--db": db},
                    [net_path, prepared.world, prepared.config.path])
-    check_sizes(prepared.net, str(net_path))
     _world_data(inputs)
     _make_folders(trace, xes, db)
     journal = Journal(db, inputs) if db is not None else None
     try:
-        return _execute(prepared.net, prepared.binding, prepared.config, inputs, journal=journal,
+        return _execute(prepared.net, binding, prepared.config, inputs, journal=journal,
                         trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
                         realtime=realtime, gui=gui, progress=progress, max_firings=max_firings,
                         keep_events=keep_events)
@@ -443,9 +429,7 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
         except NetFormatError as exc:
             raise JournalError(f"{db}: a damaged journal: its run configuration: {exc}") from None
         config.import_actions()
-        binding = bind(net, registry, path=inputs["net_file"])
-        check_sizes(net, inputs["net_file"])
-        config.check(net)
+        binding = validate(net, config, registry=registry, path=inputs["net_file"])
         return _execute(net, binding, config, inputs, journal=journal,
                         trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
                         realtime=realtime, gui=gui, progress=progress, max_firings=inputs.get("max_firings"))
@@ -508,10 +492,11 @@ def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | 
 
         world, close = load_world(world), True
     try:
-        scheduler = Scheduler(net, world=world, config=config, seed=seed, registry=registry, binding=binding)
-        return _observed_run(scheduler, net, journal=None, trace=None if trace is None else Path(trace),
-                             xes=None if xes is None else Path(xes), progress=False, keep_events=keep_events,
-                             until=until, max_firings=max_firings)
+        binding = validate(net, config, binding=binding, registry=registry)
+        with open_run(net, binding, config, seed=seed, world=world) as scheduler:
+            return _observed_run(scheduler, net, journal=None, trace=None if trace is None else Path(trace),
+                                 xes=None if xes is None else Path(xes), progress=False, keep_events=keep_events,
+                                 until=until, max_firings=max_firings)
     finally:
         if close:
             world.close()

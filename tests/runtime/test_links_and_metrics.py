@@ -58,11 +58,9 @@ class Judge(Action):
 
 @pytest.fixture
 def registry():
-    registry = Registry(load_plugins=False)
+    registry = Registry(load_plugins=False)  # the core actions are in every registry
     registry.register("test.judge", Judge)
-    from petriflow.runtime import builtin
-
-    builtin.register(registry)
+    registry.register_channel("test.walled", Walled)  # a run resolves its channel models in its registry
     return registry
 
 
