@@ -18,6 +18,15 @@ the best of ``--repeat`` runs counts, for every configuration alike.
   them, ``petriflow simulate NET --steps F`` (which prints every firing) and
   ``petriflow run NET --max-firings F``, start-up and loading included. Target:
   ``petriflow run`` >= 25 % of ``petriflow simulate`` at N = 1000.
+* **SimPy**: the lockstep model in SimPy (https://simpy.readthedocs.io), the usual
+  Python discrete-event simulator: N processes, each a loop of three
+  ``env.timeout(1)``, run until as many timeouts have fired as the runtime fires
+  transitions (one timeout, one event: one ``core.wait`` firing); events per
+  wall-clock second, and the runtime's lockstep firings/s as a share of it, measured
+  in the same run, fresh process and round-robin like the others. SimPy knows no
+  tokens, places, guards or actions: the share is what the net's machinery costs
+  over a bare event queue. Left out, with a line saying so, when SimPy is not
+  installed (``pip install simpy``; it is in the ``dev`` extras).
 * **Messages**: N agents in pairs, each sending the other a message through an
   ``ideal`` channel place, waiting 1 s, N = 10 and 1000. Target: the same flatness.
 * **Trace**: the lockstep nets again with a JSON Lines trace written.
@@ -74,6 +83,39 @@ def messages_net(n: int) -> str:
     return "\n".join(lines) + "\n"
 
 
+def simpy_agents(n: int, events: int) -> dict:
+    """The lockstep model in SimPy: ``n`` processes, each a loop of three 1 s timeouts,
+    run until ``events`` timeouts have fired (each counted when its process resumes)."""
+    import simpy
+
+    env = simpy.Environment()
+    done = env.event()
+    fired = 0
+
+    def agent():
+        nonlocal fired
+        while True:
+            for _ in range(3):  # the three core.wait transitions of one agent's cycle
+                yield env.timeout(1.0)
+                fired += 1
+                if fired == events:
+                    done.succeed()
+
+    for _ in range(n):
+        env.process(agent())
+    started = time.perf_counter()
+    env.run(until=done)
+    return {"seconds": time.perf_counter() - started, "firings": fired, "simulated": env.now}
+
+
+def have_simpy() -> bool:
+    try:
+        import simpy  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 # One measurement, in this process ---------------------------------------------------------
 def _measure(kind: str, n: int, firings: int, folder: str) -> dict:
     from petriflow.engine import Simulation
@@ -98,6 +140,8 @@ def _measure(kind: str, n: int, firings: int, folder: str) -> dict:
             scheduler.run(max_firings=count)
             marks.append([count, _rss_mib()])
         return {"rss_mib": marks}
+    if kind == "simpy":
+        return simpy_agents(n, firings)
     text = {"lockstep": agents_net(n), "staggered": agents_net(n, stagger=True), "messages": messages_net(n),
             "trace": agents_net(n), "simulate": agents_net(n)}[kind]
     net = loads_net(text)
@@ -214,7 +258,9 @@ def main(argv: list[str] | None = None) -> dict:
     firings = 3_000 if quick else 200_000
     sizes = (1, 10) if quick else (1, 10, 100, 1000)
     pairs = (10,) if quick else (10, 1000)
-    configurations = [(kind, n) for n in sizes for kind in ("lockstep", "staggered", "simulate")]
+    peer = have_simpy()
+    configurations = [(kind, n) for n in sizes
+                      for kind in ("lockstep", "staggered", "simulate") + (("simpy",) if peer else ())]
     configurations += [(kind, n) for n in pairs for kind in ("messages", "trace")]
     best = measure_all(configurations, firings, repeat)
     results: dict = {
@@ -222,6 +268,8 @@ def main(argv: list[str] | None = None) -> dict:
         "messages": {n: best[("messages", n)] for n in pairs},
         "trace": {n: best[("trace", n)] for n in pairs},
     }
+    if peer:
+        results["simpy"] = {n: best[("simpy", n)] for n in sizes}
     results["cli"] = cli(sizes[-1], firings, 1 if quick else 3)
     results["memory"] = _one("memory", 10 if quick else 100, 20_000 if quick else 1_000_000)
     results["load"] = measure_all([("load", 10 if quick else 1000)], 0, 1 if quick else 3)[("load", 10 if quick else 1000)]
@@ -239,6 +287,15 @@ def main(argv: list[str] | None = None) -> dict:
         stagger = scaling[1000]["staggered"]["per_second"] / scaling[1000]["lockstep"]["per_second"]
         print(f"\nN = 1000 ÷ N = 10 (lockstep): {ratio:.2f} (target >= 0.5); staggered ÷ lockstep at"
               f" N = 1000: {stagger:.2f} (target >= 1)")
+    if peer:
+        print("\n| agents N | petriflow lockstep firings/s | SimPy events/s (3 timeouts of 1 s a process) |"
+              " petriflow ÷ SimPy |")
+        print("|---:|---:|---:|---:|")
+        for n, row in results["simpy"].items():
+            ours, theirs = scaling[n]["lockstep"]["per_second"], row["per_second"]
+            print(f"| {n} | {ours:,.0f} | {theirs:,.0f} | {ours / theirs:.0%} |")
+    else:
+        print("\nSimPy peer left out: SimPy is not installed (pip install simpy)")
     command = results["cli"]
     print(f"\ncommands at N = {sizes[-1]} ({firings:,} firings, start-up, loading and output included):"
           f" petriflow simulate {command['simulate']['per_second']:,.0f} firings/s, petriflow run"

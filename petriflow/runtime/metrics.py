@@ -5,8 +5,9 @@ each is a function ``f(record, **params)`` of a :class:`RunRecord` (the run's re
 its events, the final tokens, the world, the run configuration) that returns a number,
 a string, ``None`` (not measured in this run), or a flat ``{key: number}`` mapping
 (reported as ``name.key``). A metric depends only on what the run did, never on the
-wall clock, unless its name says so (``core.wall_s``), so the same (net, parameters,
-seed) gives the same value on every machine and backend.
+wall clock, unless it is registered ``wall_clock=True`` (``core.wall_s``,
+``core.cpu_s_per_sim_s``: reports mark them), so the same (net, parameters, seed) gives
+the same value on every machine and backend.
 
 Register one with :func:`petriflow.metric` (or ``registry.metric``) in an action
 module or a plugin; ``events=True`` makes the run keep its events in memory for it::
@@ -32,8 +33,10 @@ Core metrics:
 ``core.messages``          messages sent / delivered / lost / bytes (``channel``, ``agent``)
 ``core.messages_per_channel``  the same per channel (``radio.sent``, ...)
 ``core.messages_per_agent``    the same per sending agent (``robot1.sent``, ...)
-``core.wall_s``            wall-clock seconds of the run (the one metric that is not
-                           reproducible)
+``core.wall_s``            wall-clock seconds of the run (not reproducible)
+``core.cpu_s_per_sim_s``   CPU seconds the run took per simulated second (not
+                           reproducible): :attr:`RunRecord.cpu` over ``core.end_time``;
+                           ``None`` when the run took no simulated time
 =========================  =============================================================
 
 Examples:
@@ -56,7 +59,7 @@ from typing import Any
 
 from petriflow.errors import PetriflowError
 
-__all__ = ["RunRecord", "register", "messages", "messages_per_agent", "messages_per_channel"]
+__all__ = ["RunRecord", "register", "messages", "messages_per_agent", "messages_per_channel", "cpu_s_per_sim_s"]
 
 
 @dataclass
@@ -72,6 +75,13 @@ class RunRecord:
         seed: the run seed.
         wall: wall-clock seconds the run took.
         scheduler: the scheduler, for anything else (channels, faults, agents).
+        cpu: CPU seconds the run took (``time.process_time()`` around the scheduler's
+            run, from entering it to closing it): user and system time of every thread
+            of the trial's process, so the scheduler, the actions, the world's physics,
+            the channels and keeping the events a metric asked for; not the imports,
+            reading and binding the net, loading the world, building the scheduler, or
+            computing metrics, nor the sweep's parent process. ``None`` when not
+            measured (a record built outside a sweep trial).
     """
 
     result: Any = None
@@ -82,6 +92,7 @@ class RunRecord:
     seed: int | None = None
     wall: float = 0.0
     scheduler: Any = None
+    cpu: float | None = None
 
     @property
     def tokens(self) -> dict[str, list[Any]]:
@@ -189,8 +200,8 @@ def _count(record: RunRecord, key) -> dict[Any, Counter]:
             continue
         counter = counts.setdefault(group, Counter(sent=0, delivered=0, lost=0, bytes=0))
         fate = event.data.get("fate")
-        if fate == "sent" or (fate == "lost" and not event.data.get("revoked")):
-            # every message put into a channel is sent or lost then (a revoked one was sent)
+        if fate == "sent" or (fate == "lost" and not event.data.get("in_flight")):
+            # every message put into a channel is sent or lost then (one a medium lost in flight was sent)
             counter["sent"] += 1
             counter["bytes"] += event.data.get("size", 0)
         if fate in ("delivered", "lost"):
@@ -225,6 +236,15 @@ def wall_s(record: RunRecord) -> float:
     return record.wall
 
 
+def cpu_s_per_sim_s(record: RunRecord) -> float | None:
+    """CPU seconds of the run per simulated second (not reproducible: depends on the
+    machine and its load); ``None`` when the CPU time was not measured or the run took
+    no simulated time."""
+    if record.cpu is None or not record.result.time > 0:
+        return None
+    return record.cpu / record.result.time
+
+
 def register(registry: Any) -> None:
     """Register the core metrics in ``registry``."""
     for name, function, events in (
@@ -241,5 +261,7 @@ def register(registry: Any) -> None:
         ("core.messages_per_channel", messages_per_channel, True),
         ("core.messages_per_agent", messages_per_agent, True),
         ("core.wall_s", wall_s, False),
+        ("core.cpu_s_per_sim_s", cpu_s_per_sim_s, False),
     ):
-        registry.register_metric(name, function, events=events, wall_clock=name == "core.wall_s")
+        registry.register_metric(name, function, events=events,
+                                 wall_clock=name in ("core.wall_s", "core.cpu_s_per_sim_s"))

@@ -13,6 +13,11 @@ A trial applies the sweep's ``set:`` targets with the row's parameters substitut
 * ``net.transitions.ID.params.KEY`` into a transition's action parameters, and
   ``net.initial.PLACE`` into the initial marking.
 
+The run's wall-clock seconds (``RunRecord.wall``) and CPU seconds (``RunRecord.cpu``,
+``time.process_time()``) are measured around the scheduler's run only, from entering it
+to closing it: not the imports, reading and binding the net, loading the world,
+building the scheduler, or computing the metrics.
+
 Examples:
     >>> data = {"robots": [{"name": "r1", "position": [0, 0]}]}
     >>> set_path(data, "robots.0.position", [1, 2], "world")
@@ -226,11 +231,13 @@ def _measure(spec: dict[str, Any], params: dict[str, Any], seed: int) -> tuple[d
         events: list[Any] = []
         if any(m.events for _, m, _ in built.metrics):
             scheduler.on_event(events.append)
-        started = wallclock.perf_counter()
+        # wall and CPU time of the run itself (RunRecord.cpu says what that includes)
+        started, cpu_started = wallclock.perf_counter(), wallclock.process_time()
         with scheduler:
             result = scheduler.run()
+        cpu = wallclock.process_time() - cpu_started
         wall = wallclock.perf_counter() - started
-        record = RunRecord(result, events, world, built.config, dict(params), seed, wall, scheduler)
+        record = RunRecord(result, events, world, built.config, dict(params), seed, wall, scheduler, cpu)
         measured: dict[str, Any] = {}
         for name, metric, args in built.metrics:
             try:
