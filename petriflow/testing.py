@@ -199,8 +199,10 @@ def check_action(cls: type[Action], params: Mapping[str, Any] | None = None, wor
     except Exception as exc:
         return [f"parameters do not check: {exc}"]
     action = cls(checked)
-    ctx = ActionContext(transition="check", agent=None, params=checked, inputs={}, world=world,
-                        seed=0, started=0.0, _reader=lambda place: [])
+    from types import SimpleNamespace
+
+    ctx = ActionContext(transition="check", agent=None, params=checked, inputs={}, world=world, seed=0,
+                        started=0.0, _run=SimpleNamespace(tokens=SimpleNamespace(read=lambda place: [])))
     hook = "setup"
     try:
         action.setup(world)

@@ -237,13 +237,14 @@ class ActionContext:
     reason: str = ""
     emitted: list[tuple[str, dict[str, Any]]] | None = None
     _rng: random.Random | None = field(default=None, repr=False)
-    _reader: Callable[[str], list[Any]] | None = field(default=None, repr=False)
-    _links: Callable[[str], tuple[Any, str | None]] | None = field(default=None, repr=False)
-    _alive: Callable[[str | None], bool] | None = field(default=None, repr=False)
-    _agents: Any = field(default=None, repr=False)
-    _resources: Any = field(default=None, repr=False)
-    _media: Callable[[str, str | None], Any] | None = field(default=None, repr=False)
+    _run: Any = field(default=None, repr=False)  # the run's services (RunServices), None outside a run
     _declared: dict[str, str] | None = field(default=None, repr=False)
+
+    def _service(self, name: str, what: str) -> Any:
+        service = getattr(self._run, name, None)
+        if service is None:
+            raise PetriflowError(f"{self.transition!r}: no run to {what}")
+        return service
 
     @property
     def rng(self) -> random.Random:
@@ -260,15 +261,12 @@ class ActionContext:
         :mod:`petriflow.runtime.agents`); it must be of the type the agent's subnet
         declares, if it declares one.
         """
-        if self._agents is None:
-            raise PetriflowError(f"{self.transition!r}: no run to keep an agent state in")
-        return self._agents.state(self.agent)
+        return self._service("agents", "keep an agent state in").state(self.agent)
 
     @state.setter
     def state(self, value: Any) -> None:
-        if self._agents is None:
-            raise PetriflowError(f"{self.transition!r}: no run to keep an agent state in")
-        self._agents.set_state(self.agent, value, self._agents.index.state_type.get(self.agent))
+        agents = self._service("agents", "keep an agent state in")
+        agents.set_state(self.agent, value, agents.index.state_type.get(self.agent))
 
     def resource(self, name: str) -> Any:
         """The run's resource the action declares as ``name`` (its ``resources``).
@@ -280,9 +278,7 @@ class ActionContext:
         if kind is None:
             raise PetriflowError(f"{self.transition!r}: the action declares no resource {name!r}"
                                  f"{did_you_mean(name, self._declared or {})}")
-        if self._resources is None:
-            raise PetriflowError(f"{self.transition!r}: no run to take resource {name!r} from")
-        return self._resources.get(kind)
+        return self._service("resources", f"take resource {name!r} from").get(kind)
 
     @property
     def elapsed(self) -> float:
@@ -309,9 +305,7 @@ class ActionContext:
         place = self.params.get(port)
         if place is None:
             return []
-        if self._reader is None:
-            raise PetriflowError(f"{self.transition!r}: no run to read port {port!r} from")
-        return self._reader(place)
+        return self._service("tokens", f"read port {port!r} from").read(place)
 
     def latest(self, port: str, default: Any = None) -> Any:
         """The data of the newest token in the port's place, or ``default``."""
@@ -325,9 +319,7 @@ class ActionContext:
         Raises:
             PetriflowError: no run, or ``place`` is not a channel place.
         """
-        if self._links is None:
-            raise PetriflowError(f"{self.transition!r}: no run to look up channel place {place!r} in")
-        return self._links(place)
+        return self._service("channels", f"look up channel place {place!r} in").model_for(place)
 
     def medium(self, place: str) -> Any:
         """What the medium carrying the channel place ``place`` lets this firing's agent
@@ -338,14 +330,12 @@ class ActionContext:
             PetriflowError: no run, ``place`` is not a channel place, or its model offers
                 no view.
         """
-        if self._media is None:
-            raise PetriflowError(f"{self.transition!r}: no run to look up channel place {place!r} in")
-        return self._media(place, self.agent)
+        return self._service("channels", f"look up channel place {place!r} in").view(place, self.agent)
 
     def running(self, agent: str | None) -> bool:
         """Whether ``agent`` runs now: not killed, not waiting to join (what a radio
         learns from an agent's beacon). ``True`` outside a run."""
-        return True if self._alive is None else self._alive(agent)
+        return True if self._run is None else self._run.faults.alive(agent)
 
     def put(self, place: str, data: Any) -> None:
         """Give the tokens this firing produces in ``place`` the data ``data`` instead

@@ -96,6 +96,10 @@ class Agents:
                 else:
                     self._readers.setdefault(agent, {}).setdefault(key, []).append(t)
 
+    def any_readers(self, agent: str | None) -> bool:
+        """Whether ``agent`` has guards that read anything of its state (``"*"``)."""
+        return agent is not None and bool(self._any.get(agent))
+
     def state(self, agent: str | None) -> Any:
         """The state of ``agent`` (``None`` when it has none yet)."""
         return None if agent is None else self.states.get(agent)

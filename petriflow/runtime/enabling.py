@@ -118,15 +118,25 @@ class EnabledSet:
                              f" {reason_of(exc)}") from exc
 
     def refresh(self) -> None:
-        """Check the dirty transitions again."""
+        """Check the dirty transitions again (:meth:`can_fire`, with its common case,
+        a running transition or one short of tokens, decided inline)."""
         dirty = self.dirty
         if dirty:
-            agenda, can_fire = self.agenda, self.can_fire
+            agenda, can_fire, running = self.agenda, self.can_fire, self.running
+            counts, row, pre = self.tokens.counts, self.index.row, self.index.compiled.pre
             for t in dirty:
-                if can_fire(t):
-                    agenda.add(t)
-                else:
+                if t in running:
                     agenda.discard(t)
+                    continue
+                for p, w in pre[row[t]]:
+                    if counts[p] < w:
+                        agenda.discard(t)
+                        break
+                else:
+                    if can_fire(t):
+                        agenda.add(t)
+                    else:
+                        agenda.discard(t)
             dirty.clear()
 
     def pick(self, draw: Callable[[], float]) -> int | None:

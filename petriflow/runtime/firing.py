@@ -72,6 +72,16 @@ class Firer:
         self.channels: Channels | None = None  # set by the run once made (channels need the run)
         self.resources: Any = None  # set by the run (petriflow.runtime.resources.Resources)
         self._declared = [getattr(cls, "resources", None) or None for cls in index.action_class]
+        compiled, consumers = index.compiled, index.consumers
+        # per transition, what a firing marks for re-checking: the consumers of the places
+        # it takes from or empties (itself among them; the tuples are shared, not copied)
+        self._touched = [tuple(consumers[p] for p in (*(p for p, _ in compiled.pre[index.row[t]]),
+                                                      *compiled.reset[index.row[t]])) + ((t,),)
+                         for t in range(len(index.ids))]
+        self._acts = [self.agents.any_readers(index.agent[t]) for t in range(len(index.ids))]
+        # per compiled row, the consumers of its non-channel output places
+        self._fed = [tuple(consumers[p] for p, _ in compiled.post[r] if not index.channel[p])
+                     for r in range(len(compiled.transitions))]
         self.count = 0
         self.progress = 0
         self.limit: int | None = None
@@ -81,12 +91,14 @@ class Firer:
 
     def fire_instant(self) -> None:
         """Fire until nothing more can fire at this instant (or the firing limit)."""
-        limit, pick, draw = self.limit, self.enabled.pick, self._rng.random
+        limit, draw, enabled = self.limit, self._rng.random, self.enabled
+        agenda, dirty, refresh, fire = enabled.agenda, enabled.dirty, enabled.refresh, self.fire
         while limit is None or self.count < limit:
-            t = pick(draw)
-            if t is None:
+            if dirty:
+                refresh()
+            if not agenda:
                 return
-            self.fire(t)
+            fire(agenda.pick(draw))
             self.now_count += 1
             if self.now_count > limits.FIRINGS_PER_INSTANT:
                 raise ZenoError(f"more than {limits.FIRINGS_PER_INSTANT} firings at t={self.kernel.now:g}s"
@@ -94,34 +106,31 @@ class Firer:
 
     def fire(self, t: int) -> None:
         """Fire transition index ``t`` now: consume, cancel its region, start its action."""
-        index, enabled, recorder = self.index, self.enabled, self.recorder
-        tid, agent, row = index.ids[t], index.agent[t], index.row[t]
+        index, recorder = self.index, self.recorder
+        tid, agent = index.ids[t], index.agent[t]
         self.count += 1
         number = self.count
-        self.progress = self.kernel.tick
-        inputs, withdrawn = self.tokens.consume(row)
-        compiled = index.compiled
-        for p, _ in compiled.pre[row]:
-            enabled.mark_place(p)
-        for p in compiled.reset[row]:
-            enabled.mark_place(p)
-        enabled.dirty.add(t)
-        self.agents.acted(agent)
-        if recorder.active:
+        kernel = self.kernel
+        self.progress = kernel.tick
+        inputs, withdrawn = self.tokens.consume(index.row[t])
+        dirty = self.enabled.dirty
+        for group in self._touched[t]:
+            dirty.update(group)
+        if self._acts[t]:
+            self.agents.acted(agent)
+        if recorder.handlers:
             details: dict[str, Any] = {"firing": number, "consumed": {p: len(v) for p, v in inputs.items()}}
             carried = {p: [summarize(d) for d in v] for p, v in inputs.items() if any(d is not None for d in v)}
             if carried:
                 details["inputs"] = carried
             recorder.emit(_START, tid, agent, **details)
         else:
-            recorder.skip()
+            recorder.count += 1
         if index.cancels[t] or withdrawn:
             self._cancel_region(t, number, withdrawn)
-        now = self.kernel.now
+        now = kernel.tick * kernel.dt
         ctx = ActionContext(tid, agent, index.params[t], inputs, self.world, self._seed_prefix + str(number),
-                            now, now, _reader=self.tokens.read, _links=self.channels.model_for,
-                            _alive=self.faults.alive, _agents=self.agents, _resources=self.resources,
-                            _declared=self._declared[t], _media=self.channels.view)
+                            now, now, _run=self, _declared=self._declared[t])
         self.runner.start(t, number, ctx)
 
     def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:
@@ -139,7 +148,8 @@ class Firer:
         """
         tid, recorder = self.index.ids[t], self.recorder
         self.progress = self.kernel.tick
-        self.agents.acted(ctx.agent)
+        if self._acts[t]:
+            self.agents.acted(ctx.agent)
         row = self.index.route[t][outcome]
         if row is None and outcome is not Outcome.CANCELLED and outcome is not Outcome.OK:
             reason = ctx.reason or outcome.value
@@ -154,7 +164,7 @@ class Firer:
         sent: list[tuple[str, Any]] = []
         if row is not None:
             produced, sent = self._produce(row, ctx)
-        if recorder.active:
+        if recorder.handlers:
             details: dict[str, Any] = {"firing": number, "outcome": outcome.value, "produced": produced}
             if ctx.result is not None:
                 details["result"] = summarize(ctx.result)
@@ -162,7 +172,7 @@ class Firer:
                 details["reason"] = ctx.reason
             recorder.emit(_END, tid, ctx.agent, **details)
         else:
-            recorder.skip()
+            recorder.count += 1
         for place, data in sent:
             self.channels.send(place, data, ctx.agent)
 
@@ -174,12 +184,13 @@ class Firer:
             result, outputs = None, result
         channel = self.index.channel
         produced = self.tokens.produce(row, result, outputs, channel)
+        dirty = self.enabled.dirty
+        for group in self._fed[row]:
+            dirty.update(group)
         compiled = self.index.compiled
         places = compiled.places
         sent: list[tuple[str, Any]] = []
         for p, w in compiled.post[row]:
             if channel[p]:
                 sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
-            else:
-                self.enabled.mark_place(p)
         return produced, sent
