@@ -1,9 +1,9 @@
 """Seed 002's two message transmission schemes, as rules driven by simulated time.
 
 Each scheme is what one module's firmware decides; it never touches a bus or a clock.
-A driver (:mod:`~petriflow.agents.bus.experiment`) asks it when the module's loop
-comes round, whether to send at an interrupt, whom a message is for and whether a
-received one is accepted, and does the rest. Random draws come from the
+A driver (the firmware's actions, :mod:`~petriflow.agents.bus.firmware`) asks it when
+the module's loop comes round, whether to send at an interrupt, whom a message is for
+and whether a received one is accepted, and does the rest. Random draws come from the
 ``random.Random`` each scheme is given, in a fixed order, so a seed fixes a run.
 
 **Algorithm 1, native** (:class:`NativeScheme`), as printed::

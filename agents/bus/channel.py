@@ -1,49 +1,71 @@
-"""The bus models as petriflow channel models: deciding a message's fate when it is sent.
+"""A bus as a petriflow medium: a run's channel messages as frames on the bus, and the
+frames' fates as the messages' fates, each when it happens.
 
-:meth:`BusModel.deliver <petriflow.agents.bus.medium.BusModel.deliver>` hands each
-message to a :class:`ChannelState`, which keeps the bus's state between messages and
-decides each one by looking ahead on a copy of it (the approximations this implies are
-listed in :mod:`petriflow.agents.bus.medium`'s docstring).
+:meth:`BusModel.attach <petriflow.agents.bus.medium.BusModel.attach>` starts a
+:class:`Carrier` on the run's kernel; the run hands it every message put into a
+channel place the bus carries (:meth:`Carrier.send`), and the carrier:
+
+* numbers the agents as they first appear to the bus (a view asked for, a message
+  sent or addressed): the first is module 0, and so on. The number is the module's
+  place on a ZigBee chain (``spacing`` metres apart) and, unless the data names an
+  ``identifier``, its CAN identifier ``0x100 + number``;
+* turns the message into frames: its bytes (:func:`payload_of`) in frames of the
+  bus's payload (8 bytes on CAN; a longer message is split and arrives with its last
+  frame), addressed to its receiver. A message whose data names a ``multicast`` group
+  and its ``receivers`` (agents) is ONE frame addressed to all of them, as a module
+  sends one message to both neighbours: its first copy requests the frame, the other
+  copies of the group (same sender, same instant, one per receiver's place) join it;
+* gives each message its fate when it happens (:class:`~petriflow.runtime.media.MediumPort`):
+  delivered when its receiver's module has read its last frame from its receive
+  buffer; lost, with the bus's reason (``collision``, ``overwritten``,
+  ``queue_full``, ``access_failure``, ``radio``), when one of its frames is lost for
+  that receiver or for everyone. A message for no agent (a frame for an address no
+  module holds) is delivered when its frame leaves the bus intact.
+
+Firmware asks the bus only through a :class:`BusView` (``ctx.medium(place)``).
 
 Examples:
     >>> from petriflow.agents.bus.medium import CanBus, SerialBus
     >>> from petriflow.runtime.channels import Message
+    >>> from petriflow.runtime.kernel import Kernel
+    >>> from petriflow.runtime.media import MediumPort, ProcessClock
     >>> import random
+    >>> seen = []
+    >>> clock = ProcessClock(Kernel(dt=0.0001))
+    >>> def fate(what, m): seen.append((what, m.data["n"], round(clock.now * 1e6)))
+    >>> port = MediumPort(clock, lambda m: fate("delivered", m), lambda m, why: fate(why, m), random.Random(0))
     >>> bus = SerialBus()
-    >>> first = Message("inbox", "a", "b", {"size": 9}, time=0.0, size=9)
-    >>> round(bus.deliver(first, random.Random(0)) * 1e6)       # 100 bits at 115 200 baud
-    868
-    >>> bus.deliver(Message("inbox", "c", "b", {}, 0.0004, 9), random.Random(0)) is None  # overlaps
-    True
-    >>> can = CanBus()
-    >>> long = Message("inbox", "a", "b", b"0123456789abcdef", 0.0, 16)
-    >>> can.deliver(long, random.Random(0)) > 2 * 44 / 512_000  # two frames, back to back
-    True
+    >>> bus.attach(port)
+    >>> bus.send(Message("inbox", "a", "b", {"n": 1, "size": 9}, 0.0, 9))   # 100 bits: 868 µs
+    >>> _ = clock.at(0.0004, bus.send, Message("inbox", "c", "b", {"n": 2, "size": 9}, 0.0004, 9))
+    >>> _ = clock.at(0.002, bus.send, Message("inbox", "c", "b", {"n": 3, "size": 9}, 0.002, 9))
+    >>> clock.run(until=0.01)
+    >>> seen                                   # 1 and 2 overlap: both lost then; 3 read on arrival
+    [('collision', 1, 400), ('collision', 2, 400), ('delivered', 3, 2868)]
+    >>> bus.view("b").reads_every(0.005)       # b now reads its buffer every 5 ms
+    >>> bus.send(Message("inbox", "a", "b", {"n": 4, "size": 9}, clock.now, 9))
+    >>> clock.run(until=0.02); seen[-1]
+    ('delivered', 4, 15000)
 """
 
 from __future__ import annotations
 
-import copy
-import math
-import random
 from typing import TYPE_CHECKING, Any
 
-from petriflow.agents.bus.timeline import MODULE, Timeline
-
+from petriflow.agents.bus.medium import Delivery, Frame, Lost, Transmission
 from petriflow.runtime.channels import Message
+from petriflow.runtime.media import MediumPort
 
 if TYPE_CHECKING:
-    from petriflow.agents.bus.medium import BusModel, Frame, Medium
+    from petriflow.agents.bus.medium import BusModel
 
-__all__ = ["ChannelState", "payload_of"]
-
-#: How far ahead (simulated seconds) a message's fate is looked for before it counts as lost.
-HORIZON = 3600.0
+__all__ = ["BusView", "Carrier", "payload_of"]
 
 
 def payload_of(message: Message) -> bytes:
-    """The bytes a message puts on the bus: its data if that is ``bytes``, else a fixed
-    pattern of ``message.size`` bytes (so CAN's bit stuffing sees ordinary bits).
+    """The bytes a message puts on the bus: its data if that is ``bytes`` (or a
+    ``payload`` in a dict), else a fixed pattern of ``message.size`` bytes (so CAN's bit
+    stuffing sees ordinary bits).
 
     Examples:
         >>> payload_of(Message("p", "a", "b", b"hi", 0.0, 2))
@@ -58,191 +80,189 @@ def payload_of(message: Message) -> bytes:
     return bytes((11 + 37 * i) & 0xFF for i in range(max(message.size, 0)))
 
 
-class ChannelState:
-    """A bus's state as a channel model sees it: one medium, advanced message by message.
+#: The key of a message for no agent among an outgoing message's receivers.
+_NOBODY = None
+
+
+class _Outgoing:
+    """One message, or one multicast group's copies, on the bus: the frames each
+    receiver (a module number, or :data:`_NOBODY`) still has to read, the copies not yet
+    decided, and the fates decided (``None``: delivered, else the loss's reason)."""
+
+    __slots__ = ("left", "messages", "fates")
+
+    def __init__(self, keys: list[int | None], frames: int) -> None:
+        self.left: dict[int | None, int] = {key: frames for key in keys}
+        self.messages: dict[int | None, Message] = {}
+        self.fates: dict[int | None, str | None] = {}
+
+    def joins(self, key: int | None) -> bool:
+        """Whether a copy for ``key`` belongs here (a receiver of the frame, not yet joined)."""
+        return key in self.left and key not in self.messages and key not in self.fates
+
+
+class Carrier:
+    """One run's messages on one bus (see the module).
 
     Args:
         bus: the bus parameters.
-        rng: random numbers of the medium (seeded from the run's channel generator).
+        port: where the run's clock is and where fates go.
+        logs: the bus keeps its transmissions, deliveries and losses.
+
+    Attributes:
+        medium: the bus (:class:`~petriflow.agents.bus.medium.BusMedium`) on the run's kernel.
+        numbers: ``{agent: module number}``.
     """
 
-    def __init__(self, bus: BusModel, rng: random.Random) -> None:
+    def __init__(self, bus: BusModel, port: MediumPort, logs: bool = False) -> None:
+        import random
+
         self.bus = bus
-        self.timeline = Timeline()
-        self.medium: Medium = bus.medium(self.timeline, rng)
-        self.pending: dict[tuple[Any, int | None], tuple[Message, float]] = {}
-        self.medium.read_on_arrival = set()  # the modules that read on arrival (read period 0)
-        self.last_end = None
+        self.port = port
+        rng = port.rng if port.rng is not None else random.Random(0)
+        self.medium = bus.medium(port.clock, rng, (), logs=logs)
+        self.medium.on_delivery(self._read)
+        self.medium.on_loss(self._lost)
+        self.medium.on_end(self._ended)
         self.numbers: dict[str | None, int] = {}
-        self.sent = 0
-        self.multicast: tuple[Any, dict[str | None, float | None], dict[str | None, str]] | None = None
-        self.reasons: dict[str | None, str] = {}
-        self.tags: tuple[Any, ...] = ()
-        self.periods: dict[int, float] = {}
+        self._group: tuple[Any, _Outgoing] | None = None  # the last multicast group sent
 
     def module(self, agent: str | None) -> int:
         """The module number of an agent (the next free number the first time)."""
-        if agent not in self.numbers:
+        number = self.numbers.get(agent)
+        if number is None:
             number = self.numbers[agent] = len(self.numbers)
             self.medium.add_module(number)
-            period = self.bus.read_period_of(agent)
-            self.periods[number] = period
-            if period > 0.0:
-                first = math.ceil(self.timeline.now / period) * period
-                self.timeline.at(first, self._read, number, rank=MODULE)
-            else:
-                self.medium.read_on_arrival.add(number)
-        return self.numbers[agent]
+        return number
 
-    def _read(self, module: int) -> None:
-        self.medium.read(module)
-        self.timeline.after(self.periods[module], self._read, module, rank=MODULE)
+    def _key(self, agent: str | None) -> int | None:
+        return _NOBODY if agent is None else self.module(agent)
 
-    def quiet_for(self, now: float) -> float:
-        """How long the medium has been silent at ``now`` (0 while a frame is on it).
-        The bus is run up to ``now`` first (later messages cannot come earlier)."""
-        if now > self.timeline.now:
-            self.timeline.run(until=now)
-        ends = [t.end for t in self.medium.transmissions]
-        if any(t.start <= now < t.end for t in self.medium.transmissions):
-            return 0.0
-        done = [end for end in ends if end <= now]
-        last = max(done + ([self.last_end] if self.last_end is not None and self.last_end <= now else []),
-                   default=None)
-        return now if last is None else now - last
-
-    def frames(self, message: Message, targets: list[str | None] | None = None) -> list[Frame]:
-        """The frames that carry ``message`` (one, or several of ``payload_limit`` bytes)
-        to its receiver, or to every agent of ``targets``."""
-        from petriflow.agents.bus.medium import Frame
-
-        sender = self.module(message.sender)
-        if targets is not None:
-            receivers = tuple(self.module(t) for t in targets)
-        else:
-            receivers = (self.module(message.receiver),) if message.receiver is not None else ()
-        identifier = message.data.get("identifier") if isinstance(message.data, dict) else None
-        if not isinstance(identifier, int) or isinstance(identifier, bool):
-            identifier = 0x100 + sender
-        data = payload_of(message)
-        limit = self.bus.payload_limit()
-        chunks = [data[i:i + limit] for i in range(0, len(data), limit)] or [b""]
-        self.sent += 1
-        return [Frame(sender, receivers, chunk, identifier, (self.sent, index)) for index, chunk in enumerate(chunks)]
-
-    def deliver(self, message: Message) -> float | None:
-        """The delay until the receiver reads the whole message, or ``None`` if it is lost.
-
-        A message whose data names a ``multicast`` group and its ``receivers`` (agents)
-        is one frame addressed to all of them (as a module sends one message to both
-        neighbours): its first copy puts the frame on the bus and decides every
-        receiver's fate; the other copies of the group (same sender, same time) only
-        read theirs.
-        """
+    def send(self, message: Message) -> None:
+        """``message`` is put into its channel place now: request its frames (or join
+        its multicast group's frame)."""
         data = message.data if isinstance(message.data, dict) else {}
         group = data.get("multicast")
+        now = self.port.clock.now
+        key = (message.sender, group, now)
+        if group is not None and self._group is not None and self._group[0] == key \
+                and self._group[1].joins(self._key(message.receiver)):
+            self._join(self._group[1], message)
+            return
+        targets: list[str | None] = [message.receiver]
         if group is not None:
-            key = (message.sender, group, message.time)
-            if self.multicast is not None and self.multicast[0] == key:
-                self.bus.loss_reason = self.multicast[2].get(message.receiver)
-                return self._remember(message, self.multicast[3], self.multicast[1].get(message.receiver))
             targets = list(data.get("receivers") or [message.receiver])
             if message.receiver not in targets:
                 targets.append(message.receiver)
-            fates = self._decide(message, targets)
-            self.multicast = (key, fates, dict(self.reasons), self.tags)
-            self.bus.loss_reason = self.reasons.get(message.receiver)
-            return self._remember(message, self.tags, fates.get(message.receiver))
-        fates = self._decide(message, None)
-        self.bus.loss_reason = self.reasons.get(message.receiver)
-        return self._remember(message, self.tags, fates[message.receiver])
+        sender = self.module(message.sender)
+        keys = list(dict.fromkeys(self._key(t) for t in targets))
+        receivers = tuple(k for k in keys if k is not _NOBODY)
+        identifier = data.get("identifier")
+        if not isinstance(identifier, int) or isinstance(identifier, bool):
+            identifier = 0x100 + sender
+        payload = payload_of(message)
+        limit = self.bus.payload_limit()
+        chunks = [payload[i:i + limit] for i in range(0, len(payload), limit)] or [b""]
+        outgoing = _Outgoing(keys, len(chunks))
+        self._group = (key, outgoing) if group is not None else None
+        self._join(outgoing, message)
+        for index, chunk in enumerate(chunks):
+            if not self.medium.request(Frame(sender, receivers, chunk, identifier, (outgoing, index))):
+                break  # the transmit queue was full: the message is lost (the rest is not sent)
 
-    def _remember(self, message: Message, tags: tuple[Any, ...], delay: float | None) -> float | None:
-        """Keep a message that will be read later: a later frame may overwrite it first."""
-        if delay is not None and delay > 0.0 and message.receiver is not None:
-            module = self.numbers.get(message.receiver)
-            for tag in tags:
-                self.pending[(tag, module)] = (message, message.time + delay)
-        return delay
+    def _join(self, outgoing: _Outgoing, message: Message) -> None:
+        key = self._key(message.receiver)
+        if key in outgoing.fates:  # decided before this copy came (a full queue, a collision)
+            self._give(message, outgoing.fates[key])
+        else:
+            outgoing.messages[key] = message
 
-    def _revoke(self, losses: list[Any], now: float) -> None:
-        """Frames already promised to a receiver that this new frame overwrote in its
-        buffer before the receiver read them, or garbled on the medium (a collision
-        with a frame still on the bus): their messages are lost after all."""
-        self.pending = {key: value for key, value in self.pending.items() if value[1] > now}
-        for loss in losses:
-            keys = [(loss.frame.tag, loss.module)] if loss.module is not None else [
-                key for key in self.pending if key[0] == loss.frame.tag]  # garbled on the bus: for everyone
-            for key in keys:
-                entry = self.pending.pop(key, None)
-                if entry is not None and entry[0].revoked is None:
-                    entry[0].revoked = loss.reason.value
+    def _decide(self, outgoing: _Outgoing, key: int | None, why: str | None) -> None:
+        if key in outgoing.fates:
+            return
+        outgoing.fates[key] = why
+        message = outgoing.messages.pop(key, None)
+        if message is not None:
+            self._give(message, why)
 
-    def _decide(self, message: Message, targets: list[str | None] | None) -> dict[str | None, float | None]:
-        self.timeline.run(until=message.time)
-        frames = self.frames(message, targets)
-        # The bus parameters are shared, not copied (they hold this state object).
-        ahead = copy.deepcopy((self.timeline, self.medium), memo={id(self.bus): self.bus})
-        modules = {self.numbers[t]: t for t in targets} if targets is not None else {
-            self.numbers.get(message.receiver) if message.receiver is not None else None: message.receiver}
-        arrivals, reasons = _look_ahead(ahead[0], ahead[1], frames, list(modules))
-        self.reasons = {agent: reasons[module] for module, agent in modules.items() if module in reasons}
-        self.tags = tuple(frame.tag for frame in frames)
-        self._revoke(ahead[1].losses, message.time)
-        for frame in frames:  # the same requests on the kept state: the same draws follow
-            self.medium.request(frame)
-        medium = self.medium  # the logs are not needed again: keep the copies small
-        ended = [t.end for t in medium.transmissions if t.end <= message.time]
-        if ended:
-            self.last_end = max(ended + ([self.last_end] if self.last_end is not None else []))
-        medium.transmissions = [t for t in medium.transmissions if t.end > message.time]
-        medium.deliveries.clear()
-        medium.losses.clear()
-        return {agent: None if arrivals.get(module) is None else max(0.0, arrivals[module] - message.time)
-                for module, agent in modules.items()}
+    def _give(self, message: Message, why: str | None) -> None:
+        if why is None:
+            self.port.deliver(message)
+        else:
+            self.port.lose(message, why)
+
+    # The bus's listeners -----------------------------------------------------------
+    def _read(self, delivery: Delivery) -> None:
+        """A module read a frame addressed to it: the message is delivered with its last frame."""
+        outgoing = delivery.frame.tag[0]
+        module = delivery.module
+        if module in outgoing.left and module not in outgoing.fates:
+            outgoing.left[module] -= 1
+            if outgoing.left[module] <= 0:
+                self._decide(outgoing, module, None)
+
+    def _lost(self, lost: Lost) -> None:
+        """A frame was lost for one module (or for all): so are its messages for it."""
+        outgoing = lost.frame.tag[0]
+        keys = list(outgoing.left) if lost.module is None else [lost.module]
+        for key in keys:
+            if key in outgoing.left:
+                self._decide(outgoing, key, lost.reason.value)
+
+    def _ended(self, transmission: Transmission) -> None:
+        """A frame left the bus: intact, it reached a message's nobody."""
+        if transmission.garbled:
+            return
+        outgoing = transmission.frame.tag[0]
+        if _NOBODY in outgoing.left and _NOBODY not in outgoing.fates:
+            outgoing.left[_NOBODY] -= 1
+            if outgoing.left[_NOBODY] <= 0:
+                self._decide(outgoing, _NOBODY, None)
 
 
-def _look_ahead(timeline: Timeline, medium: Medium, frames: list[Frame],
-                modules: list[int | None]) -> dict[int | None, float | None]:
-    """Request ``frames`` on a copy of the bus and run it until each is read or lost by
-    each of ``modules`` (``None``: nobody in particular); for each module, the time it
-    read the last frame, or ``None`` if one was lost for it."""
-    tags = {frame.tag for frame in frames}
-    if not all(medium.request(frame) for frame in frames):
-        return {module: None for module in modules}, {module: "queue_full" for module in modules}
-    read: dict[int | None, dict[Any, float]] = {module: {} for module in modules}
-    lost: dict[int | None, str] = {}
-    limit = timeline.now + HORIZON
-    seen_deliveries = len(medium.deliveries)
-    seen_losses = len(medium.losses)
+class BusView:
+    """What one module's firmware may ask its bus (``ctx.medium(place)``); the same
+    interface on every bus.
 
-    def settled() -> bool:
-        nonlocal seen_deliveries, seen_losses
-        for loss in medium.losses[seen_losses:]:
-            if loss.frame.tag not in tags:
-                continue
-            for module in modules:
-                # a frame for nobody is lost only on the bus itself (a collision...)
-                if loss.module is None or (module is not None and loss.module == module):
-                    lost.setdefault(module, loss.reason.value)
-        seen_losses = len(medium.losses)
-        for delivery in medium.deliveries[seen_deliveries:]:
-            if delivery.frame.tag in tags:
-                for module in modules:
-                    if module is None or delivery.module == module:
-                        read[module][delivery.frame.tag] = delivery.read
-        seen_deliveries = len(medium.deliveries)
-        if not frames[0].receivers:  # nobody to read it: delivered when it leaves the bus
-            for transmission in medium.transmissions:
-                if transmission.frame.tag in tags and not transmission.garbled and transmission.end <= timeline.now:
-                    for module in modules:
-                        read[module][transmission.frame.tag] = transmission.end
-        return all(module in lost or len(read[module]) == len(tags) for module in modules)
+    * :meth:`reads_every`: how often the module reads its receive buffer, and from when;
+    * :meth:`quiet_for`: how long the bus has been quiet, now;
+    * :attr:`sender_in_identifier`: whether the sender's address travels in the frame's
+      identifier (CAN), so a payload need not carry it.
 
-    while timeline.peek() <= limit:
-        timeline.step()
-        if settled():
-            break
-    arrivals = {module: None if module in lost or len(read[module]) < len(tags) else max(read[module].values())
-                for module in modules}
-    return arrivals, {module: lost.get(module, "unread") for module in modules if arrivals[module] is None}
+    Args:
+        carrier: the run's bus.
+        agent: the module's agent.
+    """
+
+    __slots__ = ("_carrier", "agent")
+
+    def __init__(self, carrier: Carrier, agent: str | None) -> None:
+        self._carrier = carrier
+        self.agent = agent
+
+    @property
+    def sender_in_identifier(self) -> bool:
+        """The sender's address travels in the frame's identifier (CAN)."""
+        return bool(self._carrier.bus.sender_in_identifier)
+
+    def reads_every(self, period: float, start: float | None = None) -> None:
+        """This module reads its receive buffer every ``period`` seconds (0: on arrival),
+        at ``start + k · period``: ``start`` is when its loop's first iteration begins
+        (default: now), the module's own phase.
+
+        Raises:
+            BusError: a period that is not a number of seconds >= 0.
+        """
+        carrier = self._carrier
+        phase = carrier.port.clock.now if start is None else start
+        carrier.medium.reads_every(carrier.module(self.agent), period, phase)
+
+    @property
+    def read_period(self) -> float | None:
+        """How often this module reads its receive buffer (0: on arrival)."""
+        carrier = self._carrier
+        return carrier.medium.read_period_of(carrier.module(self.agent))
+
+    def quiet_for(self) -> float:
+        """Seconds the bus has carried nothing, now (0 while a frame is on it)."""
+        return self._carrier.medium.quiet_for()

@@ -23,6 +23,14 @@ heard from each neighbour) and its message count.
 
 Every send, read and loss is a custom event (``bus.sent``, ``bus.read``); the metrics
 of :mod:`~petriflow.agents.bus.metrics` count them per sender, as Tables 1–3 do.
+
+The firmware asks its bus only through the view the bus declares
+(:class:`~petriflow.agents.bus.channel.BusView`, ``ctx.medium(place)``): ``boot``
+says how often and from when the module reads its receive buffer
+(``reads_every(period, start=)``: from the first iteration of its loop), ``send``
+whether the sender's address travels in the frame's identifier
+(``sender_in_identifier``: CAN), ``available`` how long the bus has been quiet
+(``quiet_for()``). It never reconfigures the bus model or tests its type.
 """
 
 from __future__ import annotations
@@ -196,15 +204,13 @@ class Boot(_Timed):
         oscillator = Oscillator(parameters, rng.uniform(0.0, 2 * math.pi), address > 0, address < len(chain) - 1)
         by_address = sorted(chain, key=lambda m: addresses[m])
         self.module = Module(name, by_address, p["algorithm"], p["messages"], scheme, oscillator, address)
-        for place in p["mailboxes"]:
-            model, _ = ctx.link(place)
-            if hasattr(model, "reads_every"):
-                model.reads_every(name, read_every)
+        self.module.updated = self.wake_at = ctx.now + max(0.0, self.duration(ctx))
+        for place in p["mailboxes"]:  # the reception routine runs once per iteration, from the first
+            ctx.medium(place).reads_every(read_every, start=self.wake_at)
         if ctx.world is not None:
             from petriflow.agents.bus.chain import joint_of
 
             self.module.joint = joint_of(ctx.world, name)
-        self.module.updated = self.wake_at = ctx.now + max(0.0, self.duration(ctx))
         ctx.emit("bus.addressed", address=address, delay=round(getattr(scheme, "delay", 0.0), 6),
                  read_every=round(read_every, 6))
         ctx.result = self.module
@@ -277,11 +283,9 @@ class Send(InstantAction):
         packet = Packet(receivers=receivers, sender=module.address, phase=float(wrap(oscillator.phase)) % (2 * math.pi),
                         offset=parameters.offset, amplitude=parameters.amplitude)
         boxes = self.params["boxes"]
-        model = ctx.link(next(iter(boxes.values())))[0] if boxes else None
-        from petriflow.agents.bus.medium import CanBus
-
+        bus = ctx.medium(next(iter(boxes.values()))) if boxes else None
         # on CAN the sender's address travels in the identifier: 8 data bytes, one frame
-        payload = encode(packet, with_sender=not isinstance(model, CanBus))
+        payload = encode(packet, with_sender=not (bus is not None and bus.sender_in_identifier))
         module.groups += 1
         group = module.groups
         names = [module.name_at(r) for r in receivers]
@@ -300,7 +304,7 @@ class Send(InstantAction):
 
 
 class Available(Action):
-    """Algorithm 2's *bus available* interrupt: wait until the bus (``box``'s model) has
+    """Algorithm 2's *bus available* interrupt: wait until the bus (``box``'s medium) has
     been quiet for this module's random ``U[0, idle_window]`` s and is free; a busy
     spell in between draws a new time for the next quiet one."""
 
@@ -309,12 +313,12 @@ class Available(Action):
     def start(self, ctx: ActionContext) -> None:
         self.module = _module(ctx)
         ctx.result = self.module
-        self.model, _ = ctx.link(self.params["box"])
+        self.bus = ctx.medium(self.params["box"])
         self.wanted = self.module.scheme.idle_delay()
         self.quiet = None
 
     def poll(self, ctx: ActionContext) -> Status:
-        quiet_for = getattr(self.model, "quiet_for", lambda now: now)(ctx.now)
+        quiet_for = self.bus.quiet_for()
         if self.quiet is not None and quiet_for < self.quiet - 1e-12:  # the bus was busy meanwhile
             self.wanted = self.module.scheme.idle_delay()
         self.quiet = quiet_for

@@ -1,23 +1,29 @@
 """One shared bus at bit-level timing: RS-485, CAN and ZigBee, with the losses of real modules.
 
-Every module of the EMERGE chain hangs on one medium. A :class:`Medium` is that
-medium's state on a :class:`~petriflow.agents.bus.timeline.Timeline`: modules
-:meth:`~Medium.request` frames, the medium puts them on the wire when its access rule
-allows, frames occupy it for ``bits / bit rate`` seconds (lengths from
+Every module of the EMERGE chain hangs on one medium. A :class:`BusMedium` is that
+medium's state on a :class:`~petriflow.runtime.media.ProcessClock` (the run's kernel,
+or a kernel of its own outside a run: :class:`BusSimulator`): modules
+:meth:`~BusMedium.request` frames, the medium puts them on the wire when its access
+rule allows, frames occupy it for ``bits / bit rate`` seconds (lengths from
 :mod:`~petriflow.agents.bus.frames`), and intact frames land in every other module's
-receive buffer, where the module finds them when it next :meth:`~Medium.read` s.
-Everything that happens is logged: :attr:`~Medium.transmissions`,
-:attr:`~Medium.deliveries` (a module read a frame addressed to it) and
-:attr:`~Medium.losses` (a :class:`Loss` reason each).
+receive buffer, where the module finds them when it next reads it. What happens is
+told to listeners as it happens (:meth:`~BusMedium.on_start`, :meth:`~BusMedium.on_end`
+of a transmission, :meth:`~BusMedium.on_delivery`: a module read a frame addressed to
+it, :meth:`~BusMedium.on_loss`: a :class:`Lost` with a :class:`Loss` reason,
+:meth:`~BusMedium.on_idle`); with ``logs=True`` (tests, figures) the medium also keeps
+them in :attr:`~BusMedium.transmissions`, :attr:`~BusMedium.deliveries` and
+:attr:`~BusMedium.losses` (a run's bus keeps none unless its model says ``logs:
+true``, so its memory stays bounded however long the run).
 
 The three buses (their parameters are :class:`SerialBus`, :class:`CanBus`,
-:class:`ZigbeeBus`; ``bus.medium(timeline, rng, modules)`` starts one):
+:class:`ZigbeeBus`; ``bus.medium(clock, rng, modules)`` starts one):
 
 * **RS-485** (:class:`SerialMedium`): a half-duplex line with no arbitration. A UART
   sends whenever its module asks (after its own previous frame). Two frames that
-  overlap in time garble each other: both are lost at every receiver (no capture:
-  differential drivers fighting give framing and checksum errors). Carrier sense,
-  for algorithm 2, sees a frame ``sense_bits`` bit times after its start bit (the
+  overlap in time garble each other: both are lost at every receiver, at the moment
+  they overlap (no capture: differential drivers fighting give framing and checksum
+  errors; the garbled frames still hold the line to their ends). Carrier sense, for
+  algorithm 2, sees a frame ``sense_bits`` bit times after its start bit (the
   receiver must sample the start bit), so two modules that check within that window
   both find the line free and collide.
 * **CAN** (:class:`CanMedium`): frames wait in the controller's transmit buffers
@@ -36,24 +42,33 @@ The three buses (their parameters are :class:`SerialBus`, :class:`CanBus`,
   channel assessment; if clear, the radio turns around (12 symbols, 192 µs) and
   sends, else BE grows (3 → 5) and after ``max_backoffs`` = 4 failed assessments the
   frame is dropped (:attr:`Loss.ACCESS_FAILURE`). Two frames that overlap on the air
-  are both garbled (no capture). A frame survives each link with the probability of
-  :class:`~petriflow.agents.bus.radio.RadioLink` (RSSI from the distance between the
-  modules, ``spacing`` metres apart along the chain). Frames are broadcasts (the CPG
-  messages carry their addresses in the payload, as in the paper's algorithm), so no
-  MAC acknowledgements or retries. After a frame the radio waits the long or short
-  interframe spacing. Received frames reach the module after the radio has written
-  their payload out over the UART. A module cannot hear the air: for it the "bus" is
-  free when its own radio has nothing to send.
+  are both garbled, at the moment they overlap (no capture). A frame survives each
+  link with the probability of :class:`~petriflow.agents.bus.radio.RadioLink` (the
+  core's log-distance RSSI, :class:`petriflow.runtime.radio.LogDistance`, at the
+  distance between the modules, ``spacing`` metres apart per module number). Frames
+  are broadcasts (the CPG messages carry their addresses in the payload, as in the
+  paper's algorithm), so no MAC acknowledgements or retries. After a frame the radio
+  waits the long or short interframe spacing. Received frames reach the module after
+  the radio has written their payload out over the UART. A module cannot hear the
+  air: for it the "bus" is free when its own radio has nothing to send.
 
 Losses common to all three (real modules' limits):
 
 * **Receive buffer** (``rx_buffer`` frames, default 1): a frame that arrives while the
-  buffer is full overwrites the oldest unread frame (:attr:`Loss.OVERWRITTEN`). The
-  paper's reception routine checks addresses in software ("the receiving module
-  rejects the packets that have not been assigned their address"), so by default
-  every intact frame enters every module's buffer and a frame for someone else can
-  overwrite one for this module; ``acceptance_filter=True`` models a hardware filter
-  (CAN acceptance masks, XBee unicast addressing) that keeps them out.
+  buffer is full overwrites the oldest unread frame, which is lost then
+  (:attr:`Loss.OVERWRITTEN`). The paper's reception routine checks addresses in
+  software ("the receiving module rejects the packets that have not been assigned
+  their address"), so by default every intact frame enters every module's buffer and
+  a frame for someone else can overwrite one for this module;
+  ``acceptance_filter=True`` models a hardware filter (CAN acceptance masks, XBee
+  unicast addressing) that keeps them out.
+* **Reading the buffer**: each module reads its buffer every ``read period`` seconds
+  (:meth:`BusMedium.reads_every`; by default the bus's ``read_period``; 0: on arrival,
+  as an interrupt would), at the times ``phase + k · period``: the *phase* is the
+  module's own (when its firmware's loop started: the firmware says so, see
+  :meth:`~petriflow.agents.bus.channel.BusView.reads_every`; 0 otherwise). A read is
+  scheduled only while a frame waits in the buffer: the next such time at or after
+  the frame's arrival, so an idle bus schedules nothing.
 * **Transmit queue** (``tx_queue`` frames waiting besides the one on the wire): a
   request finding it full is dropped (:attr:`Loss.QUEUE_FULL`). Defaults (assumed):
   3 frames for a UART driver's ring buffer and for the XBee's serial buffer, 2 on CAN
@@ -61,41 +76,29 @@ Losses common to all three (real modules' limits):
   the frame being sent). At the paper's rates (about one message a second per
   module) no queue fills; the limit matters for heavier traffic.
 
-Each bus class is also a petriflow
-:class:`~petriflow.runtime.channels.ChannelModel`: ``channels: {bus: {model: ...}}``
-with the same parameters. A channel model must decide a message's fate when it is
-sent, but on a real bus a frame's fate also depends on frames sent after it (a later
-frame can overlap it, or overwrite it in a buffer). The adaptor therefore keeps the
-bus's full state, advanced in time order as messages come (the runtime hands them
-over in time order), and decides each message by running a copy of that state
-forward with no further traffic: the message's delay is the time until its
-receiver reads its last frame (modules read every ``read_period`` seconds; 0 means
-on arrival). A later message can still take back a promise: when its frame collides
-with one already promised or overwrites it in a receiver's buffer before it was read,
-the earlier message is revoked (:attr:`~petriflow.runtime.channels.Message.revoked`)
-and the runtime records it lost at its delivery time, so losses are counted as the bus
-makes them (both frames of a collision, the older frame of an overwrite; the receive
-buffer keeps the newest). CAN frames requested within one arbitration window go in
-request order instead of identifier order. Messages longer than a frame's payload are
-split into frames (8 bytes on CAN) and arrive with their last frame. A message's
-bytes are its data when that is ``bytes``, else a fixed pattern of its ``size``.
-Module numbers follow the order agents first appear (their position on the chain, and
-on CAN their identifier ``0x100 + number``, unless the data names an ``identifier``).
+Each bus class is also a petriflow medium (:class:`petriflow.runtime.media.Medium`):
+``channels: {bus: {model: bus.can, ...}}`` with the same parameters. When the run
+starts, :meth:`BusModel.attach` starts the bus on the run's kernel; each message put
+into a channel place becomes frames on it then, and the message is delivered when its
+receiver's module reads its last frame, or lost when one of its frames is lost for
+that receiver, at that moment (:mod:`~petriflow.agents.bus.channel`: messages to
+frames, multicast groups, views). Nothing is decided ahead of time.
 
 Examples:
-    >>> from petriflow.agents.bus.timeline import Timeline
+    >>> from petriflow.runtime.kernel import Kernel
+    >>> from petriflow.runtime.media import ProcessClock
     >>> import random
-    >>> timeline = Timeline()
-    >>> medium = CanBus().medium(timeline, random.Random(0), modules=[0, 1, 2])
+    >>> clock = ProcessClock(Kernel(dt=0.001))
+    >>> medium = CanBus().medium(clock, random.Random(0), modules=[0, 1, 2], read_period=None)
     >>> _ = medium.request(Frame(sender=2, receivers=(0,), data=b"late", identifier=0x102))
     >>> _ = medium.request(Frame(sender=1, receivers=(0,), data=b"wins", identifier=0x101))
-    >>> timeline.run(until=0.01)
+    >>> clock.run(until=0.01)
     >>> [t.frame.sender for t in medium.transmissions]   # both started together: 0x101 first
     [1, 2]
     >>> [f.data for f in medium.read(0)]                 # one-frame buffer: the first was overwritten
     [b'late']
-    >>> [loss.reason.value for loss in medium.losses]
-    ['overwritten']
+    >>> [(loss.reason.value, round(loss.time * 1e6)) for loss in medium.losses]  # when the second arrived
+    [('overwritten', 309)]
 """
 
 from __future__ import annotations
@@ -105,8 +108,9 @@ import random
 from collections import deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
+from petriflow.agents.bus.errors import BusError
 from petriflow.agents.bus.frames import (
     IEEE802154_MAC_HEADER_BYTES,
     IEEE802154_MAX_FRAME_BYTES,
@@ -115,14 +119,16 @@ from petriflow.agents.bus.frames import (
     ieee802154_frame_bits,
     uart_frame_bits,
 )
-from petriflow.agents.bus.errors import BusError
 from petriflow.agents.bus.radio import RadioLink
-from petriflow.agents.bus.timeline import MEDIUM, Timeline, Timer
-
 from petriflow.outcome import Name
-from petriflow.runtime.channels import ChannelModel, Message
+from petriflow.runtime.channels import Message
+from petriflow.runtime.kernel import Kernel
+from petriflow.runtime.media import Medium, MediumPort, ProcessClock, Timer
 
 __all__ = [
+    "MEDIUM",
+    "MODULE",
+    "BusMedium",
     "BusModel",
     "BusSimulator",
     "CanBus",
@@ -131,13 +137,18 @@ __all__ = [
     "Frame",
     "Loss",
     "Lost",
-    "Medium",
     "SerialBus",
     "SerialMedium",
     "Transmission",
     "ZigbeeBus",
     "ZigbeeMedium",
 ]
+
+#: Rank of the media's own events (frame ends, arrivals): at one instant they run first.
+MEDIUM = 0
+#: Rank of the modules' events (buffer reads, sends in a :class:`BusSimulator`): they
+#: see the settled bus.
+MODULE = 1
 
 # 802.15.4 at 2.4 GHz: 62.5 k symbols a second.
 _SYMBOL = 16e-6
@@ -147,6 +158,9 @@ _TURNAROUND = 12 * _SYMBOL
 _SIFS = 12 * _SYMBOL
 _LIFS = 40 * _SYMBOL
 _MAX_SIFS_FRAME_BYTES = 18
+
+#: ``read_period`` of :meth:`BusModel.medium` when not given: the bus's own.
+_BUS_DEFAULT: Any = object()
 
 
 class Loss(Name):
@@ -184,7 +198,7 @@ class Frame:
     tag: Any = None
 
 
-@dataclass
+@dataclass(eq=False)
 class Transmission:
     """A frame on the medium from ``start`` to ``end`` (``garbled``: it met another)."""
 
@@ -216,23 +230,30 @@ class Lost:
 
 
 @dataclass
-class BusModel(ChannelModel):
-    """Parameters shared by the buses; a subclass adds its physical layer.
+class BusModel(Medium):
+    """Parameters shared by the buses; a subclass adds its physical layer. As a petriflow
+    :class:`~petriflow.runtime.media.Medium` it carries a run's channel messages (see
+    the module and :mod:`~petriflow.agents.bus.channel`).
 
     Attributes:
         tx_queue: frames a module's interface holds waiting besides the one it sends.
         rx_buffer: frames a module's receive buffer holds.
         acceptance_filter: only frames addressed to a module enter its buffer.
-        read_period: as a channel model: how often receivers read (0: on arrival).
+        read_period: how often a module reads its receive buffer, until its firmware
+            says otherwise (0: on arrival).
+        logs: in a run, keep every transmission, delivery and loss in the medium's
+            lists (memory grows with the run; for tests and figures).
+        sender_in_identifier: (class constant) the sender's address travels in the
+            frame's identifier, so a payload need not carry it (CAN).
     """
 
     tx_queue: int = field(default=3, metadata={"range": (0, 10_000)})
     rx_buffer: int = field(default=1, metadata={"range": (1, 10_000)})
     acceptance_filter: bool = False
     read_period: float = field(default=0.0, metadata={"range": (0.0, 3600.0)})
-    _channel: Any = field(default=None, init=False, repr=False, compare=False)
-    loss_reason: Any = field(default=None, init=False, repr=False, compare=False)
-    _readers: dict[str, float] = field(default_factory=dict, init=False, repr=False, compare=False)
+    logs: bool = False
+
+    sender_in_identifier: ClassVar[bool] = False
 
     def payload_limit(self) -> int:
         """Largest payload of one frame in bytes (a longer channel message is split)."""
@@ -242,36 +263,42 @@ class BusModel(ChannelModel):
         """Bits the frame occupies the medium for."""
         raise NotImplementedError
 
-    def medium(self, timeline: Timeline, rng: random.Random, modules: Iterable[int] = ()) -> Medium:
-        """Start this bus on ``timeline`` with ``modules`` attached."""
+    def medium(self, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (), *,
+               logs: bool = True, read_period: float | None = _BUS_DEFAULT) -> BusMedium:
+        """Start this bus on ``clock`` with ``modules`` attached (see :class:`BusMedium`)."""
         raise NotImplementedError
 
-    def deliver(self, message: Message, rng: Any) -> float | None:
-        """As a petriflow channel model: the message's delay, or ``None`` if it is lost
-        (see the module's docstring for how the bus state is kept between messages)."""
-        if self._channel is None:
-            from petriflow.agents.bus.channel import ChannelState
+    # As a petriflow medium --------------------------------------------------------
+    def attach(self, port: MediumPort) -> None:
+        """A run starts: the bus starts on the run's kernel (``port.clock``), its
+        random numbers from ``port.rng``; messages' fates go to ``port``."""
+        from petriflow.agents.bus.channel import Carrier
 
-            self._channel = ChannelState(self, random.Random(rng.getrandbits(64)))
-        return self._channel.deliver(message)
+        self._carrier = Carrier(self, port, logs=self.logs)
 
-    def reads_every(self, agent: str, period: float) -> None:
-        """As a channel model: ``agent``'s module reads its receive buffer every
-        ``period`` seconds (0: on arrival) instead of ``read_period`` (its firmware's
-        loop says how often; call before its first message)."""
-        if not (math.isfinite(period) and period >= 0.0):
-            raise BusError(f"a read period is a number of seconds >= 0, got {period!r}")
-        self._readers[agent] = float(period)
+    def send(self, message: Message) -> None:
+        """A message is put into a channel place now: its frames are requested now."""
+        self._attached().send(message)
 
-    def read_period_of(self, agent: str | None) -> float:
-        return self._readers.get(agent, self.read_period)
+    def view(self, agent: str | None) -> Any:
+        """What ``agent``'s firmware may ask the bus: a
+        :class:`~petriflow.agents.bus.channel.BusView`."""
+        from petriflow.agents.bus.channel import BusView
 
-    def quiet_for(self, now: float) -> float:
-        """As a channel model: how long the bus has carried nothing at ``now`` (0 while a
-        frame is on it); since the first message when none was ever sent."""
-        if self._channel is None:
-            return now
-        return self._channel.quiet_for(now)
+        return BusView(self._attached(), agent)
+
+    @property
+    def state(self) -> BusMedium | None:
+        """The bus of the run this model is attached to (``None`` before
+        :meth:`attach`): its listeners, its logs if ``logs`` is set."""
+        carrier = getattr(self, "_carrier", None)
+        return carrier.medium if carrier is not None else None
+
+    def _attached(self) -> Any:
+        carrier = getattr(self, "_carrier", None)
+        if carrier is None:
+            raise BusError(f"the {type(self).__name__} is not attached to a run (attach(port) first)")
+        return carrier
 
 
 @dataclass
@@ -290,14 +317,16 @@ class SerialBus(BusModel):
     def frame_bits(self, frame: Frame) -> int:
         return uart_frame_bits(len(frame.data) + self.checksum_bytes)
 
-    def medium(self, timeline: Timeline, rng: random.Random, modules: Iterable[int] = ()) -> SerialMedium:
-        return SerialMedium(self, timeline, rng, modules)
+    def medium(self, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (), *,
+               logs: bool = True, read_period: float | None = _BUS_DEFAULT) -> SerialMedium:
+        return SerialMedium(self, clock, rng, modules, logs=logs, read_period=read_period)
 
 
 @dataclass
 class CanBus(BusModel):
     """CAN 2.0A at ``bitrate``; frames are stuffed as their bits require. ``tx_queue``
-    defaults to 2: three transmit buffers, one holding the frame on the bus.
+    defaults to 2: three transmit buffers, one holding the frame on the bus. The
+    sender's address travels in the identifier (``sender_in_identifier``).
 
     Examples:
         >>> CanBus().frame_bits(Frame(0, (1,), bytes(8), identifier=0x100)) >= 44 + 64
@@ -308,14 +337,17 @@ class CanBus(BusModel):
     bitrate: float = field(default=512_000.0, metadata={"range": (1.0, 1e9)})
     arbitration_bits: float = field(default=1.0, metadata={"range": (0.0, 1e6)})
 
+    sender_in_identifier: ClassVar[bool] = True
+
     def payload_limit(self) -> int:
         return 8
 
     def frame_bits(self, frame: Frame) -> int:
         return can_frame_bits(frame.identifier, frame.data, interframe=False)
 
-    def medium(self, timeline: Timeline, rng: random.Random, modules: Iterable[int] = ()) -> CanMedium:
-        return CanMedium(self, timeline, rng, modules)
+    def medium(self, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (), *,
+               logs: bool = True, read_period: float | None = _BUS_DEFAULT) -> CanMedium:
+        return CanMedium(self, clock, rng, modules, logs=logs, read_period=read_period)
 
 
 @dataclass
@@ -361,42 +393,88 @@ class ZigbeeBus(BusModel):
         return RadioLink(self.tx_power_dbm, self.reference_loss_db, self.exponent, self.noise_floor_dbm,
                          interference, self.shadowing_db)
 
-    def medium(self, timeline: Timeline, rng: random.Random, modules: Iterable[int] = ()) -> ZigbeeMedium:
-        return ZigbeeMedium(self, timeline, rng, modules)
+    def medium(self, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (), *,
+               logs: bool = True, read_period: float | None = _BUS_DEFAULT) -> ZigbeeMedium:
+        return ZigbeeMedium(self, clock, rng, modules, logs=logs, read_period=read_period)
 
 
-class Medium:
-    """The state of one bus on a timeline (see the module docstring for the rules).
+def _check_period(period: float | None) -> float | None:
+    if period is None:
+        return None
+    if isinstance(period, bool) or not isinstance(period, (int, float)) \
+            or not (math.isfinite(period) and period >= 0):
+        raise BusError(f"a read period is a number of seconds >= 0, got {period!r}")
+    return float(period)
+
+
+class BusMedium:
+    """The state of one bus on a clock (see the module docstring for the rules).
 
     Args:
         bus: the bus parameters.
-        timeline: the clock shared with the modules.
+        clock: the clock it runs on (``now``, ``at(time, callback, *args, rank=)``): the
+            run's :class:`~petriflow.runtime.media.ProcessClock`.
         rng: the medium's random numbers (backoffs, radio errors).
         modules: the modules attached from the start (more with :meth:`add_module`).
+        logs: keep :attr:`transmissions`, :attr:`deliveries` and :attr:`losses`.
+        read_period: how often a module reads its buffer until :meth:`reads_every`
+            says otherwise: seconds (0: on arrival), or ``None``: only when
+            :meth:`read` is called (default: the bus's ``read_period``).
 
     Attributes:
-        transmissions: every frame put on the medium, in start order.
-        deliveries: every frame a module read that was addressed to it.
-        losses: every loss, with its reason.
+        transmissions: every frame put on the medium, in start order (with ``logs``).
+        deliveries: every frame a module read that was addressed to it (with ``logs``).
+        losses: every loss, with its reason (with ``logs``).
         keep_newest: a full receive buffer drops its oldest frame for a new one (the
             hardware's behaviour); ``False`` drops the new one.
     """
 
-    def __init__(self, bus: BusModel, timeline: Timeline, rng: random.Random, modules: Iterable[int] = ()) -> None:
+    def __init__(self, bus: BusModel, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (), *,
+                 logs: bool = True, read_period: float | None = _BUS_DEFAULT) -> None:
         self.bus = bus
-        self.timeline = timeline
+        self.clock = clock
         self.rng = rng
         self.modules: list[int] = []
+        self.logs = logs
         self.transmissions: list[Transmission] = []
         self.deliveries: list[Delivery] = []
         self.losses: list[Lost] = []
         self.keep_newest = True
-        self.read_on_arrival = False
+        self.read_period = _check_period(bus.read_period if read_period is _BUS_DEFAULT else read_period)
+        self.started = clock.now
+        self.last_end: float | None = None  # when the last frame left the medium
         self._buffers: dict[int, deque[tuple[Frame, float]]] = {}
         self._queues: dict[int, deque[Frame]] = {}
-        self._idle_listeners: list[Callable[[int], Any]] = []
+        self._readers: dict[int, tuple[float | None, float]] = {}  # module -> (period, phase)
+        self._reads: dict[int, Timer] = {}  # the read scheduled while a frame waits
+        self._on_start: list[Callable[[Transmission], Any]] = []
+        self._on_end: list[Callable[[Transmission], Any]] = []
+        self._on_delivery: list[Callable[[Delivery], Any]] = []
+        self._on_loss: list[Callable[[Lost], Any]] = []
+        self._on_idle: list[Callable[[int], Any]] = []
         for module in modules:
             self.add_module(module)
+
+    # Listeners -----------------------------------------------------------------------
+    def on_start(self, callback: Callable[[Transmission], Any]) -> None:
+        """Call ``callback(transmission)`` when a frame goes on the medium."""
+        self._on_start.append(callback)
+
+    def on_end(self, callback: Callable[[Transmission], Any]) -> None:
+        """Call ``callback(transmission)`` when a frame leaves the medium (intact or garbled)."""
+        self._on_end.append(callback)
+
+    def on_delivery(self, callback: Callable[[Delivery], Any]) -> None:
+        """Call ``callback(delivery)`` when a module reads a frame addressed to it."""
+        self._on_delivery.append(callback)
+
+    def on_loss(self, callback: Callable[[Lost], Any]) -> None:
+        """Call ``callback(lost)`` when a frame is lost (for one module or for all)."""
+        self._on_loss.append(callback)
+
+    def on_idle(self, callback: Callable[[int], Any]) -> None:
+        """Call ``callback(module)`` whenever the bus turns free in ``module``'s view."""
+        self._on_idle.append(callback)
 
     # The modules' side -------------------------------------------------------------
     def add_module(self, module: int) -> None:
@@ -418,27 +496,67 @@ class Medium:
         self.bus.frame_bits(frame)  # raises for a frame the bus cannot carry
         return self._request(frame)
 
+    def reads_every(self, module: int, period: float | None, phase: float = 0.0) -> None:
+        """``module`` reads its receive buffer at ``phase + k · period`` (``period``
+        seconds; 0: on arrival; ``None``: only when :meth:`read` is called). A frame
+        already waiting is read on the new schedule.
+
+        Raises:
+            BusError: a period that is not a number of seconds >= 0, or a phase that
+                is not finite.
+        """
+        period = _check_period(period)
+        if not (isinstance(phase, (int, float)) and math.isfinite(phase)):
+            raise BusError(f"a read phase is a time in seconds, got {phase!r}")
+        self.add_module(module)
+        self._readers[module] = (period, float(phase))
+        timer = self._reads.pop(module, None)
+        if timer is not None:
+            timer.cancel()
+        if self._buffers[module]:
+            if period == 0.0:
+                self.read(module)
+            elif period is not None:
+                self._schedule_read(module)
+
+    def read_period_of(self, module: int) -> float | None:
+        """How often ``module`` reads its buffer (see :meth:`reads_every`)."""
+        return self._readers.get(module, (self.read_period, 0.0))[0]
+
     def read(self, module: int) -> list[Frame]:
-        """The module empties its receive buffer; returns the frames addressed to it
+        """The module empties its receive buffer now; returns the frames addressed to it
         (oldest first), which count as delivered. Frames for others are discarded."""
+        timer = self._reads.pop(module, None)
+        if timer is not None:
+            timer.cancel()
         buffer = self._buffers[module]
         frames = []
-        now = self.timeline.now
+        now = self.clock.now
         while buffer:
             frame, arrived = buffer.popleft()
             if module in frame.receivers:
                 frames.append(frame)
-                self.deliveries.append(Delivery(frame, module, arrived, now))
+                self._delivered(Delivery(frame, module, arrived, now))
         return frames
+
+    def waiting(self, module: int) -> int:
+        """Frames in ``module``'s receive buffer now."""
+        return len(self._buffers[module])
 
     def is_free(self, module: int) -> bool:
         """Whether the bus looks free to ``module`` now (algorithm 2's "bus available")."""
         raise NotImplementedError
 
-    def on_idle(self, callback: Callable[[int], Any]) -> None:
-        """Call ``callback(module)`` whenever the bus turns free in ``module``'s view
-        (a bound method: the medium must stay copyable)."""
-        self._idle_listeners.append(callback)
+    def busy(self) -> bool:
+        """Whether a frame is on the medium now."""
+        raise NotImplementedError
+
+    def quiet_for(self) -> float:
+        """Seconds the medium has carried nothing, now (0 while a frame is on it; since
+        the medium started when none ever was)."""
+        if self.busy():
+            return 0.0
+        return self.clock.now - (self.started if self.last_end is None else self.last_end)
 
     def pending(self, module: int) -> int:
         """Frames the module's interface still holds (waiting or on the medium)."""
@@ -452,7 +570,7 @@ class Medium:
         """Put a frame in its sender's queue (the head is the one in service)."""
         queue = self._queues[frame.sender]
         if len(queue) - int(in_service) >= self.bus.tx_queue:
-            self.losses.append(Lost(frame, None, Loss.QUEUE_FULL, self.timeline.now))
+            self._lost(Lost(frame, None, Loss.QUEUE_FULL, self.clock.now))
             return False
         queue.append(frame)
         return True
@@ -461,38 +579,86 @@ class Medium:
         """An intact frame reaches ``module``'s receive buffer now."""
         if self.bus.acceptance_filter and module not in frame.receivers:
             return
-        now = self.timeline.now
-        if self.read_on_arrival is True or (self.read_on_arrival and module in self.read_on_arrival):
+        now = self.clock.now
+        period = self.read_period_of(module)
+        if period == 0.0:  # read on arrival
             if module in frame.receivers:
-                self.deliveries.append(Delivery(frame, module, now, now))
+                self._delivered(Delivery(frame, module, now, now))
             return
         buffer = self._buffers[module]
         if len(buffer) >= self.bus.rx_buffer:
             if not self.keep_newest:
-                self.losses.append(Lost(frame, module, Loss.OVERWRITTEN, now))
+                self._lost(Lost(frame, module, Loss.OVERWRITTEN, now))
                 return
             old, _ = buffer.popleft()
-            self.losses.append(Lost(old, module, Loss.OVERWRITTEN, now))
+            self._lost(Lost(old, module, Loss.OVERWRITTEN, now))
         buffer.append((frame, now))
+        if period is not None and module not in self._reads:
+            self._schedule_read(module)
+
+    def _schedule_read(self, module: int) -> None:
+        """The module's next read at or after now, on its phase (a frame waits)."""
+        period, phase = self._readers.get(module, (self.read_period, 0.0))
+        assert period is not None and period > 0.0
+        now = self.clock.now
+        when = phase + math.ceil((now - phase) / period - 1e-9) * period
+        self._reads[module] = self.clock.at(max(when, now), self._scheduled_read, module, rank=MODULE)
+
+    def _scheduled_read(self, module: int) -> None:
+        self._reads.pop(module, None)
+        self.read(module)
+
+    def _started(self, transmission: Transmission) -> None:
+        if self.logs:
+            self.transmissions.append(transmission)
+        for callback in self._on_start:
+            callback(transmission)
+
+    def _ended(self, transmission: Transmission) -> None:
+        self.last_end = transmission.end if self.last_end is None else max(self.last_end, transmission.end)
+        for callback in self._on_end:
+            callback(transmission)
+
+    def _garble(self, transmission: Transmission) -> None:
+        """``transmission`` overlaps another now: it is lost to everyone now."""
+        if not transmission.garbled:
+            transmission.garbled = True
+            self._lost(Lost(transmission.frame, None, Loss.COLLISION, self.clock.now))
+
+    def _delivered(self, delivery: Delivery) -> None:
+        if self.logs:
+            self.deliveries.append(delivery)
+        for callback in self._on_delivery:
+            callback(delivery)
+
+    def _lost(self, lost: Lost) -> None:
+        if self.logs:
+            self.losses.append(lost)
+        for callback in self._on_loss:
+            callback(lost)
 
     def _notify_idle(self, modules: Iterable[int]) -> None:
         for module in modules:
-            for callback in self._idle_listeners:
+            for callback in self._on_idle:
                 callback(module)
 
 
-class SerialMedium(Medium):
+class SerialMedium(BusMedium):
     """An RS-485 line: frames go out when asked; overlapping frames garble each other."""
 
     bus: SerialBus
 
-    def __init__(self, bus: SerialBus, timeline: Timeline, rng: random.Random, modules: Iterable[int] = ()) -> None:
-        super().__init__(bus, timeline, rng, modules)
+    def __init__(self, bus: SerialBus, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (),
+                 **options: Any) -> None:
+        super().__init__(bus, clock, rng, modules, **options)
         self._active: list[Transmission] = []
 
     def is_free(self, module: int) -> bool:
-        horizon = self.timeline.now - self.bus.sense_bits / self.bus.baud
+        horizon = self.clock.now - self.bus.sense_bits / self.bus.baud
         return not self._queues[module] and not any(t.start <= horizon for t in self._active)
+
+    def busy(self) -> bool:
+        return bool(self._active)
 
     def _request(self, frame: Frame) -> bool:
         busy = bool(self._queues[frame.sender])
@@ -503,21 +669,21 @@ class SerialMedium(Medium):
         return True
 
     def _start(self, frame: Frame) -> None:
-        now = self.timeline.now
+        now = self.clock.now
         bits = self.bus.frame_bits(frame)
         transmission = Transmission(frame, now, now + bits / self.bus.baud, bits)
-        for other in self._active:
-            other.garbled = transmission.garbled = True
         self._active.append(transmission)
-        self.transmissions.append(transmission)
-        self.timeline.at(transmission.end, self._end, transmission, rank=MEDIUM)
+        self._started(transmission)
+        if len(self._active) > 1:  # the line was busy: this frame and those on it are garbled now
+            for other in self._active:
+                self._garble(other)
+        self.clock.at(transmission.end, self._end, transmission, rank=MEDIUM)
 
     def _end(self, transmission: Transmission) -> None:
         self._active.remove(transmission)
         frame = transmission.frame
-        if transmission.garbled:
-            self.losses.append(Lost(frame, None, Loss.COLLISION, self.timeline.now))
-        else:
+        self._ended(transmission)
+        if not transmission.garbled:
             for module in self.modules:
                 if module != frame.sender:
                     self._arrive(frame, module)
@@ -529,24 +695,28 @@ class SerialMedium(Medium):
             self._notify_idle(self.modules)
 
 
-class CanMedium(Medium):
+class CanMedium(BusMedium):
     """A CAN bus: frames wait for an idle bus; simultaneous starts arbitrate by identifier."""
 
     bus: CanBus
 
-    def __init__(self, bus: CanBus, timeline: Timeline, rng: random.Random, modules: Iterable[int] = ()) -> None:
-        super().__init__(bus, timeline, rng, modules)
+    def __init__(self, bus: CanBus, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (),
+                 **options: Any) -> None:
+        super().__init__(bus, clock, rng, modules, **options)
         self._current: Transmission | None = None
         self._busy_until = -math.inf
         self._start_of_frame: float | None = None  # SOF of an arbitration not yet decided
         self._idle_timer: Timer | None = None
 
     def is_free(self, module: int) -> bool:
-        now = self.timeline.now
+        now = self.clock.now
         if self._current is not None or now < self._busy_until:
             return False
         sof = self._start_of_frame
         return sof is None or now < sof + self._window()
+
+    def busy(self) -> bool:
+        return self._current is not None or self._start_of_frame is not None
 
     def _window(self) -> float:
         return self.bus.arbitration_bits / self.bus.bitrate
@@ -555,7 +725,7 @@ class CanMedium(Medium):
         current = self._current
         if not self._enqueue(frame, current is not None and current.frame.sender == frame.sender):
             return False
-        now = self.timeline.now
+        now = self.clock.now
         if self._current is None and self._start_of_frame is None and now >= self._busy_until:
             if self._idle_timer is not None:
                 self._idle_timer.cancel()
@@ -565,7 +735,7 @@ class CanMedium(Medium):
 
     def _begin_arbitration(self, start: float) -> None:
         self._start_of_frame = start
-        self.timeline.at(start + self._window(), self._arbitrate, rank=MEDIUM)
+        self.clock.at(start + self._window(), self._arbitrate, rank=MEDIUM)
 
     def _arbitrate(self) -> None:
         start = self._start_of_frame
@@ -578,34 +748,35 @@ class CanMedium(Medium):
         bits = self.bus.frame_bits(winner)
         transmission = Transmission(winner, start, start + bits / self.bus.bitrate, bits)
         self._current = transmission
-        self.transmissions.append(transmission)
-        self.timeline.at(transmission.end, self._end, transmission, rank=MEDIUM)
+        self._started(transmission)
+        self.clock.at(transmission.end, self._end, transmission, rank=MEDIUM)
 
     def _end(self, transmission: Transmission) -> None:
         frame = transmission.frame
         self._queues[frame.sender].popleft()
         self._current = None
+        self._ended(transmission)
         for module in self.modules:
             if module != frame.sender:
                 self._arrive(frame, module)
         self._busy_until = transmission.end + 3 / self.bus.bitrate
-        self._idle_timer = self.timeline.at(self._busy_until, self._idle, rank=MEDIUM)
+        self._idle_timer = self.clock.at(self._busy_until, self._idle, rank=MEDIUM)
 
     def _idle(self) -> None:
         self._idle_timer = None
         if any(self._queues.values()):
-            self._begin_arbitration(self.timeline.now)
+            self._begin_arbitration(self.clock.now)
         else:
             self._notify_idle(self.modules)
 
 
-class ZigbeeMedium(Medium):
+class ZigbeeMedium(BusMedium):
     """XBee radios sharing the air with unslotted CSMA/CA."""
 
     bus: ZigbeeBus
 
-    def __init__(self, bus: ZigbeeBus, timeline: Timeline, rng: random.Random, modules: Iterable[int] = (),
-                 positions: dict[int, float] | None = None) -> None:
+    def __init__(self, bus: ZigbeeBus, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (),
+                 positions: dict[int, float] | None = None, **options: Any) -> None:
         self.positions = dict(positions or {})
         self._link = bus.link()
         self._active: list[Transmission] = []
@@ -613,7 +784,7 @@ class ZigbeeMedium(Medium):
         self._serving: dict[int, bool] = {}
         self._ready: dict[int, deque[float]] = {}
         self._attempt: dict[int, tuple[int, int]] = {}  # module -> (NB, BE)
-        super().__init__(bus, timeline, rng, modules)
+        super().__init__(bus, clock, rng, modules, **options)
 
     def add_module(self, module: int) -> None:
         super().add_module(module)
@@ -621,11 +792,15 @@ class ZigbeeMedium(Medium):
         self._ready.setdefault(module, deque())
 
     def distance(self, a: int, b: int) -> float:
-        """Metres between two modules' radios (``spacing`` per place along the chain)."""
+        """Metres between two modules' radios (``spacing`` per module number, unless
+        ``positions`` places them)."""
         return abs(self.positions.get(a, a * self.bus.spacing) - self.positions.get(b, b * self.bus.spacing))
 
     def is_free(self, module: int) -> bool:
         return not self._serving[module] and not self._queues[module]
+
+    def busy(self) -> bool:
+        return bool(self._active)
 
     def _uart_time(self, n_bytes: float) -> float:
         return uart_frame_bits(1) * n_bytes / self.bus.uart_baud
@@ -633,9 +808,10 @@ class ZigbeeMedium(Medium):
     def _request(self, frame: Frame) -> bool:
         if not self._enqueue(frame, self._serving[frame.sender]):
             return False
-        now = self.timeline.now
+        now = self.clock.now
         # The module's UART writes the bytes, then the XBee waits the packetization timeout.
-        self._ready[frame.sender].append(now + self._uart_time(len(frame.data) + self.bus.packetization_chars))
+        ready = now + self._uart_time(len(frame.data) + self.bus.packetization_chars)
+        self._ready[frame.sender].append(ready)
         if not self._serving[frame.sender]:
             self._serve(frame.sender)
         return True
@@ -645,59 +821,64 @@ class ZigbeeMedium(Medium):
         self._serving[module] = True
         ready = self._ready[module][0]
         self._attempt[module] = (0, self.bus.min_be)
-        self.timeline.at(max(ready, self.timeline.now), self._backoff, module, rank=MEDIUM)
+        self.clock.at(max(ready, self.clock.now), self._backoff, module, rank=MEDIUM)
 
     def _backoff(self, module: int) -> None:
         _, exponent = self._attempt[module]
         delay = self.rng.randrange(1 << exponent) * _UNIT_BACKOFF
-        self.timeline.at(self.timeline.now + delay + _CCA, self._assess, module, rank=MEDIUM)
+        self.clock.at(self.clock.now + delay + _CCA, self._assess, module, rank=MEDIUM)
 
     def _assess(self, module: int) -> None:
         """End of the clear channel assessment: was anything on the air during it?"""
-        now = self.timeline.now
-        since = now - _CCA
-        self._recent = [t for t in self._recent if t.end > since]
+        now = self.clock.now
+        self._forget(now)
         busy = any(t.start < now for t in self._active) or bool(self._recent)
         if not busy:
-            self.timeline.at(now + _TURNAROUND, self._transmit, module, rank=MEDIUM)
+            self.clock.at(now + _TURNAROUND, self._transmit, module, rank=MEDIUM)
             return
         backoffs, exponent = self._attempt[module]
         backoffs += 1
         if backoffs > self.bus.max_backoffs:
             frame = self._queues[module][0]
-            self.losses.append(Lost(frame, None, Loss.ACCESS_FAILURE, now))
+            self._lost(Lost(frame, None, Loss.ACCESS_FAILURE, now))
             self._next(module, now)
             return
         self._attempt[module] = (backoffs, min(exponent + 1, self.bus.max_be))
         self._backoff(module)
 
+    def _forget(self, now: float) -> None:
+        """Keep only the frames that ended less than a CCA ago."""
+        since = now - _CCA
+        self._recent = [t for t in self._recent if t.end > since]
+
     def _transmit(self, module: int) -> None:
-        now = self.timeline.now
+        now = self.clock.now
         frame = self._queues[module][0]
         bits = self.bus.frame_bits(frame)
         transmission = Transmission(frame, now, now + bits / self.bus.air_bitrate, bits)
-        for other in self._active:
-            other.garbled = transmission.garbled = True
         self._active.append(transmission)
-        self.transmissions.append(transmission)
-        self.timeline.at(transmission.end, self._end, transmission, rank=MEDIUM)
+        self._started(transmission)
+        if len(self._active) > 1:  # on the air with another: both garbled now
+            for other in self._active:
+                self._garble(other)
+        self.clock.at(transmission.end, self._end, transmission, rank=MEDIUM)
 
     def _end(self, transmission: Transmission) -> None:
-        now = self.timeline.now
+        now = self.clock.now
         self._active.remove(transmission)
+        self._forget(now)
         self._recent.append(transmission)
         frame = transmission.frame
-        if transmission.garbled:
-            self.losses.append(Lost(frame, None, Loss.COLLISION, now))
-        else:
+        self._ended(transmission)
+        if not transmission.garbled:
             out = self._uart_time(len(frame.data))
             for module in self.modules:
                 if module == frame.sender:
                     continue
                 if self._link.survives(self.distance(frame.sender, module), transmission.bits, self.rng):
-                    self.timeline.at(now + out, self._arrive, frame, module, rank=MEDIUM)
+                    self.clock.at(now + out, self._arrive, frame, module, rank=MEDIUM)
                 else:
-                    self.losses.append(Lost(frame, module, Loss.RADIO, now))
+                    self._lost(Lost(frame, module, Loss.RADIO, now))
         mac_bytes = transmission.bits // 8 - 6
         spacing = _LIFS if mac_bytes > _MAX_SIFS_FRAME_BYTES else _SIFS
         self._next(frame.sender, now + spacing)
@@ -707,7 +888,7 @@ class ZigbeeMedium(Medium):
         self._queues[module].popleft()
         self._ready[module].popleft()
         self._serving[module] = False
-        self.timeline.at(when, self._resume, module, rank=MEDIUM)
+        self.clock.at(when, self._resume, module, rank=MEDIUM)
 
     def _resume(self, module: int) -> None:
         if self._serving[module]:
@@ -719,12 +900,21 @@ class ZigbeeMedium(Medium):
 
 
 class BusSimulator:
-    """A bus on its own: schedule sends and reads, run, look at what happened.
+    """A bus on its own, outside a run: schedule sends and reads on a kernel of its own
+    (:class:`~petriflow.runtime.media.ProcessClock`), run, look at what happened.
+
+    Modules read their buffers only when told (:meth:`read`, :meth:`reads_every`).
 
     Args:
         bus: the bus parameters.
         modules: the attached modules.
         seed: seed of the medium's random numbers.
+        dt: the kernel's tick (s): events keep their exact times whatever it is; ``now``
+            after :meth:`run` is ``until`` rounded up to it.
+
+    Attributes:
+        received: the frames each module read that were addressed to it.
+        refused: the frames a full transmit queue dropped.
 
     Examples:
         >>> sim = BusSimulator(SerialBus(), modules=[0, 1, 2], seed=1)
@@ -734,40 +924,43 @@ class BusSimulator:
         >>> medium = sim.run()
         >>> [t.garbled for t in medium.transmissions], len(sim.received[1])
         ([True, True], 0)
+        >>> [(loss.reason.value, loss.time) for loss in medium.losses]   # both, when they overlapped
+        [('collision', 0.0005), ('collision', 0.0005)]
     """
 
-    def __init__(self, bus: BusModel, modules: Iterable[int], seed: int = 0) -> None:
-        self.timeline = Timeline()
-        self.medium = bus.medium(self.timeline, random.Random(seed), modules)
+    def __init__(self, bus: BusModel, modules: Iterable[int], seed: int = 0, dt: float = 1e-6) -> None:
+        self.clock = ProcessClock(Kernel(dt))
+        self.medium = bus.medium(self.clock, random.Random(seed), modules, read_period=None)
         self.received: dict[int, list[Frame]] = {m: [] for m in self.medium.modules}
         self.refused: list[Frame] = []
+        self.medium.on_delivery(self._delivered)
 
     def send(self, time: float, frame: Frame) -> None:
         """The frame's sender asks to send it at ``time``."""
-        self.timeline.at(time, self._send, frame)
+        self.clock.at(time, self._send, frame, rank=MODULE)
 
     def read(self, time: float, module: int) -> None:
         """``module`` reads its receive buffer at ``time``."""
-        self.timeline.at(time, self._read, module)
+        self.clock.at(time, self.medium.read, module, rank=MODULE)
 
-    def read_every(self, module: int, period: float, start: float = 0.0, until: float = math.inf) -> None:
-        """``module`` reads every ``period`` seconds from ``start`` while before ``until``."""
-        if start <= until:
-            self.timeline.at(start, self._read_periodically, module, period, until)
+    def reads_every(self, module: int, period: float, phase: float = 0.0) -> None:
+        """``module`` reads its buffer at ``phase + k · period`` while a frame waits (0:
+        on arrival)."""
+        self.medium.reads_every(module, period, phase)
 
-    def run(self, until: float | None = None) -> Medium:
+    def run(self, until: float | None = None) -> BusMedium:
         """Run the bus (until nothing is left, or up to ``until``); returns the medium."""
-        self.timeline.run(until)
+        kernel = self.clock.kernel
+        if until is not None:
+            self.clock.run(until)
+            return self.medium
+        while (tick := kernel.peek()) is not None:
+            self.clock.run(tick * kernel.dt)
         return self.medium
 
     def _send(self, frame: Frame) -> None:
         if not self.medium.request(frame):
             self.refused.append(frame)
 
-    def _read(self, module: int) -> None:
-        self.received[module].extend(self.medium.read(module))
-
-    def _read_periodically(self, module: int, period: float, until: float) -> None:
-        self._read(module)
-        if self.timeline.now + period <= until:
-            self.timeline.after(period, self._read_periodically, module, period, until)
+    def _delivered(self, delivery: Delivery) -> None:
+        self.received.setdefault(delivery.module, []).append(delivery.frame)

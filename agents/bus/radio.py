@@ -3,9 +3,10 @@
 A frame between two XBee radios is lost when its bits do not survive the channel. We
 compute that from the received signal strength:
 
-* **RSSI** (:meth:`RadioLink.rssi`): a log-distance path loss,
-  ``RSSI = tx_power − L(1 m) − 10·n·log10(d / 1 m) − walls`` plus, per frame, a
-  zero-mean Gaussian *shadowing* term of ``shadowing_db`` standard deviation (the
+* **RSSI** (:meth:`RadioLink.rssi`): petriflow's one log-distance path loss
+  (:class:`petriflow.runtime.radio.LogDistance`, the formula every radio channel
+  shares), ``RSSI = tx_power − L(1 m) − 10·n·log10(d / 1 m) − walls`` plus, per frame,
+  a zero-mean Gaussian *shadowing* term of ``shadowing_db`` standard deviation (the
   body of the module in between, the robot moving). Distances below ``min_distance``
   count as ``min_distance``: the log law means nothing in the antennas' near field.
 * **Bit errors** (:func:`oqpsk_bit_error_rate`): 802.15.4's 2.4 GHz O-QPSK with
@@ -37,7 +38,9 @@ from __future__ import annotations
 
 import math
 import random
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from petriflow.runtime.radio import LogDistance
 
 __all__ = ["RadioLink", "oqpsk_bit_error_rate", "packet_error_rate"]
 
@@ -75,6 +78,8 @@ class RadioLink:
         interference_dbm: other 2.4 GHz traffic (Wi-Fi...) at the receiver, or ``-inf``.
         shadowing_db: standard deviation of the per-frame Gaussian shadowing.
         min_distance: distances below this count as this (metres).
+        path: the path loss (:class:`~petriflow.runtime.radio.LogDistance`) of these
+            parameters.
     """
 
     tx_power_dbm: float = 0.0
@@ -84,11 +89,15 @@ class RadioLink:
     interference_dbm: float = -math.inf
     shadowing_db: float = 0.0
     min_distance: float = 0.05
+    path: LogDistance = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "path", LogDistance(self.tx_power_dbm, self.reference_loss_db, self.exponent,
+                                                     self.min_distance))
 
     def rssi(self, distance: float, walls_db: float = 0.0) -> float:
-        """Mean received power in dBm at ``distance`` metres."""
-        d = max(distance, self.min_distance)
-        return self.tx_power_dbm - self.reference_loss_db - 10.0 * self.exponent * math.log10(d) - walls_db
+        """Mean received power in dBm at ``distance`` metres through ``walls_db`` of walls."""
+        return self.path.rssi(distance, walls_db)
 
     def noise_dbm(self) -> float:
         """Noise plus interference in dBm."""

@@ -75,10 +75,6 @@ class Message:
         time: simulated send time.
         size: payload size in bytes (from the token data's ``size`` if any).
         distance: sender-receiver distance in metres, when the world knows both.
-        revoked: why the message was lost after all, when its model changed its mind
-            before the delivery time (e.g. a frame overwritten in the receiver's buffer
-            by a later one before it was read): set it (a reason) and the message is
-            lost on arrival instead of delivered.
     """
 
     place: str
@@ -88,7 +84,6 @@ class Message:
     time: float
     size: int = 16
     distance: float | None = None
-    revoked: str | None = None
 
 
 class ChannelModel:
@@ -422,10 +417,13 @@ class Channels:
                       channel=self.channel[message.place])
 
     def _lost(self, message: Message, why: str) -> None:
-        """A medium lost ``message`` now (``why``: the reason it gives)."""
+        """A medium lost ``message`` now (``why``: the reason it gives). The event says
+        ``in_flight``: the message was recorded ``sent`` when it was put in, so it counts
+        once as sent."""
         model, receiver = self.model_for(message.place)
         self.run.emit("message", None, message.sender, fate=Fate.LOST.value, why=str(why), place=message.place,
-                      channel=self.channel[message.place], receiver=receiver, size=message.size)
+                      channel=self.channel[message.place], receiver=receiver, size=message.size,
+                      in_flight=True)
         self._notice(model, message.place, message.data, message.sender, receiver, str(why), self.run.kernel.now)
 
     def view(self, place: str, agent: str | None) -> Any:
@@ -443,17 +441,7 @@ class Channels:
         return view(agent)
 
     def arrive(self, delivery: Delivery) -> None:
-        """A message reaches its place: the token appears there (or, if its model
-        revoked it meanwhile, it is lost now)."""
-        message = delivery.message
-        if message is not None and message.revoked:
-            model, receiver = self.model_for(delivery.place)
-            self.run.emit("message", None, delivery.sender, fate=Fate.LOST.value, why=str(message.revoked),
-                          place=delivery.place, channel=self.channel[delivery.place], receiver=receiver,
-                          size=message.size, revoked=True)
-            self._notice(model, delivery.place, delivery.data, delivery.sender, receiver, str(message.revoked),
-                         self.run.kernel.now)
-            return
+        """A message reaches its place: the token appears there."""
         self.run.deliver(delivery.place, delivery.data)
         fate = Fate.NOTICED if delivery.notice else Fate.DELIVERED
         self.run.emit("message", None, delivery.sender, fate=fate.value, place=delivery.place,

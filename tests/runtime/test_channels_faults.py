@@ -175,29 +175,29 @@ def test_a_lost_message_can_leave_a_loss_notice():
         Scheduler(loads_net(TALK), config=RunConfig(channels={"radio": {**radio, "on_loss": "maybe"}}))
 
 
-def test_a_model_can_revoke_a_promised_message_before_it_arrives():
-    """A message its model revoked after promising it is lost at its delivery time (fate
-    lost, revoked), counted once as sent, and leaves a notice with on_loss: notify."""
-    from petriflow.runtime.channels import ChannelModel
+def test_a_medium_that_loses_a_message_in_flight_counts_it_once_as_sent():
+    """A medium (a process on the run's kernel) that loses a message after it was sent
+    records it lost then (fate lost, in_flight), counted once as sent, and leaves a
+    notice with on_loss: notify."""
+    from petriflow.runtime.media import Medium
     from petriflow.runtime.metrics import RunRecord, messages as count
+    from petriflow.runtime.registry import Registry
 
-    class Fickle(ChannelModel):
-        def deliver(self, message, rng):
-            self.promised = message
-            return 0.5
+    class Fickle(Medium):
+        def attach(self, port):
+            self.port = port
 
-    scheduler = Scheduler(loads_net(TALK), config=RunConfig(channels={"radio": {"model": "ideal"}}))
-    model = Fickle()
-    model.on_loss = "notify"
-    scheduler.channels.models["radio"] = model
+        def send(self, message):
+            self.port.clock.after(0.5, self.port.lose, message, "overwritten")
+
+    registry = Registry(False)
+    registry.register_channel("test.fickle", Fickle)
+    scheduler = Scheduler(loads_net(TALK), registry=registry,
+                          config=RunConfig(channels={"radio": {"model": "test.fickle", "on_loss": "notify"}}))
     events = []
     scheduler.on_event(events.append)
-
-    def revoke(event):
-        if event.kind == "message" and event.data.get("fate") == "sent":
-            model.promised.revoked = "overwritten"
-    scheduler.on_event(revoke)
     result = scheduler.run(until=5)
     assert messages(events) == [("sent", 0.0), ("lost", 0.5), ("noticed", 0.5)]
+    assert [e.data.get("in_flight") for e in events if e.kind == "message"] == [None, True, None]
     assert result.marking == {"a_done": 1, "b_done": 1}
     assert count(RunRecord(result, events)) == {"sent": 1, "delivered": 0, "lost": 1, "bytes": 4}

@@ -8,8 +8,7 @@ import importlib
 
 import pytest
 
-MODULES = ["errors", "frames", "packet", "timeline", "radio", "medium", "channel", "cpg", "algorithms", "addressing",
-           "experiment", "plugin"]
+MODULES = ["errors", "frames", "packet", "radio", "medium", "channel", "cpg", "algorithms", "addressing", "plugin"]
 
 
 @pytest.mark.parametrize("name", MODULES)

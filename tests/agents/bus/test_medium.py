@@ -6,9 +6,11 @@ import itertools
 import random
 
 import pytest
+from petriflow.agents.bus.errors import BusError
 from petriflow.agents.bus.frames import FrameError
 from petriflow.agents.bus.medium import BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
-from petriflow.agents.bus.timeline import Timeline
+from petriflow.runtime.kernel import Kernel
+from petriflow.runtime.media import ProcessClock
 
 BIT_CAN = 1 / 512_000
 BIT_SERIAL = 1 / 115_200
@@ -21,6 +23,13 @@ def frame(sender, receivers=(1,), identifier=None, data=bytes(8), tag=None):
     """A frame of 8 zero bytes, by default with the identifier 0x100 + sender."""
     identifier = 0x100 + sender if identifier is None else identifier
     return Frame(sender, tuple(receivers), data, identifier, tag if tag is not None else sender)
+
+
+def on_clock(bus, modules, rng=None, **options):
+    """A bus on a kernel of its own (1 µs ticks); modules read only when told."""
+    clock = ProcessClock(Kernel(1e-6))
+    options.setdefault("read_period", None)
+    return bus.medium(clock, rng or random.Random(0), modules, **options), clock
 
 
 class FixedBackoff(random.Random):
@@ -78,15 +87,16 @@ def test_can_shared_identifier_is_an_error():
 
 def test_can_refuses_nine_data_bytes():
     """A request the bus cannot carry fails at once."""
-    medium = CanBus().medium(Timeline(), random.Random(0), [0, 1])
+    medium, _ = on_clock(CanBus(), [0, 1])
     with pytest.raises(FrameError):
         medium.request(frame(0, (1,), 0x100, bytes(9)))
 
 
 # RS-485 -----------------------------------------------------------------------------
 
-def test_rs485_overlapping_frames_garble_both():
-    """A frame starting while another is on the line: both are lost to everyone."""
+def test_rs485_overlapping_frames_garble_both_at_the_overlap():
+    """A frame starting while another is on the line: both are lost to everyone, at the
+    moment they overlap (not when the first was sent, nor when they end)."""
     sim = BusSimulator(SerialBus(), modules=[0, 1, 2])
     sim.send(0.0, frame(0, (1,)))
     sim.send(50 * BIT_SERIAL, frame(2, (1,)))
@@ -94,7 +104,8 @@ def test_rs485_overlapping_frames_garble_both():
     medium = sim.run()
     assert [t.garbled for t in medium.transmissions] == [True, True]
     assert sim.received[1] == []
-    assert sorted(loss.frame.sender for loss in medium.losses if loss.reason is Loss.COLLISION) == [0, 2]
+    collisions = sorted((loss.frame.sender, loss.time) for loss in medium.losses if loss.reason is Loss.COLLISION)
+    assert collisions == [(0, pytest.approx(50 * BIT_SERIAL)), (2, pytest.approx(50 * BIT_SERIAL))]
 
 
 def test_rs485_back_to_back_frames_both_arrive():
@@ -112,29 +123,31 @@ def test_rs485_back_to_back_frames_both_arrive():
 
 def test_rs485_carrier_sense_sees_a_frame_one_bit_after_its_start():
     """is_free is true within the sensing delay of a start bit, false after it."""
-    timeline = Timeline()
-    medium = SerialBus().medium(timeline, random.Random(0), [0, 1])
+    medium, clock = on_clock(SerialBus(), [0, 1])
     medium.request(frame(0))
-    timeline.run(until=0.5 * BIT_SERIAL)
-    assert medium.is_free(1)
-    timeline.run(until=2 * BIT_SERIAL)
+    clock.run(until=0.5 * BIT_SERIAL)
+    assert medium.is_free(1) and medium.quiet_for() == 0.0
+    clock.run(until=2 * BIT_SERIAL)
     assert not medium.is_free(1)
-    timeline.run(until=0.01)
+    clock.run(until=0.01)
     assert medium.is_free(1)
+    assert medium.quiet_for() == pytest.approx(0.01 - 90 * BIT_SERIAL)  # 8 bytes and a checksum, 8N1
 
 
 # Buffers and queues -----------------------------------------------------------------
 
-def test_receive_buffer_of_one_frame_is_overwritten():
-    """Two frames before a read: the module gets the newer; the older is lost, overwritten."""
+def test_receive_buffer_of_one_frame_is_overwritten_when_the_newer_arrives():
+    """Two frames before a read: the module gets the newer; the older is lost,
+    overwritten, when the newer reached the buffer (the end of its transmission)."""
     sim = BusSimulator(CanBus(), modules=[0, 1, 2])
     sim.send(0.0, frame(0, (1,), 0x100, tag="old"))
     sim.send(0.001, frame(2, (1,), 0x102, tag="new"))
     sim.read(0.005, 1)
     medium = sim.run()
     assert [f.tag for f in sim.received[1]] == ["new"]
-    assert [(loss.frame.tag, loss.module, loss.reason) for loss in medium.losses
-            if loss.module == 1] == [("old", 1, Loss.OVERWRITTEN)]
+    new = medium.transmissions[1]
+    assert [(loss.frame.tag, loss.module, loss.reason, loss.time) for loss in medium.losses
+            if loss.module == 1] == [("old", 1, Loss.OVERWRITTEN, new.end)]
 
 
 def test_bigger_receive_buffer_keeps_both():
@@ -161,18 +174,18 @@ def test_frame_for_another_module_overwrites_without_acceptance_filter():
 
 def test_transmit_queue_overflows():
     """tx_queue=1: one frame on the line, one waiting, the third is dropped."""
-    timeline = Timeline()
-    medium = SerialBus(tx_queue=1).medium(timeline, random.Random(0), [0, 1])
+    sim = BusSimulator(SerialBus(tx_queue=1), modules=[0, 1])
+    medium = sim.medium
     results = [medium.request(frame(0, tag=i)) for i in range(3)]
     assert results == [True, True, False]
     assert [(loss.frame.tag, loss.reason) for loss in medium.losses] == [(2, Loss.QUEUE_FULL)]
-    timeline.run()
+    sim.run()
     assert [t.frame.tag for t in medium.transmissions] == [0, 1]
 
 
 def test_unattached_sender_is_refused():
     """A module must be attached before it sends."""
-    medium = SerialBus().medium(Timeline(), random.Random(0), [0])
+    medium, _ = on_clock(SerialBus(), [0])
     with pytest.raises(FrameError):
         medium.request(frame(5))
 
@@ -203,13 +216,12 @@ def test_zigbee_busy_channel_raises_the_backoff_exponent_and_gives_up():
     2^5, 2^5, then the frame is dropped for channel access failure."""
     slow = ZigbeeBus(air_bitrate=1000.0)  # the first frame holds the air for 0.336 s
     rng = FixedBackoff(0)
-    medium = slow.medium(Timeline(), rng, [0, 1, 2])
-    timeline = medium.timeline
+    medium, clock = on_clock(slow, [0, 1, 2], rng)
     medium.request(frame(0, (2,), tag="jammer"))
-    timeline.run(until=0.005)
+    clock.run(until=0.005)
     rng.asked.clear()
     medium.request(frame(1, (2,), tag="victim"))
-    timeline.run(until=0.2)
+    clock.run(until=0.2)
     assert rng.asked == [8, 16, 32, 32, 32]
     [loss] = [loss for loss in medium.losses if loss.frame.tag == "victim"]
     assert loss.reason is Loss.ACCESS_FAILURE
@@ -219,22 +231,23 @@ def test_zigbee_busy_channel_raises_the_backoff_exponent_and_gives_up():
 def test_zigbee_radios_assessing_together_collide():
     """Two radios whose CCAs end at the same time both find the air clear, both send,
     both frames are garbled."""
-    medium = ZigbeeBus().medium(Timeline(), FixedBackoff(0), [0, 1, 2])
+    medium, clock = on_clock(ZigbeeBus(), [0, 1, 2], FixedBackoff(0))
     medium.request(frame(0, (2,), tag="a"))
     medium.request(frame(1, (2,), tag="b"))
-    medium.timeline.run()
+    clock.run(until=0.1)
     assert [t.garbled for t in medium.transmissions] == [True, True]
-    assert {loss.frame.tag for loss in medium.losses if loss.reason is Loss.COLLISION} == {"a", "b"}
+    start = medium.transmissions[0].start
+    assert {(loss.frame.tag, loss.time) for loss in medium.losses if loss.reason is Loss.COLLISION} == {
+        ("a", start), ("b", start)}
 
 
 def test_zigbee_radio_after_a_clear_assessment_waits_for_the_air():
     """A radio whose CCA comes after another's frame started defers: no collision."""
-    rng = FixedBackoff(0)
-    medium = ZigbeeBus().medium(Timeline(), rng, [0, 1, 2])
+    medium, clock = on_clock(ZigbeeBus(), [0, 1, 2], FixedBackoff(0))
     medium.request(frame(0, (2,), tag="a"))
-    medium.timeline.run(until=0.0025)  # a is on the air now
+    clock.run(until=0.0025)  # a is on the air now
     medium.request(frame(1, (2,), tag="b"))
-    medium.timeline.run()
+    clock.run(until=0.1)
     assert [t.garbled for t in medium.transmissions] == [False, False]
     a, b = medium.transmissions
     assert b.start >= a.end
@@ -256,8 +269,7 @@ def test_zigbee_weak_link_loses_frames_to_bit_errors():
 
 def test_zigbee_module_only_sees_its_own_radio():
     """The module cannot hear the air: the bus is 'free' for it while another radio sends."""
-    timeline = Timeline()
-    medium = ZigbeeBus().medium(timeline, random.Random(0), [0, 1])
+    medium, _ = on_clock(ZigbeeBus(), [0, 1])
     medium.request(frame(0))
     assert not medium.is_free(0) and medium.is_free(1)
 
@@ -272,7 +284,7 @@ def test_same_seed_same_history(bus):
             sender = i % 3
             sim.send(0.0007 * i, frame(sender, ((sender + 1) % 3,), 0x100 + sender, bytes(8), tag=i))
         for module in range(3):
-            sim.read_every(module, 0.02, start=0.001 * module, until=0.1)
+            sim.reads_every(module, 0.02, phase=0.001 * module)
         medium = sim.run()
         return ([(t.frame.tag, round(t.start, 9), t.garbled) for t in medium.transmissions],
                 [(loss.frame.tag, loss.module, loss.reason) for loss in medium.losses])
@@ -280,3 +292,72 @@ def test_same_seed_same_history(bus):
     assert history(1) == history(1)
     if isinstance(bus, ZigbeeBus):  # backoffs and fading are drawn: another seed, another history
         assert history(1) != history(2)
+
+
+# Reads, listeners and logs ---------------------------------------------------------
+
+def test_a_read_is_scheduled_only_while_a_frame_waits_on_the_modules_phase():
+    """A module reading every 10 ms from 3 ms: nothing is scheduled while its buffer is
+    empty; a frame arriving at about 0.24 ms is read at 3 ms, one arriving at about 13.3
+    ms at 23 ms, and when the bus is done nothing is left pending (a run would end)."""
+    medium, clock = on_clock(CanBus(), [0, 1])
+    medium.reads_every(1, 0.01, phase=0.003)
+    assert clock.kernel.pending == 0
+    reads = []
+    medium.on_delivery(lambda d: reads.append((d.frame.tag, d.arrived, d.read)))
+    medium.request(frame(0, (1,), tag="first"))
+    clock.run(until=0.0005)
+    assert medium.waiting(1) == 1 and clock.kernel.pending == 1  # the read at 3 ms, nothing else
+    clock.run(until=0.005)
+    assert clock.kernel.pending == 0
+    assert reads == [("first", medium.transmissions[0].end, pytest.approx(0.003))]
+    clock.at(0.0131, medium.request, frame(0, (1,), tag="second"))
+    clock.run(until=0.05)
+    assert reads[1] == ("second", medium.transmissions[1].end, pytest.approx(0.023))
+    assert clock.kernel.pending == 0
+
+
+def test_a_read_period_of_zero_reads_on_arrival_and_a_new_period_reads_a_waiting_frame():
+    medium, clock = on_clock(CanBus(), [0, 1])
+    medium.request(frame(0, (1,), tag="waits"))
+    clock.run(until=0.001)
+    assert medium.waiting(1) == 1 and medium.read_period_of(1) is None
+    medium.reads_every(1, 0.0)  # on arrival: what waits is read now
+    assert medium.waiting(1) == 0 and [d.frame.tag for d in medium.deliveries] == ["waits"]
+    medium.request(frame(0, (1,), tag="now"))
+    clock.run(until=0.002)
+    first, second = medium.transmissions
+    assert [(d.arrived, d.read) for d in medium.deliveries] == [(first.end, pytest.approx(0.001)),
+                                                                (second.end, second.end)]
+    with pytest.raises(BusError):
+        medium.reads_every(1, -1.0)
+
+
+def test_listeners_hear_everything_and_logs_can_be_off():
+    """Without logs the medium keeps no lists (a run's bus); listeners still hear each
+    start, end, delivery and loss as it happens."""
+    medium, clock = on_clock(SerialBus(), [0, 1, 2], logs=False, read_period=0.0)
+    heard = []
+    medium.on_start(lambda t: heard.append(("start", t.frame.tag)))
+    medium.on_end(lambda t: heard.append(("end", t.frame.tag, t.garbled)))
+    medium.on_delivery(lambda d: heard.append(("read", d.frame.tag, d.module)))
+    medium.on_loss(lambda lost: heard.append((lost.reason.value, lost.frame.tag)))
+    medium.on_idle(lambda module: heard.append(("idle", module)))
+    medium.request(frame(0, (1,), tag="a"))
+    clock.at(50 * BIT_SERIAL, medium.request, frame(2, (1,), tag="b"))
+    clock.at(0.01, medium.request, frame(2, (1,), tag="c"))
+    clock.run(until=0.02)
+    assert heard == [("start", "a"), ("start", "b"), ("collision", "a"), ("collision", "b"),
+                     ("end", "a", True), ("end", "b", True), ("idle", 0), ("idle", 1), ("idle", 2),
+                     ("start", "c"), ("end", "c", False), ("read", "c", 1), ("idle", 0), ("idle", 1), ("idle", 2)]
+    assert medium.transmissions == medium.deliveries == medium.losses == []
+
+
+def test_zigbee_rssi_is_the_cores_log_distance_model():
+    """One log-distance formula: the radio link's RSSI is petriflow.runtime.radio's."""
+    from petriflow.runtime.radio import LogDistance
+
+    link = ZigbeeBus(tx_power_dbm=3.0, exponent=2.5).link()
+    assert link.path == LogDistance(3.0, 40.0, 2.5, 0.05)
+    for distance in (0.01, 0.08, 1.0, 30.0):
+        assert link.rssi(distance, walls_db=4.0) == LogDistance(3.0, 40.0, 2.5, 0.05).rssi(distance, 4.0)

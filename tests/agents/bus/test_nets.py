@@ -3,20 +3,16 @@ bus channel's multicast frames and read periods, whole runs and the chain's sens
 
 from __future__ import annotations
 
-import random
-
 import pytest
 import yaml
 
 from petriflow import examples
 from petriflow.agents.bus.chain import front_is_free
 from petriflow.agents.bus.firmware import Module
-from petriflow.agents.bus.medium import CanBus, SerialBus
 from petriflow.agents.bus.nets import build
 from petriflow.analysis import check_net
 from petriflow.io import load_net
 from petriflow.io.yaml import loads_net
-from petriflow.runtime.channels import Message
 from petriflow.runtime.config import RunConfig
 from petriflow.testing import fire_one
 from petriflow.world import World
@@ -107,21 +103,44 @@ def test_reception_keeps_a_neighbours_phase_and_counts_a_lost_frame():
     assert [e.data["data"] for e in lost.events if e.kind == "custom"][0]["why"] == "collision"
 
 
-def test_a_multicast_message_is_one_frame_on_the_bus():
-    bus, rng = SerialBus(), random.Random(0)
-    data = {"payload": bytes(9), "multicast": 1, "receivers": ["b", "c"]}
-    first = bus.deliver(Message("box_a_b", "a", "b", data, 0.0, 9), rng)
-    second = bus.deliver(Message("box_a_c", "a", "c", data, 0.0, 9), rng)
-    assert first == second == pytest.approx(100 / 115_200) and bus._channel.sent == 1
+def test_a_middle_modules_message_is_one_frame_read_by_both_neighbours_at_their_reads():
+    """Algorithm 1 on CAN with logs: m2's send puts a copy in each neighbour's place but
+    ONE frame on the bus, addressed to both; each copy arrives when its module reads
+    its buffer (every 20 ms + its delay, from the end of its boot); a neighbour-less
+    frame is never on the bus."""
+    from petriflow.runtime.scheduler import Scheduler
+
+    config = RunConfig(channels={"bus": {"model": "bus.can", "on_loss": "notify", "logs": True}}, dt=0.002)
+    scheduler = Scheduler(loads_net(build(3, 1, messages=3)), config=config, seed=3)
+    events = []
+    scheduler.on_event(events.append)
+    assert scheduler.run(until=60).reason == "final"
+    medium = scheduler.channels.models["bus"].state
+    carrier = scheduler.channels.models["bus"]._carrier
+    by_number = {number: agent for agent, number in carrier.numbers.items()}
+    frames = [(by_number[t.frame.sender], sorted(by_number[r] for r in t.frame.receivers))
+              for t in medium.transmissions]
+    assert frames.count(("m2", ["m1", "m3"])) == 3 and len(frames) == 9  # 3 modules × 3 messages: 9 frames
+    addressed = {e.agent: e.data["data"]["read_every"] for e in events
+                 if e.kind == "custom" and e.data["name"] == "bus.addressed"}
+    booted = {e.transition[:2]: e.time for e in events if e.kind == "end" and e.transition.endswith("_boot")}
+    for delivery in medium.deliveries:  # every read on the reader's own phase
+        reader = by_number[delivery.module]
+        k = (delivery.read - booted[reader]) / addressed[reader]
+        assert k == pytest.approx(round(k), abs=0.002 / addressed[reader] + 1e-6)
 
 
-def test_a_module_reads_its_buffer_at_its_own_period():
-    bus, rng = CanBus(), random.Random(0)
-    bus.reads_every("b", 0.5)
-    delay = bus.deliver(Message("box_a_b", "a", "b", {"payload": bytes(8)}, 0.1, 8), rng)
-    assert delay == pytest.approx(0.4)  # the next read of b is at 0.5 s
-    assert bus.quiet_for(0.1001) == 0.0  # the frame is on the bus (about 0.2 ms)
-    assert bus.quiet_for(0.3) == pytest.approx(0.2, abs=0.001)
+def test_a_module_tells_the_bus_its_read_period_through_its_view():
+    """bus.boot asks the bus through ctx.medium: the module reads every step (algorithm 2)."""
+    net = loads_net(build(3, 2))
+    from petriflow.runtime.scheduler import Scheduler
+
+    scheduler = Scheduler(net, config=CAN, seed=1)
+    scheduler.run(until=0.2)
+    bus = scheduler.channels.models["bus"]
+    assert bus.view("m2").read_period == pytest.approx(0.02) and bus.view("m3").read_period == pytest.approx(0.02)
+    assert bus.view("m1").read_period == 0.0  # algorithm 2's head receives nothing: the bus's default
+    scheduler.close()
 
 
 def test_whole_runs_end_at_the_final_marking_with_every_message_counted(tmp_path):
