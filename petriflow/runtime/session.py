@@ -472,19 +472,14 @@ def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | 
         (3.0, ['run', 'start', 'end', 'stop'])
     """
     binding = None
+    config = RunConfig.from_dict(config) if isinstance(config, dict) else config
     if not isinstance(net, Net):
-        if isinstance(config, (RunConfig, dict)):
-            config = config if isinstance(config, RunConfig) else RunConfig.from_dict(config)
         if world is None or isinstance(world, (str, Path)):
             return run_files(net, world=world, config=config, seed=seed, until=until, trace=trace, xes=xes,
                              registry=registry, max_firings=max_firings, keep_events=keep_events)
         prepared = prepare(net, config=config, registry=registry)  # a file run over a World made in code
         net, config, binding = prepared.net, prepared.config, prepared.binding
-    if isinstance(config, dict):
-        config = RunConfig.from_dict(config)
-    elif isinstance(config, (str, Path)):
-        config = load_config(config)
-    config = config or RunConfig()
+    config = (load_config(config) if isinstance(config, (str, Path)) else config) or RunConfig()
     config.import_actions()
     close = False
     if isinstance(world, (str, Path)):
