@@ -1,5 +1,19 @@
 """A test kit: fire one transition of a real net with its real action, in pytest.
 
+:func:`fire_one` loads a net the way ``petriflow run`` does: a net file (or a net read
+from one) finds its run configuration (the one it names, else ``run.yaml`` beside it),
+imports the action modules that configuration lists, and loads the world it names;
+channels and faults come from it too. A firing that is still running when ``timeout``
+(simulated seconds) runs out is an error naming the transition, its action and the
+timeout, never a silent empty result.
+
+The pytest fixture ``petriflow_net`` (this module is a pytest plugin, registered when
+petriflow is installed) makes a user's test three lines::
+
+    def test_dock(petriflow_net):
+        fired = petriflow_net("nets/mine/net.yaml").fire("dock")
+        assert fired.outcome == "ok"
+
 Examples:
     >>> from petriflow.io.yaml import loads_net
     >>> net = loads_net('''
@@ -15,6 +29,7 @@ Examples:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from petriflow.errors import PetriflowError
@@ -22,10 +37,24 @@ from petriflow.marking import Marking
 from petriflow.net import Net
 from petriflow.runtime.action import Action, ActionContext, Outcome, Param, Status
 from petriflow.runtime.registry import Registry
-from petriflow.runtime.scheduler import Scheduler
 from petriflow.runtime.trace import Event
 
-__all__ = ["fire_one", "FiredTransition", "ScriptedAction", "check_action", "StubWorld"]
+
+def _fixture(function: Any) -> Any:
+    """``pytest.fixture(function)`` when pytest is installed (this module is its plugin),
+    else the function itself."""
+    try:
+        import pytest
+    except ImportError:  # pragma: no cover - petriflow without pytest
+        return function
+    return pytest.fixture(function)
+
+__all__ = ["fire_one", "FiredTransition", "FiringTimeout", "LoadedNet", "load", "ScriptedAction", "check_action",
+           "StubWorld", "petriflow_net"]
+
+
+class FiringTimeout(PetriflowError):
+    """The fired transition's action was still running when the test's timeout ran out."""
 
 
 @dataclass
@@ -52,7 +81,7 @@ class FiredTransition:
 
 
 def fire_one(
-    net: Net,
+    net: Net | str | Path,
     transition: str,
     marking: Mapping[str, int] | None = None,
     *,
@@ -66,32 +95,45 @@ def fire_one(
     """Fire ``transition`` of ``net`` once, with its bound action, and wait for it.
 
     Args:
-        net: the net (its actions are bound and checked as in a real run).
+        net: the net (its actions are bound and checked as in a real run), or its file.
         transition: the transition to fire.
         marking: token counts to start from (default: the net's initial marking);
             tokens without data (``None``).
         tokens: token data per place to start from, instead of ``marking``.
-        world: a world (or :class:`StubWorld`) for actions that need one.
+        world: a world (or :class:`StubWorld`) for actions that need one (default:
+            the one the run configuration names, loaded for this firing).
         registry: where actions are looked up (default: the run registry).
         seed: the run seed (the firing's random generator derives from it).
         timeout: simulated seconds to wait for the action.
-        config: a run configuration (:class:`~petriflow.runtime.config.RunConfig`):
-            its channel models carry the channel places (a radio the action judges).
+        config: a run configuration (:class:`~petriflow.runtime.config.RunConfig`,
+            its mapping, or a file; default: the one the net's file names, as ``run``).
 
     Raises:
         NotEnabledError: the transition is not enabled in the given marking.
+        FiringTimeout: the action was still running after ``timeout`` seconds.
     """
-    scheduler = Scheduler(net, world=world, seed=seed, registry=registry, config=config)
-    if tokens is not None:
-        scheduler.set_tokens({p: list(v) for p, v in tokens.items()})
-    elif marking is not None:
-        net.check_marking(marking)
-        scheduler.set_tokens({p: [None] * n for p, n in marking.items()})
-    events: list[Event] = []
-    scheduler.on_event(events.append)
-    with scheduler:
+    with load(net, config=config, world=world, registry=registry) as loaded:
+        return loaded.fire(transition, marking, tokens=tokens, seed=seed, timeout=timeout)
+
+
+def _fire(net: Net, binding: Any, config: Any, world: Any, transition: str, marking: Mapping[str, int] | None,
+          tokens: Mapping[str, Sequence[Any]] | None, seed: int, timeout: float) -> FiredTransition:
+    from petriflow.runtime.assembly import open_run
+
+    with open_run(net, binding, config, seed=seed, world=world) as scheduler:
+        if tokens is not None:
+            scheduler.set_tokens({p: list(v) for p, v in tokens.items()})
+        elif marking is not None:
+            net.check_marking(marking)
+            scheduler.set_tokens({p: [None] * n for p, n in marking.items()})
+        events: list[Event] = []
+        scheduler.on_event(events.append)
         run = scheduler.fire_one(transition, timeout=timeout)
     ends = [e for e in events if e.kind == "end" and e.transition == transition]
+    if not ends and run.reason != "failed":
+        action = net.transitions[transition].action
+        raise FiringTimeout(f"transition {transition!r} (action {action}) was still running after {timeout:g} s"
+                            " of simulated time: give fire_one a longer timeout=, or check why it does not end")
     outcome = ends[-1].data["outcome"] if ends else None
     result = ends[-1].data.get("result") if ends else None
     reason = ends[-1].data.get("reason") if ends else None
@@ -100,6 +142,95 @@ def fire_one(
     starts = [e for e in events if e.kind == "start"]
     took = (ends[-1].time if ends else run.time) - (starts[0].time if starts else 0.0)
     return FiredTransition(outcome, result, run.marking, run.tokens, events, round(took, 9), reason)
+
+
+class LoadedNet:
+    """A net loaded as ``petriflow run`` loads it, to fire its transitions one at a time
+    (what :func:`load` and the ``petriflow_net`` fixture give).
+
+    Attributes:
+        net: the net.
+        config: its run configuration.
+        world: the world the configuration names (or the one given), or ``None``.
+    """
+
+    def __init__(self, net: Net, binding: Any, config: Any, world: Any, owned: bool) -> None:
+        self.net, self.binding, self.config, self.world = net, binding, config, world
+        self._owned = owned
+
+    def fire(self, transition: str, marking: Mapping[str, int] | None = None, *,
+             tokens: Mapping[str, Sequence[Any]] | None = None, seed: int = 0,
+             timeout: float = 60.0) -> FiredTransition:
+        """Fire ``transition`` once (see :func:`fire_one`)."""
+        return _fire(self.net, self.binding, self.config, self.world, transition, marking, tokens, seed, timeout)
+
+    def close(self) -> None:
+        """Close the world if it was loaded here."""
+        if self._owned and self.world is not None:
+            self.world.close()
+            self.world = None
+
+    def __enter__(self) -> "LoadedNet":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+
+def load(net: Net | str | Path, *, config: Any = None, world: Any = None,
+         registry: Registry | None = None) -> LoadedNet:
+    """Load a net (a file, or a net read from one) with its run configuration, action
+    modules and world, as ``petriflow run`` does; a :class:`LoadedNet` to fire from.
+
+    Raises:
+        NetFormatError: a file is missing or malformed, or an action does not bind.
+    """
+    from petriflow.runtime.assembly import validate
+    from petriflow.runtime.config import RunConfig, load_config
+
+    if isinstance(net, (str, Path)) or (config is None and getattr(net, "path", None)):
+        from petriflow.runtime.session import prepare
+
+        source = net if isinstance(net, (str, Path)) else Path(net.path)
+        given = RunConfig.from_dict(config) if isinstance(config, dict) else config
+        prepared = prepare(source, config=given, registry=registry)
+        if not isinstance(net, (str, Path)):  # keep the caller's net object (it may be edited in the test)
+            prepared.net = net
+        net, config, binding = prepared.net, prepared.config, prepared.binding
+        world_file = prepared.world
+    else:
+        config = RunConfig.from_dict(config) if isinstance(config, dict) else (
+            load_config(config) if isinstance(config, (str, Path)) else config) or RunConfig()
+        config.import_actions()
+        binding, world_file = None, None
+    binding = validate(net, config, binding=None if binding is None or binding.net is not net else binding,
+                       registry=registry)
+    owned = world is None and world_file is not None
+    if owned:
+        from petriflow.world import load_world
+
+        world = load_world(world_file)
+    return LoadedNet(net, binding, config, world, owned)
+
+
+@_fixture
+def petriflow_net(request: Any) -> Any:
+    """The pytest fixture: ``petriflow_net(path, **load options)`` loads a net as
+    ``petriflow run`` does (:func:`load`; a relative path is taken from the test's
+    folder, then the current one), closed at the end of the test."""
+    loaded: list[LoadedNet] = []
+
+    def make(path: str | Path, **options: Any) -> LoadedNet:
+        where = Path(path)
+        if not where.is_absolute() and not where.exists():
+            beside = Path(str(request.fspath)).parent / where
+            where = beside if beside.exists() else where
+        loaded.append(load(where, **options))
+        return loaded[-1]
+
+    yield make
+    for item in loaded:
+        item.close()
 
 
 class ScriptedAction(Action):

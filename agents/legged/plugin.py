@@ -7,7 +7,7 @@ Examples:
     >>> from petriflow.runtime.registry import Registry
     >>> registry = Registry(load_plugins=False)
     >>> register(registry)
-    >>> registry.names()
+    >>> [name for name in registry.names() if name.startswith("gait.")]
     ['gait.brace', 'gait.stand_up', 'gait.turn', 'gait.walk']
 """
 
