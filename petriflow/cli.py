@@ -258,6 +258,16 @@ def cmd_export(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _progress(args: argparse.Namespace) -> bool | float:
+    """What ``run`` shows while it runs: nothing (``--quiet``, ``--json``), else a line on
+    a terminal, and off one a line every ``--progress-every`` seconds."""
+    if args.quiet or args.json:
+        return False
+    if not args.progress_every > 0:
+        raise PetriflowError(f"--progress-every must be a number of seconds > 0, got {args.progress_every}")
+    return float(args.progress_every)
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     from petriflow.runtime.session import resume, run_files
 
@@ -265,7 +275,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.db is None:
             raise PetriflowError("--resume needs --db RUN_DB (the journal of the run to continue)")
         outcome = resume(args.db, trace=args.trace, xes=args.xes, realtime=args.realtime,
-                         gui=args.gui, progress=not args.json)
+                         gui=args.gui, progress=_progress(args))
     else:
         if args.net is None:
             raise PetriflowError("give the net to run (or --resume --db RUN_DB)")
@@ -275,7 +285,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             raise PetriflowError(f"--max-firings must be >= 0, got {args.max_firings}")
         outcome = run_files(args.net, world=args.world, config=args.config, seed=args.seed,
                             until=args.until, trace=args.trace, xes=args.xes, db=args.db,
-                            realtime=args.realtime, gui=args.gui, progress=not args.json,
+                            realtime=args.realtime, gui=args.gui, progress=_progress(args),
                             max_firings=args.max_firings)
     result = outcome.result
     summary = {
@@ -348,13 +358,22 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
+    from petriflow.analysis.coverability import DEFAULT_MAX_COVERABILITY
+    from petriflow.analysis.invariants import DEFAULT_BUDGET
     from petriflow.analysis.reachability import DEFAULT_MAX_STATES
     from petriflow.analysis.report import check_net, exit_code, format_report, plain
 
     if args.max_states is not None and args.max_states < 1:
         raise PetriflowError(f"--max-states must be >= 1, got {args.max_states}")
+    for option, value in (("--max-coverability", args.max_coverability),
+                          ("--invariant-budget", args.invariant_budget)):
+        if value is not None and value < 0:
+            raise PetriflowError(f"{option} must be >= 0, got {value}")
     net, _ = _load_bound(args.net, args.import_actions)
-    result = check_net(net, max_states=args.max_states or DEFAULT_MAX_STATES)
+    result = check_net(
+        net, max_states=args.max_states or DEFAULT_MAX_STATES,
+        max_coverability=DEFAULT_MAX_COVERABILITY if args.max_coverability is None else args.max_coverability,
+        invariant_budget=DEFAULT_BUDGET if args.invariant_budget is None else args.invariant_budget)
     if args.json:
         _print_json(plain(result))
     else:
@@ -431,6 +450,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--realtime", action="store_true", help="pace simulated time to the wall clock")
     run.add_argument("--gui", action="store_true", help="open pybullet's GUI (needs a display)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
+    run.add_argument("--quiet", action="store_true", help="no progress on standard error")
+    run.add_argument("--progress-every", type=float, default=30.0, metavar="S",
+                     help="off a terminal (a log, CI): a progress line every S wall seconds (default 30)")
     run.set_defaults(handler=cmd_run)
 
     actions = sub.add_parser("actions", help="List the actions transitions can be bound to.",
@@ -453,7 +475,15 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--json", action="store_true", help="print JSON")
     check.add_argument("--import-actions", action="store_true", help=import_help)
     check.add_argument("--max-states", type=int, default=None, metavar="N",
-                       help="most markings to explore (default 2,000,000); beyond it, exit 2")
+                       help="most markings to explore (default 2,000,000); beyond it the facts"
+                       " found so far, and exit 2 (1 when one of them fails)")
+    check.add_argument("--max-coverability", type=int, default=None, metavar="N",
+                       help="most nodes of the Karp-Miller search that decides boundedness before"
+                       " the state space (default 100,000; 0: none)")
+    check.add_argument("--invariant-budget", type=int, default=None, metavar="N",
+                       help="work budget of each of the P- and T-semiflow computations (default"
+                       " 100,000,000 steps, about 0.2 s; 0: skip them); beyond it they are"
+                       " 'not computed (over budget)'")
     from petriflow.sweep.command import add_parser as add_sweep
 
     add_sweep(sub)

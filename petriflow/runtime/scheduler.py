@@ -171,12 +171,18 @@ class Scheduler:
             self.registry, ResourceContext(world, Liveness(self.faults.alive, index.agents), self.config))
         self._started = self._closed = False
         self._opened = False  # whether the instant at tick 0 was processed
+        self._watchers: list[Any] = []
         self._finished: RunResult | None = None
 
     # Observers ----------------------------------------------------------------------
     def on_event(self, handler: EventHandler) -> None:
         """Call ``handler(event)`` for every event, in order."""
         self.recorder.on_event(handler)
+
+    def on_instant(self, watcher: Any) -> None:
+        """Call ``watcher(scheduler)`` after each instant: for displays that need no
+        event data (a progress line), so no event has to be built for them."""
+        self._watchers.append(watcher)
 
     def emit(self, kind: str, transition: str | None = None, agent: str | None = None, **data: Any) -> None:
         """Record an event (for components; observers receive it)."""
@@ -285,6 +291,8 @@ class Scheduler:
             if fire:
                 self.firer.fire_instant()
             if not kernel.due():
+                for watcher in self._watchers:
+                    watcher(self)
                 return
 
     def step(self) -> None:

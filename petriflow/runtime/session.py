@@ -101,34 +101,52 @@ class Prepared:
 
 
 class Progress:
-    """A one-line live display (simulated time, firings, agents alive) on a terminal.
+    """Progress of a run on standard error: a live line on a terminal, or, off a
+    terminal (a log, CI), a line every ``interval`` wall seconds, so a long run is never
+    silent. Simulated time, firings and agents alive.
 
-    It appears only after the run has lasted ``delay`` wall seconds and only when
-    ``stream`` is a terminal.
+    Args:
+        scheduler: the run.
+        stream: where to write (default: standard error).
+        delay: on a terminal, seconds before the line first appears.
+        interval: off a terminal, seconds between lines (``None``: nothing off a terminal).
     """
 
-    def __init__(self, scheduler: Scheduler, stream: TextIO = sys.stderr, delay: float = 1.0) -> None:
+    def __init__(self, scheduler: Scheduler, stream: TextIO = sys.stderr, delay: float = 1.0,
+                 interval: float | None = 30.0) -> None:
         self.scheduler = scheduler
         self.stream = stream
         self.delay = delay
         self.start = wallclock.perf_counter()
         self.last = 0.0
         self.shown = False
-        self.active = hasattr(stream, "isatty") and stream.isatty()
+        self.terminal = hasattr(stream, "isatty") and stream.isatty()
+        self.interval = interval
+        self.active = self.terminal or interval is not None
 
-    def __call__(self, event: Event) -> None:
-        if not self.active:
-            return
-        now = wallclock.perf_counter()
-        if now - self.start < self.delay or now - self.last < 0.2:
-            return
-        self.last = now
+    def _text(self, time: float) -> str:
         alive = sum(self.scheduler.alive.values())
         total = len(self.scheduler.alive)
         agents = f"  agents alive {alive}/{total}" if total else ""
-        self.stream.write(f"\r  t = {event.time:9.2f} s  firings {self.scheduler.firings:7d}{agents}   ")
-        self.stream.flush()
-        self.shown = True
+        return f"t = {time:9.2f} s  firings {self.scheduler.firings:7d}{agents}"
+
+    def __call__(self, scheduler: Scheduler) -> None:
+        """After an instant (``Scheduler.on_instant``): no event needs building for it."""
+        if not self.active:
+            return
+        now = wallclock.perf_counter()
+        if self.terminal:
+            if now - self.start < self.delay or now - self.last < 0.2:
+                return
+            self.last = now
+            self.stream.write(f"\r  {self._text(scheduler.now)}   ")
+            self.stream.flush()
+            self.shown = True
+        elif now - max(self.last, self.start) >= self.interval:
+            self.last = now
+            self.stream.write(f"{self.scheduler.net.id}: {self._text(scheduler.now)}"
+                              f"  ({now - self.start:.0f} s wall)\n")
+            self.stream.flush()
 
     def close(self) -> None:
         if self.shown:
@@ -260,7 +278,7 @@ def _check_outputs(outputs: dict[str, str | Path | None], read: list[Path | str 
 
 
 def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: Path | None,
-             xes: Path | None, progress: bool, keep_events: bool) -> dict[str, Any]:
+             xes: Path | None, progress: bool | float, keep_events: bool) -> dict[str, Any]:
     """Subscribe the requested observers; returns them by name."""
     observers: dict[str, Any] = {}
     if keep_events:
@@ -282,15 +300,15 @@ def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: 
         observers["xes"] = XesWriter(xes, case=net.id, labels=labels, silent=silent)
         scheduler.on_event(observers["xes"])
     if progress:
-        display = Progress(scheduler)
-        if display.active:  # an observer makes every event be built: only on a terminal
+        display = Progress(scheduler, interval=None if progress is True else float(progress))
+        if display.active:  # watches instants: no event is built for it
             observers["progress"] = display
-            scheduler.on_event(display)
+            scheduler.on_instant(display)
     return observers
 
 
 def _observed_run(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: Path | None,
-                  xes: Path | None, progress: bool, keep_events: bool, **limits: Any) -> RunOutcome:
+                  xes: Path | None, progress: bool | float, keep_events: bool, **limits: Any) -> RunOutcome:
     """Run ``scheduler`` with the requested observers; the trace and XES files are
     renamed into place if the run ends, dropped if it raises."""
     observers: dict[str, Any] = {}
@@ -319,7 +337,7 @@ def _observed_run(scheduler: Scheduler, net: Net, *, journal: Journal | None, tr
 
 def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, Any], *,
              journal: Journal | None, trace: Path | None, xes: Path | None, realtime: bool, gui: bool,
-             progress: bool, max_firings: int | None, keep_events: bool = False) -> RunOutcome:
+             progress: bool | float, max_firings: int | None, keep_events: bool = False) -> RunOutcome:
     with open_run(net, binding, config, seed=inputs["seed"], world_data=_world_data(inputs),
                   world_file=inputs.get("world_file"), world_base=inputs.get("world_base"), gui=gui,
                   realtime=realtime) as scheduler:
@@ -359,13 +377,14 @@ def _make_folders(*outputs: str | Path | None) -> None:
 def run_files(net_path: str | Path, *, world: str | Path | None = None, config: str | Path | None = None,
               seed: int | None = None, until: float | None = None, trace: str | Path | None = None,
               xes: str | Path | None = None, db: str | Path | None = None, realtime: bool = False,
-              gui: bool = False, registry: Registry | None = None, progress: bool = False,
+              gui: bool = False, registry: Registry | None = None, progress: bool | float = False,
               max_firings: int | None = None, keep_events: bool = False) -> RunOutcome:
     """Run the net in ``net_path`` (what ``petriflow run`` does).
 
     The run configuration is ``config``, else the one the net names, else
     ``run.yaml`` beside the net; ``world``, ``seed`` and ``until`` override what the
-    configuration says.
+    configuration says. ``progress``: ``True`` shows a live line on a terminal; a
+    number of seconds also prints a line that often off a terminal (a log, CI).
 
     Raises:
         NetFormatError: a file is missing or malformed, an action is unknown...
@@ -404,7 +423,7 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
 
 def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path | None = None,
            realtime: bool = False, gui: bool = False, registry: Registry | None = None,
-           progress: bool = False) -> RunOutcome:
+           progress: bool | float = False) -> RunOutcome:
     """Continue the run journaled in ``db`` after a kill.
 
     The run is re-executed from its journaled inputs (the firing limit and the trace and

@@ -39,7 +39,7 @@ from typing import Any, Callable
 
 from petriflow.errors import PetriflowError
 from petriflow.sweep.backends import BACKENDS, BackendError, default_workers, run_local, run_ray
-from petriflow.sweep.report import metric_names, summary
+from petriflow.sweep.report import metric_names, summary, trial_status
 from petriflow.sweep.spec import Sweep, Trial, load_sweep
 from petriflow.sweep.store import Store, StoreError
 
@@ -86,16 +86,55 @@ class SweepResult:
         return names
 
 
-def _progress(total: int, enabled: bool) -> Any:
-    if not enabled or total == 0:
-        return None
-    from tqdm import tqdm
+class _LogProgress:
+    """Progress for a log or CI (no terminal): a line on standard error every
+    ``interval`` wall seconds, from a background thread, so a long trial is not silence."""
 
-    return tqdm(total=total, unit="trial", file=sys.stderr, dynamic_ncols=True, leave=False)
+    def __init__(self, name: str, total: int, interval: float) -> None:
+        import threading
+
+        self.name, self.total, self.interval = name, total, interval
+        self.done = self.failed = 0
+        self.started = wallclock.perf_counter()
+        self._stop = threading.Event()
+        print(f"{name}: running {total} trial{'s' if total != 1 else ''}", file=sys.stderr, flush=True)
+        self._thread = threading.Thread(target=self._loop, daemon=True)
+        self._thread.start()
+
+    def update(self, result: dict[str, Any]) -> None:
+        self.done += 1
+        self.failed += result.get("status") != "ok" or result.get("outcome") == "failed"
+
+    def line(self) -> str:
+        elapsed = wallclock.perf_counter() - self.started
+        left = (elapsed / self.done * (self.total - self.done)) if self.done else None
+        eta = f", about {left:.0f} s left" if left is not None else ""
+        return (f"{self.name}: {self.done}/{self.total} trials done ({self.failed} failed) after"
+                f" {elapsed:.0f} s{eta}")
+
+    def _loop(self) -> None:
+        while not self._stop.wait(self.interval):
+            print(self.line(), file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        self._stop.set()
+        print(self.line(), file=sys.stderr, flush=True)
+
+
+def _progress(name: str, total: int, progress: Any) -> Any:
+    """``"bar"`` (or ``True``): a progress bar (a terminal); a number: a line every that
+    many seconds (a log); ``None``/``False``: nothing."""
+    if not progress or total == 0:
+        return None
+    if progress is True or progress == "bar":
+        from tqdm import tqdm
+
+        return tqdm(total=total, unit="trial", file=sys.stderr, dynamic_ncols=True, leave=False)
+    return _LogProgress(name, total, float(progress))
 
 
 def run_sweep(sweep: Sweep, *, backend: str = "local", workers: int | None = None, db: str | Path | None = None,
-              resume: bool = False, progress: bool = False, ray_address: str | None = None,
+              resume: bool = False, progress: Any = False, ray_address: str | None = None,
               on_result: Callable[[Trial, dict[str, Any]], None] | None = None) -> SweepResult:
     """Run every trial of ``sweep`` not yet in ``db``; record and summarise them.
 
@@ -105,7 +144,8 @@ def run_sweep(sweep: Sweep, *, backend: str = "local", workers: int | None = Non
             default: the cluster's CPUs).
         db: the results database (default: in memory).
         resume: ``db`` exists: run only the trials it lacks.
-        progress: show a progress bar (on a terminal).
+        progress: ``"bar"`` (a terminal's progress bar), a number of seconds (a line
+            on standard error that often: a log, CI), or nothing.
         ray_address: the Ray cluster (default ``RAY_ADDRESS``, else a local instance).
         on_result: called with each trial's result as it arrives.
 
@@ -128,7 +168,7 @@ def run_sweep(sweep: Sweep, *, backend: str = "local", workers: int | None = Non
             results = run_local(payloads, workers or default_workers(), sweep.timeout)
         else:
             results = run_ray(payloads, workers, sweep.timeout, ray_address)
-        bar = _progress(len(todo), progress)
+        bar = _progress(sweep.name, len(todo), progress)
         try:
             for index, result in results:
                 trial = todo[index]
@@ -136,7 +176,7 @@ def run_sweep(sweep: Sweep, *, backend: str = "local", workers: int | None = Non
                 if on_result is not None:
                     on_result(trial, result)
                 if bar is not None:
-                    bar.update(1)
+                    bar.update(result if isinstance(bar, _LogProgress) else 1)
         finally:
             if bar is not None:
                 bar.close()
@@ -145,5 +185,5 @@ def run_sweep(sweep: Sweep, *, backend: str = "local", workers: int | None = Non
         store.close()
     names = metric_names([m.name for m in sweep.metrics], trials)
     rows = summary(sweep.rows, trials, names)
-    failures = [t for t in trials if t["status"] != "ok"]
+    failures = [t for t in trials if trial_status(t) != "ok"]
     return SweepResult(sweep, rows, trials, names, len(todo), wallclock.perf_counter() - started, failures)

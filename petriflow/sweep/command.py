@@ -1,7 +1,10 @@
 """``petriflow sweep``: run a sweep file and print (or write) its report.
 
-Exit codes: 0 every trial ran, 1 some trial failed (error, crash or timeout; they are
-in the report and the results database), 2 bad input.
+Exit codes: 0 every trial ran and no run ended ``failed``, 1 some trial failed (its
+run ended failed, or it could not run, crashed or timed out; they are in the report,
+with their status, and in the results database), 2 bad input. Progress goes to standard
+error: a bar on a terminal, a line every ``--progress-every`` seconds otherwise (a log,
+CI), nothing with ``--quiet``.
 """
 
 from __future__ import annotations
@@ -37,6 +40,10 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sweep.add_argument("--json", action="store_true", help="print the report as JSON")
     sweep.add_argument("--csv", metavar="OUT", help="write the report as CSV")
     sweep.add_argument("--plot", metavar="OUT.png", help="plot each metric against the first parameter")
+    sweep.add_argument("--metrics", metavar="NAMES", help="report only these metrics (comma-separated)")
+    sweep.add_argument("--quiet", action="store_true", help="no progress on standard error")
+    sweep.add_argument("--progress-every", type=float, default=30.0, metavar="S",
+                       help="off a terminal: a progress line every S wall seconds (default 30)")
     sweep.set_defaults(handler=cmd_sweep)
     return sweep
 
@@ -60,22 +67,36 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     _check_outputs({"--db": args.db, "--csv": args.csv, "--plot": args.plot},
                    [Path(sweep.path)] + ([Path(sweep.run)] if sweep.run else []))
+    if not args.progress_every > 0:
+        raise PetriflowError(f"--progress-every must be a number of seconds > 0, got {args.progress_every}")
+    progress = None if args.quiet else ("bar" if sys.stderr.isatty() else args.progress_every)
     result = run_sweep(sweep, backend=args.backend, workers=args.workers, db=args.db, resume=args.resume,
-                       progress=not args.json and sys.stderr.isatty(), ray_address=args.ray_address)
+                       progress=progress, ray_address=args.ray_address)
+    if args.metrics:
+        wanted = [m.strip() for m in args.metrics.split(",") if m.strip()]
+        unknown = [m for m in wanted if m not in result.names]
+        if unknown:
+            from petriflow.errors import did_you_mean
+
+            raise PetriflowError(f"--metrics: no metric {unknown[0]!r}{did_you_mean(unknown[0], result.names)}"
+                                 f" (the sweep reports {', '.join(result.names)})")
+        result.names = wanted
     parameters = sweep.parameters
     if args.json:
         json.dump(result.to_json(), sys.stdout, indent=2)
         sys.stdout.write("\n")
     else:
         title = sweep.name + (f" ({sweep.paper_source})" if sweep.paper_source else "")
-        print(f"{title}: {len(result.trials)} trials in {len(result.rows)} rows"
+        print(f"{title}: {_count(len(result.trials), 'trial')} in {_count(len(result.rows), 'row')}"
               f" ({result.ran} run now in {result.wall:.1f} s wall, {len(result.failures)} failed)")
         print(text_table(result.rows, result.names, parameters))
         if result.wall_clock():
             print(f"  wall-clock (not reproducible between runs, unlike the other metrics):"
                   f" {', '.join(result.wall_clock())}")
+        from petriflow.sweep.report import trial_status
+
         for failure in result.failures[:5]:
-            print(f"  failed: row {failure['row'] + 1} seed {failure['seed']}: {failure['status']}:"
+            print(f"  failed: row {failure['row'] + 1} seed {failure['seed']}: {trial_status(failure)}:"
                   f" {failure['error']}")
         if len(result.failures) > 5:
             print(f"  ... and {len(result.failures) - 5} more failures (see --db)")
@@ -89,3 +110,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             if path:
                 print(f"  wrote {path}")
     return 1 if result.failures else 0
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}{'' if n == 1 else 's'}"

@@ -8,7 +8,13 @@ Examples:
     ...           {"row": 0, "status": "ok", "metrics": {"t": 12.0}},
     ...           {"row": 0, "status": "timeout", "metrics": {}}]
     >>> summary(rows, trials, ["t"])[0]
-    {'params': {'n': 1}, 'trials': 3, 'failed': 1, 'metrics': {'t': {'mean': 11.0, 'sd': 1.414214, 'n': 2}}, 'paper': {'t': 9.0}}
+    {'params': {'n': 1}, 'trials': 3, 'failed': 1, 'status': {'ok': 2, 'timeout': 1}, 'metrics': {'t': {'mean': 11.0, 'sd': 1.414214, 'n': 2}}, 'paper': {'t': 9.0}}
+
+A trial's status is ``ok``, ``run failed`` (it ran, and the run ended ``failed``: an
+action failed with no failure route), ``error`` (it could not run: a bad parameter, a
+metric that raised), ``crashed`` (its worker process died) or ``timeout`` (it ran past
+the sweep's timeout). Every status but ``ok`` counts as failed, in the table, in the
+JSON and in the exit code (1 when any trial failed).
 """
 
 from __future__ import annotations
@@ -21,7 +27,17 @@ from typing import Any
 
 from petriflow.sweep.spec import Row
 
-__all__ = ["summary", "metric_names", "text_table", "write_csv", "plot"]
+__all__ = ["summary", "metric_names", "text_table", "write_csv", "plot", "trial_status", "fixed", "deviation"]
+
+#: A trial that ran and whose run ended ``failed`` (an action failure with no route).
+RUN_FAILED = "run failed"
+
+
+def trial_status(trial: dict[str, Any]) -> str:
+    """A trial's status for reports (see the module)."""
+    if trial["status"] == "ok" and trial.get("outcome") == "failed":
+        return RUN_FAILED
+    return trial["status"]
 
 
 def metric_names(declared: list[str], trials: list[dict[str, Any]]) -> list[str]:
@@ -60,11 +76,12 @@ def summary(rows: list[Row], trials: list[dict[str, Any]], names: list[str]) -> 
     out = []
     for row in rows:
         done = by_row.get(row.index, [])
-        ok = [t for t in done if t["status"] == "ok"]
-        metrics = {name: _stats([t["metrics"][name] for t in ok if t["metrics"].get(name) is not None])
+        statuses = Counter(trial_status(t) for t in done)
+        measured = [t for t in done if t["status"] == "ok"]  # a failed run's metrics still describe it
+        metrics = {name: _stats([t["metrics"][name] for t in measured if t["metrics"].get(name) is not None])
                    for name in names}
-        out.append({"params": row.params, "trials": len(done), "failed": len(done) - len(ok),
-                    "metrics": metrics, "paper": dict(row.paper)})
+        out.append({"params": row.params, "trials": len(done), "failed": len(done) - statuses.get("ok", 0),
+                    "status": dict(sorted(statuses.items())), "metrics": metrics, "paper": dict(row.paper)})
     return out
 
 
@@ -78,6 +95,34 @@ def _number(value: Any) -> str:
     return f"{value:.3g}"
 
 
+def fixed(mean: float, sd: float | None) -> str:
+    """``mean ± sd`` to the precision the spread allows: two significant digits of the
+    sd, the mean to the same decimal place (four significant digits without a spread).
+
+    Examples:
+        >>> fixed(36.29, 0.00577), fixed(18.25, 9.342), fixed(246.0, 5.02), fixed(0.5, 0.0)
+        ('36.2900 ± 0.0058', '18.2 ± 9.3', '246.0 ± 5.0', '0.5')
+    """
+    if not sd:
+        return _number(mean)
+    decimals = max(0, 1 - math.floor(math.log10(abs(sd))))
+    return f"{mean:.{decimals}f} ± {sd:.{decimals}f}"
+
+
+def deviation(mean: float | None, paper: Any) -> str:
+    """Measured minus published, and as a share of the published value.
+
+    Examples:
+        >>> deviation(246.0, 240), deviation(121.0, 120.0), deviation(None, 3), deviation(5.0, 0)
+        ('+6 (+2.5%)', '+1 (+0.8%)', '-', '+5')
+    """
+    if mean is None or not isinstance(paper, (int, float)) or isinstance(paper, bool):
+        return "-"
+    difference = mean - paper
+    text = f"{difference:+.3g}" if abs(difference) < 1000 else f"{difference:+,.0f}"
+    return text if paper == 0 else f"{text} ({100 * difference / abs(paper):+.1f}%)"
+
+
 def _cell(stats: dict[str, Any]) -> str:
     if stats.get("counts"):
         return " ".join(f"{k}:{v}" for k, v in stats["counts"].items())
@@ -85,35 +130,62 @@ def _cell(stats: dict[str, Any]) -> str:
         return "-"
     if stats["n"] == 1:
         return _number(stats["mean"])
-    return f"{_number(stats['mean'])} ± {_number(stats['sd'])}"
+    return fixed(stats["mean"], stats["sd"])
 
 
-def text_table(rows: list[dict[str, Any]], names: list[str], parameters: list[str]) -> str:
-    """The report as an aligned text table: parameters, trials, failures, and per
-    metric ``mean ± sd`` with the paper's value in brackets beside it."""
-    header = [*parameters, "trials", "failed"]
-    for name in names:
-        header.append(name)
-        if any(name in row["paper"] for row in rows):
-            header.append("paper")
-    lines = [header]
+def text_table(rows: list[dict[str, Any]], names: list[str], parameters: list[str], width: int = 100) -> str:
+    """The report as aligned text: parameters, trials, failures (with their statuses),
+    and per metric ``mean ± sd``, and where the paper gives a value, the paper's value and
+    the deviation (measured − paper, and %). A table wider than ``width`` characters is
+    split into blocks of metrics, each repeating the parameter columns."""
+    lead = [*parameters, "trials", "failed"]
+    lead_cells = []
     for row in rows:
         line = [_number(row["params"].get(p)) if not isinstance(row["params"].get(p), str) else row["params"][p]
                 for p in parameters]
-        line += [str(row["trials"]), str(row["failed"])]
-        for name in names:
-            line.append(_cell(row["metrics"][name]))
-            if any(name in r["paper"] for r in rows):
-                line.append(_number(row["paper"].get(name)))
-        lines.append(line)
-    widths = [max(len(str(line[i])) for line in lines) for i in range(len(header))]
+        failed = str(row["failed"])
+        bad = {k: v for k, v in row.get("status", {}).items() if k != "ok"}
+        if bad:
+            failed += " (" + ", ".join(f"{k} {v}" for k, v in bad.items()) + ")"
+        lead_cells.append(line + [str(row["trials"]), failed])
+    blocks: list[tuple[list[str], list[list[str]]]] = []
+    for name in names:
+        header = [name]
+        cells = [[_cell(row["metrics"][name])] for row in rows]
+        if any(name in r["paper"] for r in rows):
+            header += ["paper", "deviation"]
+            for cell, row in zip(cells, rows):
+                cell += [_number(row["paper"].get(name)), deviation(row["metrics"][name]["mean"], row["paper"].get(name))]
+        blocks.append((header, cells))
+    lead_width = _width([lead] + lead_cells)
+    tables, current = [], []
+    for block in blocks:
+        size = _width([block[0]] + block[1])
+        if current and lead_width + sum(_width([b[0]] + b[1]) for b in current) + size > width:
+            tables.append(current)
+            current = []
+        current.append(block)
+    tables.append(current)
     text = []
-    for number, line in enumerate(lines):
-        text.append("  ".join(str(cell).rjust(width) if number else str(cell).ljust(width)
-                              for cell, width in zip(line, widths)).rstrip())
-        if number == 0:
-            text.append("  ".join("-" * w for w in widths))
+    for group in tables:
+        header = lead + [h for block in group for h in block[0]]
+        lines = [header] + [lead_cells[i] + [c for block in group for c in block[1][i]] for i in range(len(rows))]
+        widths = [max(len(str(line[i])) for line in lines) for i in range(len(header))]
+        if text:
+            text.append("")
+        for number, line in enumerate(lines):
+            text.append("  ".join(str(cell).rjust(w) if number else str(cell).ljust(w)
+                                  for cell, w in zip(line, widths)).rstrip())
+            if number == 0:
+                text.append("  ".join("-" * w for w in widths))
     return "\n".join(text)
+
+
+def _width(lines: list[list[str]]) -> int:
+    """Characters the columns of ``lines`` take, two spaces between them."""
+    if not lines or not lines[0]:
+        return 0
+    return sum(max(len(str(line[i])) for line in lines) + 2 for i in range(len(lines[0])))
 
 
 def write_csv(path: str | Path, rows: list[dict[str, Any]], names: list[str], parameters: list[str]) -> None:

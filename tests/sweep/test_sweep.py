@@ -87,7 +87,10 @@ def test_crashes_timeouts_and_exceptions_are_rows_and_the_sweep_goes_on(folder, 
     assert status[2][0] == "timeout"
     assert status[3] == ("ok", "failed")  # an action's exception is the run's failed outcome
     assert status[4] == ("ok", "failed")
-    assert [row["failed"] for row in result.rows] == [0, 1, 1, 0, 0]
+    # a trial whose run ended failed counts as failed (status "run failed"), its metrics kept
+    assert [row["failed"] for row in result.rows] == [0, 1, 1, 1, 1]
+    assert [row["status"] for row in result.rows] == [{"ok": 1}, {"crashed": 1}, {"timeout": 1},
+                                                       {"run failed": 1}, {"run failed": 1}]
     crashed = next(t for t in result.trials if t["row"] == 1)
     assert "exit code 3" in crashed["error"]
     slept = next(t for t in result.trials if t["row"] == 2)
@@ -116,7 +119,7 @@ def test_cli_report_json_csv_and_plot(folder, tmp_path, capsys):
     assert code == 0
     report = json.loads(capsys.readouterr().out)
     assert report["spec"] == str(path.resolve())
-    assert [set(row) for row in report["rows"]] == [{"params", "trials", "failed", "metrics", "paper"}] * 2
+    assert [set(row) for row in report["rows"]] == [{"params", "trials", "failed", "status", "metrics", "paper"}] * 2
     assert report["rows"][1]["paper"] == {"time_s": 3.5}
     assert set(report["rows"][0]["metrics"]["time_s"]) == {"mean", "sd", "n"}
     lines = (tmp_path / "r.csv").read_text().splitlines()

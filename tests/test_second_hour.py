@@ -1,0 +1,58 @@
+"""The second hour of a user: long work in logs, readable sweep reports."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from petriflow.sweep.report import deviation, fixed, text_table
+from tests.conftest import NETS
+
+TICKER = """petriflow: 1
+places: [{id: p, tokens: 1}, count]
+transitions:
+  - {id: tick, action: core.wait, params: {seconds: 0.01}, in: [p], out: [p, count]}
+"""
+
+
+def _petriflow(*argv, cwd=None) -> subprocess.CompletedProcess:
+    """The command line with standard error a pipe (a log, CI), not a terminal."""
+    return subprocess.run([sys.executable, "-m", "petriflow.cli", *map(str, argv)], capture_output=True, text=True,
+                          timeout=300, cwd=cwd)
+
+
+def test_a_run_off_a_terminal_prints_progress_lines_unless_quiet(tmp_path):
+    net = tmp_path / "ticker.yaml"
+    net.write_text(TICKER)
+    done = _petriflow("run", net, "--until", "3000", "--progress-every", "0.05")
+    assert done.returncode == 0, done.stderr
+    lines = [line for line in done.stderr.splitlines() if line.startswith("ticker: t =")]
+    assert lines and "firings" in lines[0] and "s wall" in lines[0]
+    quiet = _petriflow("run", net, "--until", "3000", "--progress-every", "0.05", "--quiet")
+    assert quiet.returncode == 0 and quiet.stderr == ""
+
+
+def test_a_sweep_off_a_terminal_says_how_far_it_is():
+    done = _petriflow("sweep", NETS / "passage" / "experiments" / "speed.yaml", "--trials", "1", "--workers", "2",
+                      "--progress-every", "0.2")
+    assert done.returncode == 0, done.stderr
+    assert "speed: running 6 trials" in done.stderr
+    assert "speed: 6/6 trials done (0 failed)" in done.stderr
+    assert "6 trials in 6 rows" in done.stdout
+
+
+def test_report_precision_follows_the_spread_and_deviation_is_shown():
+    assert fixed(36.29, 0.00577) == "36.2900 ± 0.0058"
+    assert fixed(18.25, 9.342) == "18.2 ± 9.3"
+    assert deviation(516.0, 360) == "+156 (+43.3%)"
+
+
+def test_a_wide_report_wraps_into_blocks_that_fit_100_columns():
+    names = [f"metric_number_{i}" for i in range(12)]
+    rows = [{"params": {"robots": n}, "trials": 5, "failed": 0, "status": {"ok": 5},
+             "metrics": {name: {"mean": 123.456 * n, "sd": 1.5, "n": 5} for name in names},
+             "paper": {names[0]: 100.0 * n}} for n in (1, 2)]
+    text = text_table(rows, names, ["robots"])
+    assert max(len(line) for line in text.splitlines()) <= 100
+    assert text.count("robots") >= 3  # the parameter columns repeat in every block
+    assert "deviation" in text and "+23.5 (+23.5%)" in text
