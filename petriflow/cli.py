@@ -255,6 +255,7 @@ def cmd_export(args: argparse.Namespace) -> int:
         print(witness["message"])
     export_net(net, args.output, format, marking=marking, highlight=highlight, caption=caption,
                rankdir=args.rankdir, size=size)
+    print(f"wrote {args.output}")
     return EXIT_OK
 
 
@@ -306,7 +307,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     else:
         factor = outcome.realtime_factor
         pace = ("no simulated time passed" if result.time <= 0 else
-                f"{factor:.1f}x real time" if factor < 1e6 else f"{factor:.3g}x real time")
+                "too quick to time" if outcome.wall < 0.01 else f"{factor:.1f}x real time")
         print(f"{outcome.net.id}: {result.reason} at t = {result.time:g} s after {result.firings}"
               f" firing{'' if result.firings == 1 else 's'} (seed {outcome.seed}; {outcome.wall:.2f} s wall, {pace})")
         print(f"  marking at the end: {_format_marking(result.marking)}")
@@ -332,6 +333,8 @@ def cmd_actions(args: argparse.Namespace) -> int:
 
     listing = []
     for spec in default_registry.specs():
+        if args.pattern and args.pattern.lower() not in spec.name.lower():
+            continue
         cls = spec.load()
         params = {
             name: {"type": type_name(p), "default": None if p.default is REQUIRED else p.default,
@@ -434,12 +437,14 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser(
         "run", help="Run a net: fire transitions as agent actions over a pybullet world.",
         description="Run a net: fire transitions as agent actions over a pybullet world. The run"
-        " configuration (seed, limits, world, channels, faults) is --config, or run.yaml beside"
-        " the net when it exists. Exit 0 when the run ends, 1 when an action failed without a"
-        " failure route or the net stopped short of its final marking, 2 on bad input.")
+        " configuration (seed, limits, world, channels, faults, action modules) is --config, else the"
+        " one the net names (run: FILE, or inline in the net), else run.yaml beside the net when it"
+        " exists. Exit 0 when the run ends, 1 when an action failed without a failure route or the net"
+        " stopped short of its final marking, 2 on bad input.")
     run.add_argument("net", nargs="?", help="net file (omit with --resume)")
     run.add_argument("--world", help="world description (YAML); overrides the configuration's")
-    run.add_argument("--config", help="run configuration (YAML)")
+    run.add_argument("--config", help="run configuration (YAML; default: the one the net names, else run.yaml"
+                     " beside it)")
     run.add_argument("--seed", type=int, help="random seed (overrides the configuration's)")
     run.add_argument("--until", type=float, help="simulated-time limit in seconds")
     run.add_argument("--max-firings", type=int, help="stop after this many firings")
@@ -457,6 +462,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     actions = sub.add_parser("actions", help="List the actions transitions can be bound to.",
                              description="List the registered actions and their parameters.")
+    actions.add_argument("pattern", nargs="?", help="only the actions whose name contains this (e.g. comm.)")
     actions.add_argument("--json", action="store_true", help="print JSON")
     actions.set_defaults(handler=cmd_actions)
 

@@ -99,7 +99,12 @@ class UnknownElementError(PetriflowError, KeyError):
     def __init__(self, kind: str, name: str, candidates: Iterable[str]) -> None:
         self.kind = kind
         self.name = name
-        self.message = f"unknown {kind} {name!r}{did_you_mean(name, candidates)}"
+        candidates = list(candidates)
+        hint = did_you_mean(name, candidates)
+        if not hint and candidates:  # nothing close: say what there is
+            shown = ", ".join(candidates[:8]) + (f" and {len(candidates) - 8} more" if len(candidates) > 8 else "")
+            hint = f" (the net has: {shown})"
+        self.message = f"unknown {kind} {name!r}{hint}"
         super().__init__(self.message)
 
     def __str__(self) -> str:  # KeyError would quote the whole message

@@ -56,3 +56,29 @@ def test_a_wide_report_wraps_into_blocks_that_fit_100_columns():
     assert max(len(line) for line in text.splitlines()) <= 100
     assert text.count("robots") >= 3  # the parameter columns repeat in every block
     assert "deviation" in text and "+23.5 (+23.5%)" in text
+
+
+def test_a_cycle_of_instant_transitions_names_the_file_the_limit_and_the_cycle():
+    done = _petriflow("run", NETS / "philosophers" / "philosophers-5.yaml")
+    assert done.returncode == 2
+    message = done.stderr.strip()
+    assert message.startswith(f"petriflow: {NETS / 'philosophers' / 'philosophers-5.yaml'}: more than 100,000")
+    assert "FIRINGS_PER_INSTANT" in message and "take_" in message and "release_" in message
+
+
+def test_small_gaps_of_the_command_line(tmp_path):
+    passage = NETS / "passage" / "passage.yaml"
+    fired = _petriflow("fire", passage, "nope")
+    assert fired.returncode == 2 and "(the net has: red_approach, red_enter" in fired.stderr
+    exported = _petriflow("export", passage, "-f", "pnml", "-o", tmp_path / "p.pnml")
+    assert exported.returncode == 0 and exported.stdout.strip() == f"wrote {tmp_path / 'p.pnml'}"
+    moved = _petriflow("run", tmp_path / "p.pnml")
+    assert moved.returncode == 2 and "give it with --config" in moved.stderr
+    listed = _petriflow("actions", "core.")
+    assert listed.returncode == 0 and listed.stdout.lstrip().startswith("core.")
+    assert "gait.walk" not in listed.stdout
+    net = tmp_path / "quick.yaml"
+    net.write_text("petriflow: 1\nplaces: [{id: i, tokens: 1}, o]\n"
+                   "transitions: [{id: t, action: core.wait, params: {seconds: 1000}, in: [i], out: [o]}]\n")
+    done = _petriflow("run", net)
+    assert "too quick to time" in done.stdout and "x real time" not in done.stdout

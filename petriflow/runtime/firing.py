@@ -86,6 +86,7 @@ class Firer:
         self.progress = 0
         self.limit: int | None = None
         self.now_count = 0  # firings at the current instant (the Zeno check's)
+        self._looping: list[str] = []  # near the limit: what fires (to name a cycle)
         self._rng = random.Random(f"{seed}:conflicts")
         self._seed_prefix = f"{seed}:"
 
@@ -98,11 +99,30 @@ class Firer:
                 refresh()
             if not agenda:
                 return
-            fire(agenda.pick(draw))
+            t = agenda.pick(draw)
+            fire(t)
             self.now_count += 1
-            if self.now_count > limits.FIRINGS_PER_INSTANT:
-                raise ZenoError(f"more than {limits.FIRINGS_PER_INSTANT} firings at t={self.kernel.now:g}s"
-                                " without time passing (a cycle of instant transitions?)")
+            if self.now_count > limits.FIRINGS_PER_INSTANT - 64:
+                self._zeno(t)
+
+    def new_instant(self) -> None:
+        """Time moved on: the count of firings in one instant starts again."""
+        self.now_count = 0
+        self._looping.clear()
+
+    def _zeno(self, t: int) -> None:
+        """Near the limit of firings in one instant: remember what fires, and at the limit
+        stop the run naming the file, the limit and the transitions that keep firing."""
+        looping = self._looping
+        looping.append(self.index.ids[t])
+        if self.now_count > limits.FIRINGS_PER_INSTANT:
+            names = list(dict.fromkeys(looping))
+            where = f"{self.net.path}: " if self.net.path else ""
+            raise ZenoError(f"{where}more than {limits.FIRINGS_PER_INSTANT:,} firings at t={self.kernel.now:g} s"
+                            f" without time passing (limit FIRINGS_PER_INSTANT, docs/limits.md): instant"
+                            f" transitions fire in a cycle: {', '.join(names[:8])}"
+                            f"{f' and {len(names) - 8} more' if len(names) > 8 else ''} (give one of them an"
+                            " action that takes time, or stop the run with --max-firings)")
 
     def fire(self, t: int) -> None:
         """Fire transition index ``t`` now: consume, cancel its region, start its action."""

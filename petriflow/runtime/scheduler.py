@@ -279,7 +279,7 @@ class Scheduler:
 
     def _advance(self, tick: int) -> None:
         self.clock.advance(self.kernel, self.world, tick)
-        self.firer.now_count = 0
+        self.firer.new_instant()
 
     def _instant(self, fire: bool = True) -> None:
         """Process the current tick: due polls and events, then the firings."""

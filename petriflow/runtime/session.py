@@ -179,8 +179,8 @@ def net_config(net: Net, path: Path) -> RunConfig | None:
     if isinstance(named, str):
         file = path.parent / named
         if not file.is_file():
-            raise NetFormatError(f"run configuration {named!r} not found (looked for {file})", path=str(path),
-                                 line=net.lines.get("run"))
+            raise NetFormatError(f"run configuration {named!r} not found (looked for {file}); give it with"
+                                 " --config, or put it beside the net", path=str(path), line=net.lines.get("run"))
         return load_config(file)
     return RunConfig.from_dict(named, str(path), base=str(path.parent), line=net.lines.get("run"))
 
