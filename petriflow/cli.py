@@ -362,7 +362,6 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     from petriflow.analysis.coverability import DEFAULT_MAX_COVERABILITY
-    from petriflow.analysis.invariants import DEFAULT_BUDGET
     from petriflow.analysis.reachability import DEFAULT_MAX_STATES
     from petriflow.analysis.report import check_net, exit_code, format_report, plain
 
@@ -376,7 +375,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     result = check_net(
         net, max_states=args.max_states or DEFAULT_MAX_STATES,
         max_coverability=DEFAULT_MAX_COVERABILITY if args.max_coverability is None else args.max_coverability,
-        invariant_budget=DEFAULT_BUDGET if args.invariant_budget is None else args.invariant_budget)
+        invariant_budget=args.invariant_budget)
     if args.json:
         _print_json(plain(result))
     else:
@@ -487,9 +486,10 @@ def build_parser() -> argparse.ArgumentParser:
                        help="most nodes of the Karp-Miller search that decides boundedness before"
                        " the state space (default 100,000; 0: none)")
     check.add_argument("--invariant-budget", type=int, default=None, metavar="N",
-                       help="work budget of each of the P- and T-semiflow computations (default"
-                       " 100,000,000 steps, about 0.2 s; 0: skip them); beyond it they are"
-                       " 'not computed (over budget)'")
+                       help="work budget of each of the P- and T-semiflow computations (0: skip"
+                       " them); default 100,000,000 steps (about 0.2 s) for P-semiflows and, for"
+                       " T-semiflows, 100 steps per state and edge explored (10,000,000 to"
+                       " 100,000,000); beyond it they are 'not computed (over budget)'")
     from petriflow.sweep.command import add_parser as add_sweep
 
     add_sweep(sub)

@@ -5,7 +5,8 @@ One concept per module:
 
 * :mod:`~petriflow.analysis.reachability` — the state space (:func:`reachability_graph`,
   :class:`StateSpace`, :func:`to_networkx`);
-* :mod:`~petriflow.analysis.coverability` — Karp–Miller coverability graph, unbounded places;
+* :mod:`~petriflow.analysis.coverability` — Karp–Miller coverability graph, unbounded places,
+  and the budgeted depth-first search that decides boundedness before the state space;
 * :mod:`~petriflow.analysis.properties` — bounds, deadlocks, dead transitions, liveness,
   reversibility, read off a state space;
 * :mod:`~petriflow.analysis.soundness` — WF-net structure and classical soundness;
@@ -19,7 +20,15 @@ Examples:
     (11, True)
 """
 
-from petriflow.analysis.coverability import OMEGA, CoverabilityGraph, coverability_graph, unbounded_places
+from petriflow.analysis.coverability import (
+    DEFAULT_MAX_COVERABILITY,
+    OMEGA,
+    CoverabilityGraph,
+    CoverabilitySearch,
+    coverability_graph,
+    coverability_search,
+    unbounded_places,
+)
 from petriflow.analysis.invariants import (
     InvariantLimit,
     is_covered_by_p_semiflows,
@@ -56,9 +65,10 @@ from petriflow.analysis.soundness import (
 )
 
 __all__ = [
-    "DEFAULT_MAX_STATES", "OMEGA", "CoverabilityGraph", "InvariantLimit", "SoundnessReport",
+    "DEFAULT_MAX_COVERABILITY", "DEFAULT_MAX_STATES", "OMEGA", "CoverabilityGraph",
+    "CoverabilitySearch", "InvariantLimit", "SoundnessReport",
     "StateSpace", "StateSpaceLimit", "UnboundedNetError", "Violation", "WorkflowStructure",
-    "check_net", "check_soundness", "coverability_graph", "dead_transitions",
+    "check_net", "check_soundness", "coverability_graph", "coverability_search", "dead_transitions",
     "deadlock_witness", "deadlocks", "exit_code", "format_report", "is_covered_by_p_semiflows",
     "is_free_choice", "is_live", "is_reversible", "is_safe", "non_live_transitions",
     "p_semiflows", "place_bounds", "reachability_graph", "structural_bounds", "t_semiflows",

@@ -44,6 +44,9 @@ def pivot_columns(matrix: np.ndarray) -> list[int]:
     rows, cols = work.shape
     pivots: list[int] = []
     rank = 0
+    # An upper bound of every |entry| (only the rows a step updates can grow), so the
+    # overflow test does not read the whole matrix at every step.
+    top = int(np.abs(work).max(initial=0))
     for col in range(cols):
         if rank == rows:
             break
@@ -59,7 +62,7 @@ def pivot_columns(matrix: np.ndarray) -> list[int]:
         hit = factors != 0
         if hit.any():
             piv = pivot_row[col]
-            if work.dtype != object and np.abs(work).max() >= _SAFE:
+            if work.dtype != object and top >= _SAFE:
                 work = work.astype(object)
                 pivot_row, below = work[rank], work[rank + 1:]
                 piv = pivot_row[col]
@@ -68,6 +71,7 @@ def pivot_columns(matrix: np.ndarray) -> list[int]:
                 g = np.gcd.reduce(updated, axis=1)
                 g[g == 0] = 1
                 updated //= g[:, None]
+                top = max(top, int(np.abs(updated).max(initial=0)))
             below[hit] = updated
         pivots.append(col)
         rank += 1

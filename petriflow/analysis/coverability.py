@@ -13,6 +13,15 @@ markings, so:
 * a place is unbounded exactly when some node has ω in it;
 * a transition is dead (never enabled) exactly when no node enables it.
 
+Two ways to build it:
+
+* :func:`coverability_graph`: breadth first, in Python, every node and edge kept (the
+  textbook graph, for small nets and for drawing);
+* :func:`coverability_search`: depth first, compiled (:mod:`petriflow.analysis._karp_miller`),
+  within a node budget, keeping only what decides boundedness: the unbounded places,
+  a pumping witness (shortened), the transitions that fire, and, when it finishes, the
+  dead transitions and bounds. ``petriflow check`` runs it before the state space.
+
 Examples:
     >>> from petriflow.io.yaml import loads_net
     >>> net = loads_net('''
@@ -40,7 +49,8 @@ from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.net import Net
 
-__all__ = ["OMEGA", "CoverabilityGraph", "coverability_graph", "coverability_graph_if_any",
+__all__ = ["DEFAULT_MAX_COVERABILITY", "OMEGA", "CoverabilityGraph", "CoverabilitySearch",
+           "coverability_graph", "coverability_graph_if_any", "coverability_search",
            "unbounded_places"]
 
 #: The ω of an ω-marking: more tokens than any bound (compares above every integer).
@@ -229,3 +239,288 @@ def unbounded_places(
         []
     """
     return coverability_graph(net, marking, max_nodes=max_nodes).unbounded_places
+
+
+#: Default node budget of :func:`coverability_search` (``petriflow check --max-coverability``).
+DEFAULT_MAX_COVERABILITY = 100_000
+
+
+@dataclass
+class CoverabilitySearch:
+    """What a budgeted Karp–Miller search (:func:`coverability_search`) established.
+
+    Attributes:
+        complete: the search finished: its nodes form a coverability graph, so
+            ``unbounded_places`` are exactly the unbounded places, ``dead_transitions``
+            exactly the dead ones and ``place_bounds`` the bounds.
+        nodes, edges: the graph's size when the search stopped.
+        unbounded_places: places with ω in some node: unbounded, all of them when
+            ``complete``, at least these otherwise.
+        witness: an :class:`~petriflow.analysis.reachability.UnboundedNetError` built
+            from the first pump found (a plain firing sequence and the pump that can be
+            repeated), ``None`` when none was found.
+        dead_transitions: transitions no node enables (``None`` unless ``complete``).
+        fired: transitions some node enables (never dead).
+        place_bounds: per place the most tokens (``None`` for ω), when ``complete``.
+        stopped: why an incomplete search stopped (``"budget"`` or ``"overflow"``).
+    """
+
+    complete: bool
+    nodes: int
+    edges: int
+    unbounded_places: list[str]
+    witness: object | None
+    dead_transitions: list[str] | None
+    fired: list[str]
+    place_bounds: dict[str, int | None] | None
+    stopped: str | None = None
+
+    @property
+    def bounded(self) -> bool | None:
+        """``True`` (complete, no ω), ``False`` (some ω), ``None`` (not decided)."""
+        if self.unbounded_places:
+            return False
+        return True if self.complete else None
+
+
+def coverability_search(
+    net: Net,
+    marking: Mapping[str, int] | None = None,
+    *,
+    max_nodes: int = DEFAULT_MAX_COVERABILITY,
+    compiled: CompiledNet | None = None,
+    max_cells: int = 25_000_000,
+) -> CoverabilitySearch:
+    """A Karp–Miller coverability graph searched depth first, compiled, within a budget.
+
+    Meant to decide boundedness before (and instead of) a full state space: it stops
+    after ``max_nodes`` nodes and says what it proved by then. Depth first, a pump far
+    from the start is found without enumerating the markings closer to it; ω-markings
+    fold the unbounded places, so the graph of an unbounded net is finite too.
+
+    Args:
+        net: the net (without reset arcs: Karp–Miller acceleration is unsound for them).
+        marking: the start marking (default: the net's initial marking).
+        max_nodes: the node budget (memory: 8 bytes a place a node, plus about 50).
+        compiled: a :class:`~petriflow.engine.CompiledNet` of ``net`` to reuse.
+        max_cells: the most node-place entries to hold (200 MB at the default): on nets
+            with many places the node budget shrinks to fit.
+
+    Raises:
+        PetriflowError: the net has cancellation regions (reset arcs).
+
+    Examples:
+        >>> from petriflow.io.yaml import loads_net
+        >>> net = loads_net('''
+        ... petriflow: 1
+        ... places: [{id: idle, tokens: 1}, mailbox]
+        ... transitions:
+        ...   - {id: send, in: [idle], out: [idle, mailbox]}
+        ...   - {id: read, in: [mailbox], out: []}
+        ... ''')
+        >>> found = coverability_search(net)
+        >>> found.complete, found.unbounded_places, found.witness.pump
+        (True, ['mailbox'], ['send'])
+    """
+    import numpy as np
+
+    from petriflow.analysis import _karp_miller as km
+    from petriflow.analysis import _kernel
+    from petriflow.analysis.reachability import UnboundedNetError, _changes, _origins
+
+    compiled = compiled or CompiledNet(net)
+    if getattr(compiled, "has_resets", False):
+        raise PetriflowError("the Karp-Miller coverability graph does not apply to nets with"
+                             " cancellation regions (reset arcs)")
+    if max_nodes < 1:
+        raise ValueError(f"max_nodes must be >= 1, got {max_nodes}")
+    start_marking = net.initial_marking if marking is None else net.check_marking(marking)
+    start = np.asarray(compiled.vector(start_marking), dtype=np.int64)
+    n_p, n_t = len(compiled.places), len(compiled.transitions)
+    max_nodes = max(1, min(max_nodes, max_cells // max(1, n_p)))
+
+    def csr(lists):
+        at = np.zeros(len(lists) + 1, dtype=np.int64)
+        at[1:] = np.cumsum([len(items) for items in lists])
+        flat = [item for items in lists for item in items]
+        return (at, np.array([p for p, _ in flat], dtype=np.int64),
+                np.array([w for _, w in flat], dtype=np.int64))
+
+    fixed = (*csr(compiled.pre), *csr(_changes(compiled)), max_nodes)
+    size = min(1024, max_nodes + 1)
+    per_node = [np.empty((size, n_p), dtype=np.int64)] + [
+        np.empty(size, dtype=np.int64) for _ in range(7)]
+    per_node[0][0] = start
+    table = np.zeros(2 * 2 * 1024, dtype=np.uint64)
+    fired = np.zeros(n_t, dtype=np.int8)
+    counters = np.array([0, 0, 0, -1, -1, -1], dtype=np.int64)
+    while True:
+        rows, parent, parent_t, totals, seg_root, seg_min, stack, stack_next = per_node
+        status = km.search(*fixed, rows, parent, parent_t, totals, seg_root, seg_min, table,
+                           stack, stack_next, fired, counters)
+        if status != km.FULL:
+            break
+        nodes = int(counters[0])
+        if nodes >= len(rows):
+            grown = []
+            for a in per_node:
+                bigger = np.empty((min(2 * len(a), max_nodes + 1),) + a.shape[1:], dtype=a.dtype)
+                bigger[:len(a)] = a
+                grown.append(bigger)
+            per_node = grown
+        slots = len(table) // 2
+        if 2 * (nodes + 1) > slots // 2:
+            bigger = np.zeros(4 * len(table), dtype=np.uint64)
+            _kernel.rehash(table, 2, 0, bigger)
+            table = bigger
+    rows, parent, parent_t = per_node[0], per_node[1], per_node[2]
+    nodes = int(counters[0])
+    rows = rows[:nodes]
+    omega = (rows == km.OMEGA).any(axis=0) if nodes else np.zeros(n_p, dtype=bool)
+    places = [compiled.places[p] for p in np.flatnonzero(omega)]
+    witness = None
+    if counters[3] >= 0:
+        node, ancestor, t = int(counters[3]), int(counters[4]), int(counters[5])
+
+        def walk(s: int, stop: int) -> list[str]:
+            sequence = []
+            while s != stop:
+                sequence.append(compiled.transitions[int(parent_t[s])])
+                s = int(parent[s])
+            return sequence[::-1]
+
+        covered_row = rows[ancestor]
+        covering_row = rows[node].copy()
+        for p, d in _changes(compiled)[t]:
+            covering_row[p] += d
+        prefix, pump = walk(ancestor, 0), walk(node, ancestor) + [compiled.transitions[t]]
+        prefix, pump, covered_row, covering_row = _shorter(compiled, start, prefix, pump)
+        grown = [compiled.places[p] for p in range(n_p) if covering_row[p] > covered_row[p]]
+        witness = UnboundedNetError(grown, prefix, pump,
+                                    compiled.marking([int(c) for c in covered_row]),
+                                    compiled.marking([int(c) for c in covering_row]))
+    complete = status == km.OK
+    origins = _origins(compiled)
+    fired_names = list(dict.fromkeys(origins[t] for t in np.flatnonzero(fired)))
+    dead = bounds = None
+    if complete:
+        dead = list(dict.fromkeys(origins[t] for t in range(n_t) if not fired[t]))
+        dead = [d for d in dead if d not in set(fired_names)]
+        top = rows.max(axis=0) if nodes else np.zeros(n_p, dtype=np.int64)
+        bounds = {p: (None if omega[j] else int(top[j])) for j, p in enumerate(compiled.places)}
+    return CoverabilitySearch(complete, nodes, int(counters[1]), places, witness, dead,
+                              fired_names, bounds,
+                              None if complete else ("budget" if status == km.LIMIT else "overflow"))
+
+
+#: Entries :func:`_shorter` may compare while it shortens a witness (about 0.1 s of numpy).
+_SHORTEN_WORK = 20_000_000
+
+
+def _shorter(compiled: CompiledNet, start, prefix: list[str], pump: list[str]):
+    """A shorter unboundedness witness: ``(prefix, pump, covered, covering)``.
+
+    A depth-first search finds its pump at the end of a long, wandering path. Any prefix
+    that ends where the pump can fire will do (the pump adds ``Δ >= 0``, ``Δ != 0``
+    wherever it can fire), so firings are dropped from the prefix while the rest stays
+    firable and ends in the same marking: each firing that changes nothing, and each
+    pair of firings that undo each other (the wandering of a depth-first search through
+    a bounded part is mostly such pairs), checked on the markings between the two only;
+    then blocks of firings, halving the block size (delta debugging), while the pump
+    can still fire at the end. All within a fixed amount of work.
+    """
+    import numpy as np
+
+    index = {t: k for k, t in enumerate(compiled.transitions)}
+    n_p, n_t = len(compiled.places), len(compiled.transitions)
+    start = np.asarray(start, dtype=np.int64)
+    if n_p * n_t > 4_000_000 or not prefix:   # too large for dense rows, or nothing to drop
+        def fire(m, seq):
+            m = m.copy()
+            for t in seq:
+                for p, w in compiled.pre[index[t]]:
+                    m[p] -= w
+                for p, w in compiled.post[index[t]]:
+                    m[p] += w
+            return m
+
+        covered = fire(start, prefix)
+        return prefix, pump, covered, fire(covered, pump)
+    pre = np.zeros((n_t, n_p), dtype=np.int64)
+    change = np.zeros((n_t, n_p), dtype=np.int64)
+    for t in range(n_t):
+        for p, w in compiled.pre[t]:
+            pre[t, p] += w
+            change[t, p] -= w
+        for p, w in compiled.post[t]:
+            change[t, p] += w
+    budget = [_SHORTEN_WORK]
+
+    def before(m, ids):
+        """The marking before each firing of ``ids`` from ``m``."""
+        budget[0] -= len(ids) * n_p
+        steps = np.cumsum(change[ids], axis=0) if len(ids) else np.zeros((0, n_p), np.int64)
+        return np.vstack([m[None, :], m + steps[:-1]]) if len(ids) else steps
+
+    def firable(m, ids):
+        return bool((before(m, ids) >= pre[ids]).all()) if len(ids) else True
+
+    ids = np.array([index[t] for t in prefix], dtype=np.int64)
+    pump_ids = np.array([index[t] for t in pump], dtype=np.int64)
+    # Firings that change nothing.
+    ids = ids[change[ids].any(axis=1)]
+    # Pairs that undo each other, nearest first.
+    changed = True
+    while changed and budget[0] > 0:
+        changed = False
+        marks = before(start, ids)
+        keys = [change[t].tobytes() for t in ids]
+        undo = {}
+        for k, t in enumerate(ids):
+            undo.setdefault((-change[t]).tobytes(), []).append(k)
+        k = 0
+        keep = np.ones(len(ids), dtype=bool)
+        while k < len(ids) and budget[0] > 0:
+            if keep[k]:
+                for j in undo.get(keys[k], ()):
+                    if j <= k or not keep[j]:
+                        continue
+                    inner = np.flatnonzero(keep[k + 1:j]) + k + 1
+                    budget[0] -= len(inner) * n_p
+                    if (marks[inner] - change[ids[k]] >= pre[ids[inner]]).all():
+                        keep[k] = keep[j] = False
+                        marks[k + 1:j] -= change[ids[k]]
+                        changed = True
+                    break
+            k += 1
+        ids = ids[keep]
+    end = start + change[ids].sum(axis=0)
+
+    def pump_ok(m, seq):
+        if not firable(m, seq):
+            return False
+        delta = change[seq].sum(axis=0)
+        return bool((delta >= 0).all() and (delta > 0).any())
+
+    def prefix_ok(seq):
+        return firable(start, seq) and pump_ok(start + change[seq].sum(axis=0), pump_ids)
+
+    def reduce(seq, good):
+        block = max(1, len(seq) // 2)
+        while block >= 1 and budget[0] > 0:
+            k = 0
+            while k < len(seq) and budget[0] > 0:
+                candidate = np.concatenate([seq[:k], seq[k + block:]])
+                if good(candidate):
+                    seq = candidate
+                else:
+                    k += block
+            block //= 2
+        return seq
+
+    pump_ids = reduce(pump_ids, lambda seq: pump_ok(end, seq))
+    ids = reduce(ids, prefix_ok)
+    covered = start + change[ids].sum(axis=0)
+    covering = covered + change[pump_ids].sum(axis=0)
+    names = compiled.transitions
+    return [names[t] for t in ids], [names[t] for t in pump_ids], covered, covering

@@ -92,12 +92,18 @@ class StateSpaceLimit(PetriflowError):
         limit: the ``max_states`` that was exceeded.
         explored: states stored when the exploration stopped.
         expanded: states whose successors had all been computed.
+        partial: what was explored, as a :class:`StateSpace` whose ``expanded`` says
+            how many of its states (the first ones) have all their edges; every fact
+            read off it is a fact about the net (``None`` where the search that stopped
+            keeps no graph).
     """
 
-    def __init__(self, limit: int, explored: int, expanded: int) -> None:
+    def __init__(self, limit: int, explored: int, expanded: int,
+                 partial: StateSpace | None = None) -> None:
         self.limit = limit
         self.explored = explored
         self.expanded = expanded
+        self.partial = partial
         super().__init__(
             f"state space exceeds max_states={limit}: stopped after {explored} states "
             f"({expanded} fully expanded); raise the limit (--max-states) to explore further"
@@ -156,6 +162,10 @@ class StateSpace:
         parent: per state, the state it was first reached from (-1 for state 0).
         parent_transition: per state, the transition index of that edge (-1 for state 0).
         representation: ``"bitmask"`` (the exploration stayed safe) or ``"counts"``.
+        expanded: ``None`` for a complete state space; for the part explored before a
+            limit stopped the search (:attr:`StateSpaceLimit.partial`), the number of
+            states, the first ones, whose edges are all there (the others have none
+            yet: they are not deadlocks).
 
     :attr:`edge_source` (the source state of each edge) is expanded from
     ``edge_offsets`` on first use.
@@ -174,6 +184,7 @@ class StateSpace:
     _column_of_place: np.ndarray = field(repr=False)
     _markings: np.ndarray | None = field(default=None, repr=False)
     _edge_source: np.ndarray | None = field(default=None, repr=False)
+    expanded: int | None = None
 
     # Sizes ----------------------------------------------------------------------------
     @property
@@ -276,9 +287,16 @@ class StateSpace:
     def deadlocks(self) -> np.ndarray:
         """Ids of the states that enable no transition, in increasing order.
 
-        The first one is a deadlock nearest to the initial marking (BFS numbering).
+        The first one is a deadlock nearest to the initial marking (BFS numbering). In a
+        partial state space, only the expanded states are candidates.
         """
-        return np.flatnonzero(self.edge_offsets[1:] == self.edge_offsets[:-1])
+        dead = np.flatnonzero(self.edge_offsets[1:] == self.edge_offsets[:-1])
+        return dead if self.expanded is None else dead[dead < self.expanded]
+
+    @property
+    def complete(self) -> bool:
+        """Whether this is the whole reachability graph (not a partial one)."""
+        return self.expanded is None
 
     def path(self, state: int) -> list[str]:
         """A shortest firing sequence (transition ids) from the initial marking to ``state``."""
@@ -382,7 +400,8 @@ _BASIS_FROM_PLACES = 16
 
 
 def warm_up() -> None:
-    """Compile (or load from numba's disk cache) both exploration loops now.
+    """Compile (or load from numba's disk cache) the exploration loops, the Karp–Miller
+    search and Farkas' adjacency test now.
 
     The first exploration in a process otherwise pays this (a fraction of a second from
     the cache; several seconds the very first time after installation).
@@ -396,6 +415,10 @@ def warm_up() -> None:
             net.add_place(f"unused_{k}")
         reachability_graph(net)
     reachability_graph(producer_consumer(2))       # count rows, unboundedness checks
+    from petriflow.analysis.coverability import coverability_search
+    from petriflow.analysis.invariants import semiflows
+    coverability_search(producer_consumer(2))      # the depth-first Karp-Miller search
+    semiflows(np.array([[1], [-1], [1]]))          # Farkas' compiled adjacency test
     for tokens in (300, 70_000, 2**40):            # count rows of every wider dtype
         net = independent_cycles(1)
         net.add_place("stock", tokens=tokens)
@@ -629,7 +652,8 @@ def _explore_bits(kernel, compiled: CompiledNet, m0: Sequence[int], max_states: 
     if status == kernel.NOT_SAFE:
         return None
     if status == kernel.LIMIT:
-        raise StateSpaceLimit(max_states, int(buffers.counters[0]), int(buffers.counters[2]))
+        raise StateSpaceLimit(max_states, int(buffers.counters[0]), int(buffers.counters[2]),
+                              _space(compiled, "bitmask", buffers, column, partial=True))
     return _space(compiled, "bitmask", buffers, column)
 
 
@@ -678,20 +702,29 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states
             raise PetriflowError("a token count exceeds 2**63 - 1: the net is too large to"
                                  " explore")
         if status == kernel.LIMIT:
-            raise StateSpaceLimit(max_states, int(buffers.counters[0]),
-                                  int(buffers.counters[2]))
+            raise StateSpaceLimit(max_states, int(buffers.counters[0]), int(buffers.counters[2]),
+                                  _space(compiled, "counts", buffers, col, partial=True))
         if status == kernel.UNBOUNDED:
             _unbounded(compiled, buffers, col)
         return _space(compiled, "counts", buffers, col)
 
 
 def _space(compiled: CompiledNet, representation: str, buffers: _Buffers,
-           column: list[int]) -> StateSpace:
+           column: list[int], partial: bool = False) -> StateSpace:
+    """The :class:`StateSpace` a kernel left in ``buffers``; ``partial``: it stopped at
+    the state limit, so only the states before ``counters[2]`` have all their edges."""
     states, edges = int(buffers.counters[0]), int(buffers.counters[1])
     rows, parent, parent_t, first_edge = buffers.state[:4]
     e_transition, e_target = buffers.edge
     offsets = np.empty(states + 1, dtype=np.int64)
-    offsets[:states] = first_edge[:states]
+    expanded = None
+    if partial:
+        expanded = min(int(buffers.counters[2]), states)
+        edges = int(first_edge[expanded]) if expanded < states else edges
+        offsets[:expanded] = first_edge[:expanded]
+        offsets[expanded:] = edges
+    else:
+        offsets[:states] = first_edge[:states]
     offsets[states] = edges
     return StateSpace(
         places=tuple(compiled.places),
@@ -705,6 +738,7 @@ def _space(compiled: CompiledNet, representation: str, buffers: _Buffers,
         representation=representation,
         _rows=rows[:states],
         _column_of_place=np.asarray(column, dtype=np.int64),
+        expanded=expanded,
     )
 
 

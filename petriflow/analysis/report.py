@@ -1,9 +1,13 @@
 """``petriflow check``: every analysis of one net, as JSON-ready data and as text.
 
-:func:`check_net` runs the structure checks (WF-net, free-choice), P/T-semiflows,
-boundedness (structurally by P-semiflows, then on the fly during reachability, with a
-Karp–Miller coverability graph to name the unbounded places), the reachability graph
-and the properties read off it, and, for WF-nets, classical soundness with witnesses.
+:func:`check_net` runs the structure checks (WF-net, free-choice), P-semiflows,
+boundedness (structurally by P-semiflows, else by a budgeted depth-first Karp–Miller
+search before any state space, else on the fly during reachability), the reachability
+graph and the properties read off it, and, for WF-nets, classical soundness with
+witnesses, then T-semiflows. Each step has its own budget (docs/analysis.md, "Budgets"):
+semiflows over budget are "not computed (over budget)"; an exploration stopped at the
+state limit still reports every fact it found (``partial``) and lists what stays
+``undecided``.
 
 Which marking is explored: the net's initial marking; for a WF-net whose file marks
 no place at all (several editors store WF-nets that way), one token in the source place
@@ -22,7 +26,9 @@ Exit codes (:func:`exit_code`), as the rest of the command line:
   markings other than the final one);
 * ``1`` — a property fails (the ``violations`` say which, with witnesses);
 * ``2`` — no verdict: the state space exceeds ``--max-states`` (``"complete": false`` in
-  the JSON, a one-line message on standard error), or the net file is bad input.
+  the JSON, a one-line message on standard error) and nothing found before the limit
+  fails (a deadlock, or for a WF-net improper completion or a dead end, found before it
+  gives ``1``), or the net file is bad input.
 
 Examples:
     >>> from petriflow.classic import dining_philosophers
@@ -39,8 +45,13 @@ from typing import Any
 
 import numpy as np
 
-from petriflow.analysis.coverability import coverability_graph_if_any
+from petriflow.analysis.coverability import (
+    DEFAULT_MAX_COVERABILITY,
+    CoverabilitySearch,
+    coverability_search,
+)
 from petriflow.analysis.invariants import (
+    DEFAULT_BUDGET,
     DEFAULT_MAX_ROWS,
     InvariantLimit,
     p_semiflows,
@@ -56,6 +67,7 @@ from petriflow.analysis.properties import (
 )
 from petriflow.analysis.reachability import (
     DEFAULT_MAX_STATES,
+    StateSpace,
     StateSpaceLimit,
     UnboundedNetError,
     reachability_graph,
@@ -86,43 +98,81 @@ EXIT_OK, EXIT_PROBLEM, EXIT_UNDECIDED = 0, 1, 2
 #: Farkas' algorithm row limit used by :func:`check_net`.
 INVARIANT_ROWS = DEFAULT_MAX_ROWS
 
+#: Why a kind of semiflow was not computed, as the report says it.
+_NOT_COMPUTED = {"budget": "over budget", "rows": "over budget", "size": "net too large",
+                 "skipped": "skipped"}
+
 
 def _format(marking: dict[str, int] | Marking) -> str:
     return ", ".join(f"{p}={c}" for p, c in marking.items()) or "(empty)"
 
 
-def _invariants(compiled: CompiledNet, start: Marking) -> tuple[dict[str, Any], bool]:
-    """The ``invariants`` section and whether P-semiflows prove the net bounded."""
-    section: dict[str, Any] = {}
+def _semiflows(section: dict[str, Any], kind: str, compiled: CompiledNet, budget: int):
+    """P- or T-semiflows into ``section`` (``None`` and the reason when not computed)."""
+    key = f"{kind}_semiflows"
+    if budget <= 0:
+        section[key] = None
+        section.setdefault("not_computed", {})[key] = "skipped"
+        return None
     try:
-        flows = p_semiflows(compiled, max_rows=INVARIANT_ROWS)
+        found = (p_semiflows if kind == "p" else t_semiflows)(compiled, max_rows=INVARIANT_ROWS,
+                                                              budget=budget)
     except InvariantLimit as exc:
-        section.update(p_semiflows=None, covered_by_p_semiflows=None, structural_bounds=None,
-                       note=str(exc))
-        flows = None
-    if flows is not None:
+        section[key] = None
+        section.setdefault("not_computed", {})[key] = _NOT_COMPUTED[exc.reason]
+        section.setdefault("note", str(exc))
+        return None
+    section[key] = found
+    return found
+
+
+def _invariants(compiled: CompiledNet, start: Marking, budget: int) -> tuple[dict[str, Any], set[str]]:
+    """The ``invariants`` section (P-semiflows) and the places they bound."""
+    section: dict[str, Any] = {"p_budget": budget}
+    flows = _semiflows(section, "p", compiled, budget)
+    covered: set[str] = set()
+    if flows is None:
+        section.update(covered_by_p_semiflows=None, structural_bounds=None)
+    else:
         covered = {p for y in flows for p in y}
-        section["p_semiflows"] = flows
         section["covered_by_p_semiflows"] = len(covered) == len(compiled.places)
         section["structural_bounds"] = structural_bounds(compiled, start, semiflows_found=flows)
-    try:
-        section["t_semiflows"] = t_semiflows(compiled, max_rows=INVARIANT_ROWS)
-    except InvariantLimit as exc:
-        section["t_semiflows"] = None
-        section.setdefault("note", str(exc))
     if getattr(compiled, "has_resets", False):
         section["note"] = ("cancellation regions (reset arcs) only remove tokens: P-semiflows"
                            " give upper bounds y·M <= y·M0, not equalities")
-    return section, bool(section.get("covered_by_p_semiflows"))
+    return section, covered
 
 
-def check_net(net: Net, *, max_states: int = DEFAULT_MAX_STATES) -> dict[str, Any]:
+#: With the default budget, T-semiflows (which no verdict needs) get this many steps per
+#: state and edge explored (about 2.5 times the exploration's own time), at least
+#: :data:`T_BUDGET_FLOOR` and at most the P-semiflows' budget.
+T_BUDGET_PER_EDGE = 100
+T_BUDGET_FLOOR = 10_000_000
+
+
+def check_net(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
+              max_coverability: int = DEFAULT_MAX_COVERABILITY,
+              invariant_budget: int | None = None) -> dict[str, Any]:
     """Analyse ``net`` and return the JSON-ready result ``petriflow check`` prints.
+
+    In order, each within its own budget: the structure (WF-net, free-choice);
+    P-semiflows (``invariant_budget``), which may prove every place bounded; unless they
+    do, a depth-first Karp–Miller search (``max_coverability`` nodes), which reports an
+    unbounded net with its pumping witness without exploring further; the state space
+    (``max_states``) and the properties read off it, or, when it stops at the limit,
+    every definite fact found so far; T-semiflows (``invariant_budget``).
 
     Args:
         net: the net.
         max_states: the most reachable markings to explore; beyond it the result has
-            ``"complete": false`` and ``"error"`` (the structural parts are still there).
+            ``"complete": false`` and ``"error"``, with what was found so far.
+        max_coverability: the node budget of the Karp–Miller search (0: none; the
+            exploration then tests boundedness on the fly only).
+        invariant_budget: the work budget of each semiflow computation (0: none); by
+            default :data:`~petriflow.analysis.invariants.DEFAULT_BUDGET` for the
+            P-semiflows and, for the T-semiflows, in proportion to the states and edges
+            explored (:data:`T_BUDGET_PER_EDGE` each, from :data:`T_BUDGET_FLOOR` up to
+            the same default).
 
     Returns:
         A dict; see the module documentation for the meaning of its keys.
@@ -166,19 +216,25 @@ def check_net(net: Net, *, max_states: int = DEFAULT_MAX_STATES) -> dict[str, An
         "max_tokens_place": None,
         "max_tokens_marking": None,
         "unbounded_places": [],
+        "unbounded_places_complete": None,
         "k_bound": None,
+        "coverability": None,
         "violations": [],
         "algorithm": [],
     }
-    result["invariants"], structurally_bounded = _invariants(compiled, start)
+    p_budget = DEFAULT_BUDGET if invariant_budget is None else invariant_budget
+    result["invariants"], covered = _invariants(compiled, start, p_budget)
+    structurally_bounded = bool(result["invariants"].get("covered_by_p_semiflows"))
     result["structurally_bounded"] = structurally_bounded
     if structurally_bounded:
         result["algorithm"].append("P-semiflows cover every place: bounded for any marking")
     violations: list[Violation] = []
+    probe: CoverabilitySearch | None = None
     try:
         soundness = None
         if structure.is_wf_net:
-            soundness = check_soundness(net, max_states=max_states)
+            soundness = check_soundness(net, max_states=max_states, max_coverability=max_coverability,
+                                        bounded=structurally_bounded or None)
             result["sound"] = soundness.sound
             result["soundness"] = {
                 "option_to_complete": soundness.option_to_complete,
@@ -193,28 +249,166 @@ def check_net(net: Net, *, max_states: int = DEFAULT_MAX_STATES) -> dict[str, An
             violations.append(Violation("not_wf_net", f"not a WF-net: {structure.problem}",
                                         elements=structure.not_on_path))
         same_start = soundness is not None and start == Marking({structure.source: 1})
+        probe = soundness.coverability if same_start else None
         if same_start and soundness.space is not None:
             space = soundness.space
         elif same_start and soundness.bounded is False:
             space = None
-            _unbounded_result(result, net, compiled, start, None, max_states, soundness)
+            witness = next((v for v in soundness.violations if v.kind == "unbounded"), None)
+            _unbounded_result(result, probe, witness.elements if witness else [], covered,
+                              compiled.places)
+            if witness is not None and result["unbounded_places_complete"]:
+                # P-semiflows bound every other place: the list is exact after all
+                witness.message = witness.message.replace("places (at least):", "places:")
         else:
-            try:
-                space = reachability_graph(net, start, max_states=max_states, compiled=compiled,
-                                           detect_unbounded=not structurally_bounded)
-            except UnboundedNetError as exc:
-                space = None
-                violations.append(_unbounded_result(result, net, compiled, start, exc,
-                                                    max_states, None))
+            space = None
+            if not same_start and not structurally_bounded and max_coverability > 0 \
+                    and not getattr(compiled, "has_resets", False):
+                probe = coverability_search(net, start, max_nodes=max_coverability, compiled=compiled)
+            exc = probe.witness if probe is not None and probe.bounded is False else None
+            _coverability_note(result, probe, max_coverability)
+            if exc is None:
+                known = structurally_bounded or (probe is not None and probe.bounded)
+                try:
+                    space = reachability_graph(net, start, max_states=max_states, compiled=compiled,
+                                               detect_unbounded=not known)
+                except UnboundedNetError as found:
+                    exc = found
+            if exc is not None:
+                _unbounded_result(result, probe, exc.places, covered, compiled.places)
+                violations.append(_unbounded_violation(result, exc))
+        _coverability_note(result, probe, max_coverability)
         if space is not None:
             _bounded_result(result, space, violations, structure.is_wf_net, net.final_marking)
     except StateSpaceLimit as exc:
+        _coverability_note(result, probe or getattr(exc, "coverability", None), max_coverability)
         result["complete"] = False
         result["error"] = str(exc)
-        result["sound"] = None if structure.is_wf_net else False
+        # Stopped in the soundness check (from [i]) or, soundness decided, in the
+        # exploration of the net's own initial marking.
+        from_i = structure.is_wf_net and soundness is None
+        if from_i or not structure.is_wf_net:
+            result["sound"] = None if structure.is_wf_net else False
+        if exc.partial is not None:
+            _partial_result(result, exc.partial, violations, structure.is_wf_net, from_i,
+                            net.final_marking, soundness_final(net, structure))
+    t_budget = invariant_budget
+    if t_budget is None:
+        explored = (result["states"] or 0) + (result["edges"] or 0)
+        explored += sum((result.get(k) or {}).get(n, 0) for k, n in (
+            ("partial", "states_explored"), ("partial", "edges_explored"),
+            ("coverability", "nodes"), ("coverability", "edges")))
+        t_budget = min(DEFAULT_BUDGET, max(T_BUDGET_FLOOR, T_BUDGET_PER_EDGE * explored))
+    result["invariants"]["t_budget"] = t_budget
+    _semiflows(result["invariants"], "t", compiled, t_budget)
     result["violations"] = [v.to_dict() for v in violations]
     result["algorithm"] = "; ".join(result["algorithm"])
     return result
+
+
+def soundness_final(net: Net, structure) -> Marking | None:
+    """The final marking soundness is decided for: the net's, else one token in ``o``."""
+    if not structure.is_wf_net:
+        return None
+    return net.final_marking if net.final_marking is not None else Marking({structure.sink: 1})
+
+
+def _coverability_note(result: dict[str, Any], probe: CoverabilitySearch | None, budget: int) -> None:
+    """The ``coverability`` section and its line in ``algorithm`` (once)."""
+    if probe is None or result["coverability"] is not None:
+        return
+    result["coverability"] = {"nodes": probe.nodes, "edges": probe.edges, "complete": probe.complete,
+                              "budget": budget}
+    if not probe.complete and probe.bounded is None:
+        result["algorithm"].append(f"Karp-Miller coverability search: over its budget ({budget:,} nodes)"
+                                   " without finding a pump; boundedness tested during the exploration")
+    elif probe.bounded:
+        result["algorithm"].append("Karp-Miller coverability search: bounded (no pump)")
+
+
+def _partial_result(result: dict[str, Any], space: StateSpace, violations: list[Violation],
+                    workflow: bool, from_i: bool, final, sound_final) -> None:
+    """What a state space stopped at the limit still proves (each a fact about the net).
+
+    Reached markings are reachable: a place holding ``k`` tokens in one proves its bound
+    is at least ``k`` (and the net not safe when ``k >= 2``); a transition fired is not
+    dead; an expanded marking that enables nothing is a deadlock, with its path; for a
+    WF-net, a marking covering the final one with tokens left elsewhere is improper
+    completion, and a dead marking other than the final one has lost the option to
+    complete. Everything else stays undecided (``null``).
+    """
+    bounds = space.place_bounds()
+    names = space.places
+    top = int(bounds.max(initial=0))
+    dead_states = deadlocks(space)
+    fired = np.zeros(len(space.transitions), dtype=bool)
+    fired[space.edge_transition] = True
+    not_dead = list(dict.fromkeys(space.origins[t] for t in np.flatnonzero(fired)))
+    stuck = dead_states
+    if final is not None and dead_states.size:
+        stuck = np.asarray([s for s in dead_states.tolist() if space.marking(int(s)) != final],
+                           dtype=dead_states.dtype)
+    found = {
+        "states_explored": space.num_states,
+        "states_expanded": int(space.expanded),
+        "edges_explored": space.num_edges,
+        "max_tokens_place_at_least": top,
+        "max_tokens_marking_at_least": space.max_tokens_marking,
+        "k_bound_at_least": {p: int(k) for p, k in zip(names, bounds)},
+        "deadlock_markings_found": int(dead_states.size),
+        "not_dead_transitions": not_dead,
+    }
+    result["partial"] = found
+    if top >= 2:
+        result["safe"] = False
+    if dead_states.size:
+        result["deadlock_free"] = False
+    result["stuck_markings"] = None
+    # Proved without the state space: bounded by P-semiflows or by the Karp-Miller search,
+    # safe when the P-semiflows bound every place by 1.
+    search = result.get("coverability") or {}
+    if result.get("structurally_bounded") or (search.get("complete") and result.get("bounded") is None):
+        result["bounded"] = True
+    limits_found = (result.get("invariants") or {}).get("structural_bounds") or {}
+    if result["safe"] is None and len(limits_found) == len(names) and max(limits_found.values(), default=0) <= 1:
+        result["safe"] = True
+    undecided = ["states", "edges", "live", "reversible", "dead_transitions",
+                 "max_tokens_place", "max_tokens_marking", "k_bound"]
+    undecided += [k for k in ("bounded", "safe", "deadlock_free") if result[k] is None]
+    if workflow and from_i:
+        undecided.append("sound")
+    if workflow and from_i and sound_final is not None:
+        final_vector = np.array([sound_final.get(p, 0) for p in names], dtype=np.int64)
+        markings = space.markings
+        improper = np.flatnonzero((markings >= final_vector).all(axis=1)
+                                  & (markings != final_vector).any(axis=1))
+        if improper.size:
+            state = int(improper[0])
+            reached = space.marking(state)
+            violations.append(Violation(
+                "improper_completion",
+                f"improper completion: a reachable marking covers the final marking"
+                f" {_format(sound_final)} with tokens left elsewhere: {_format(reached)}"
+                " (found before the state limit)", space.path(state), reached.to_dict()))
+        dead_ends = [s for s in dead_states.tolist() if space.marking(int(s)) != sound_final]
+        if dead_ends:
+            state = int(dead_ends[0])
+            reached = space.marking(state)
+            violations.append(Violation(
+                "no_option_to_complete",
+                f"no option to complete: {_format(reached)} is a deadlock other than the final"
+                f" marking {_format(sound_final)} (found before the state limit)",
+                space.path(state), reached.to_dict()))
+        if improper.size or dead_ends:
+            result["sound"] = False
+            undecided.remove("sound")
+    elif stuck.size and not workflow:
+        state = int(stuck[0])
+        reached = space.marking(state)
+        violations.append(Violation(
+            "deadlock", f"deadlock: {_format(reached)} enables no transition (found before the"
+                        " state limit; more may exist)", space.path(state), reached.to_dict()))
+    result["undecided"] = undecided
 
 
 def _bounded_result(result: dict[str, Any], space, violations: list[Violation],
@@ -271,36 +465,49 @@ def _reaches(space, final) -> bool:
         return False
 
 
-def _unbounded_result(result, net, compiled, start, exc, max_states, soundness) -> Violation | None:
-    """Fill the result for an unbounded net; returns the violation for a non-WF net."""
+def _unbounded_result(result: dict[str, Any], probe: CoverabilitySearch | None,
+                      pumped: list[str], covered: set[str], every_place) -> None:
+    """Fill the result for an unbounded net from the Karp–Miller search (if any) and the
+    places a witness pumps. The list is exact when the search finished, or when every
+    place it leaves out is bounded by a P-semiflow."""
     result.update(bounded=False, safe=False, live=None, deadlock_free=None)
-    places = list(exc.places) if exc is not None else []
-    graph = coverability_graph_if_any(net, start, max_nodes=max_states, compiled=compiled)
-    if graph is None:
-        result["algorithm"].append("Karp-Miller coverability graph: too large or not"
-                                   " applicable (reset arcs), unbounded places listed are"
-                                   " those the witness pumps")
-    if graph is not None:
-        places = graph.unbounded_places
-        result["dead_transitions"] = graph.dead_transitions()
-        result["k_bound"] = graph.place_bounds()
-        result["algorithm"].append("Karp-Miller coverability graph (unbounded places, dead"
-                                   " transitions)")
-    elif soundness is not None:
-        places = next((v.elements for v in soundness.violations if v.kind == "unbounded"), [])
-    result["unbounded_places"] = places
-    if exc is None:
-        return None
+    places = list(pumped)
+    if probe is not None:
+        places = list(dict.fromkeys(probe.unbounded_places + places))
+        if probe.complete:
+            result["dead_transitions"] = probe.dead_transitions
+            result["k_bound"] = probe.place_bounds
+        else:
+            result["not_dead_transitions"] = probe.fired
+    order = {p: k for k, p in enumerate(every_place)}
+    result["unbounded_places"] = sorted(places, key=order.__getitem__)
+    exact = (probe is not None and probe.complete) or covered | set(places) >= set(every_place)
+    result["unbounded_places_complete"] = bool(exact)
+    if probe is not None and probe.unbounded_places:
+        result["algorithm"].append("Karp-Miller coverability search (depth first): unbounded"
+                                   + ("" if probe.complete else ", graph over its budget"))
+    else:
+        result["algorithm"].append("reachability graph stopped: a marking strictly covers an"
+                                   " earlier one on its path (unbounded)")
+
+
+def _unbounded_violation(result: dict[str, Any], exc: UnboundedNetError) -> Violation:
+    places = result["unbounded_places"]
+    more = "" if result["unbounded_places_complete"] else " (at least)"
     return Violation(
         "unbounded",
         f"unbounded: firing {' '.join(exc.pump)} from the marking reached by"
         f" [{' '.join(exc.prefix)}] adds tokens to {', '.join(exc.places)} and can be repeated"
-        f" forever; unbounded places: {', '.join(places)}",
+        f" forever; unbounded places{more}: {', '.join(places)}",
         exc.prefix + exc.pump, exc.covering.to_dict(), places)
 
 
 def exit_code(result: dict[str, Any]) -> int:
     """0: sound WF-net, or bounded and deadlock-free; 1: a property fails; 2: no verdict.
+
+    A result stopped at the state limit (``complete`` false) is 1 when what was found
+    before the limit already fails (a deadlock, improper completion, a dead end in a
+    WF-net), else 2.
 
     Examples:
         >>> exit_code({"complete": False})
@@ -310,7 +517,11 @@ def exit_code(result: dict[str, Any]) -> int:
         1
     """
     if not result.get("complete", True):
-        return EXIT_UNDECIDED
+        # Stopped at the limit: a definite failure found on the way still fails.
+        if result.get("workflow_net"):
+            return EXIT_PROBLEM if result.get("sound") is False else EXIT_UNDECIDED
+        found = any(v.get("kind") == "deadlock" for v in result.get("violations", ()))
+        return EXIT_PROBLEM if found or result.get("bounded") is False else EXIT_UNDECIDED
     if result.get("workflow_net"):
         return EXIT_OK if result.get("sound") else EXIT_PROBLEM
     stuck = result.get("stuck_markings")
@@ -344,6 +555,19 @@ def format_report(result: dict[str, Any]) -> str:
         lines.append(f"  {problem or 'not a WF-net'}")
     if not result["complete"]:
         lines.append(f"  state space: {result['error']}")
+        found = result.get("partial")
+        if found:
+            facts = [f"{_count(found['states_explored'], 'state')} ({found['states_expanded']} expanded),"
+                     f" {_count(found['edges_explored'], 'edge')}"]
+            if result.get("safe") is False:
+                top = max(found["k_bound_at_least"].items(), key=lambda item: item[1])
+                facts.append(f"not safe ({top[0]} reaches {top[1]} tokens)")
+            if found["deadlock_markings_found"]:
+                facts.append(f"{_count(found['deadlock_markings_found'], 'deadlock')} found")
+            facts.append(f"{len(found['not_dead_transitions'])} of {result['transitions']}"
+                         " transitions fire (not dead)")
+            lines.append("  found before the limit: " + "; ".join(facts))
+            lines.append(f"  undecided: {', '.join(result.get('undecided', []))}")
     elif result["bounded"]:
         safety = "safe" if result["safe"] else f"{result['max_tokens_place']}-bounded"
         lines.append(f"  state space: {_count(result['states'], 'state')}, {_count(result['edges'], 'edge')};"
@@ -354,17 +578,26 @@ def format_report(result: dict[str, Any]) -> str:
         lines.append(f"  deadlock-free: {_yes(result['deadlock_free'])}{ending}"
                      f"   live: {_yes(result['live'])}   reversible: {_yes(result['reversible'])}")
     else:
-        lines.append(f"  UNBOUNDED: places {', '.join(result['unbounded_places'])}")
+        more = "" if result.get("unbounded_places_complete", True) else (
+            " (at least; the others are undecided: coverability over its budget)")
+        lines.append(f"  UNBOUNDED: places {', '.join(result['unbounded_places'])}{more}")
     dead = result.get("dead_transitions")
     if dead is not None:
         lines.append(f"  dead transitions: {', '.join(dead) if dead else 'none'}")
     invariants = result.get("invariants") or {}
     p_flows, t_flows = invariants.get("p_semiflows"), invariants.get("t_semiflows")
+    why = invariants.get("not_computed") or {}
+
+    def counted(flows, key):
+        if flows is not None:
+            return str(len(flows))
+        return f"not computed ({why[key]})" if key in why else "not computed"
+
+    too_large = invariants.get("note") if "net too large" in why.values() else None
     lines.append(
-        f"  P-semiflows: {'not computed' if p_flows is None else len(p_flows)}"
+        f"  P-semiflows: {counted(p_flows, 'p_semiflows')}"
         f"{' (cover every place)' if invariants.get('covered_by_p_semiflows') else ''};"
-        f" T-semiflows: {'not computed' if t_flows is None else len(t_flows)}"
-        + (f" ({invariants['note']})" if invariants.get("note") and (p_flows is None or t_flows is None) else ""))
+        f" T-semiflows: {counted(t_flows, 't_semiflows')}" + (f" ({too_large})" if too_large else ""))
     for violation in result["violations"]:
         if violation["kind"] == "not_wf_net" and not result["workflow_net"]:
             continue

@@ -48,7 +48,11 @@ from typing import Any
 import numpy as np
 
 from petriflow.analysis._graph import reaching
-from petriflow.analysis.coverability import coverability_graph_if_any
+from petriflow.analysis.coverability import (
+    DEFAULT_MAX_COVERABILITY,
+    CoverabilitySearch,
+    coverability_search,
+)
 from petriflow.analysis.properties import dead_transitions, deadlocks, is_live
 from petriflow.analysis.reachability import (
     DEFAULT_MAX_STATES,
@@ -225,6 +229,10 @@ class SoundnessReport:
         crosscheck: for free-choice WF-nets, the short-circuited net's liveness and
             boundedness and whether they agree with the verdict.
         space: the reachability graph from ``[i]`` (bounded WF-nets only).
+        coverability: the budgeted Karp–Miller search from ``[i]`` run before the
+            state space (``None`` when it was not run).
+        unbounded_places_complete: for an unbounded net, whether the unbounded places
+            listed are all of them (``False``: at least these).
     """
 
     sound: bool
@@ -241,6 +249,8 @@ class SoundnessReport:
     final_marking: dict[str, int] | None = None
     crosscheck: dict[str, Any] | None = None
     space: StateSpace | None = field(default=None, repr=False)
+    coverability: CoverabilitySearch | None = field(default=None, repr=False)
+    unbounded_places_complete: bool | None = None
 
 
 def check_soundness(
@@ -249,8 +259,15 @@ def check_soundness(
     final_marking: Mapping[str, int] | None = None,
     max_states: int = DEFAULT_MAX_STATES,
     crosscheck: bool = True,
+    max_coverability: int = DEFAULT_MAX_COVERABILITY,
+    bounded: bool | None = None,
 ) -> SoundnessReport:
     """Decide classical soundness of a WF-net for one token in its source place.
+
+    Boundedness comes first and cheap: unless ``bounded`` says it is known, a
+    Karp–Miller search of at most ``max_coverability`` nodes
+    (:func:`~petriflow.analysis.coverability.coverability_search`) runs before the state
+    space; an unbounded net is reported from it without exploring further.
 
     Args:
         net: the net (its own initial marking is ignored: soundness is about ``[i]``).
@@ -258,12 +275,17 @@ def check_soundness(
         max_states: passed to the reachability graph.
         crosscheck: for free-choice WF-nets, also check that the short-circuited net is
             live and bounded exactly when the net was found sound.
+        max_coverability: the node budget of the Karp–Miller search (0: none).
+        bounded: ``True`` when the net is known to be bounded (P-semiflows cover every
+            place): no search, no on-the-fly unboundedness test.
 
     Returns:
         A :class:`SoundnessReport`.
 
     Raises:
-        StateSpaceLimit: more than ``max_states`` markings are reachable from ``[i]``.
+        StateSpaceLimit: more than ``max_states`` markings are reachable from ``[i]``;
+            its ``partial`` state space holds what was explored and its
+            ``coverability`` the search run before (``check_net`` reports what they prove).
     """
     structure = workflow_structure(net)
     free_choice = is_free_choice(net)
@@ -280,10 +302,21 @@ def check_soundness(
     compiled = CompiledNet(net)
     report = SoundnessReport(False, structure, [], free_choice=free_choice,
                              initial_marking=start.to_dict(), final_marking=final.to_dict())
+    probe = None
+    if not bounded and max_coverability > 0 and not getattr(compiled, "has_resets", False):
+        probe = coverability_search(net, start, max_nodes=max_coverability, compiled=compiled)
+        report.coverability = probe
+        if probe.bounded is False:
+            return _unbounded(probe.witness, report, probe)
+    known = bounded or (probe is not None and probe.bounded)
     try:
-        space = reachability_graph(net, start, max_states=max_states, compiled=compiled)
+        space = reachability_graph(net, start, max_states=max_states, compiled=compiled,
+                                   detect_unbounded=not known)
     except UnboundedNetError as exc:
-        return _unbounded(net, compiled, start, exc, report, max_states)
+        return _unbounded(exc, report, probe)
+    except StateSpaceLimit as exc:
+        exc.coverability = probe             # what the search proved, for the report
+        raise
     report.space = space
     report.bounded = True
     report.algorithm = "reachability graph from [i] (explicit breadth-first search)"
@@ -342,25 +375,28 @@ def check_soundness(
     return report
 
 
-def _unbounded(net: Net, compiled: CompiledNet, start: Marking, exc: UnboundedNetError,
-               report: SoundnessReport, max_states: int) -> SoundnessReport:
+def _unbounded(exc: UnboundedNetError, report: SoundnessReport,
+               probe: CoverabilitySearch | None) -> SoundnessReport:
     """The report for an unbounded WF-net: unsound, with the pumping witness."""
     report.bounded = False
-    report.algorithm = ("reachability graph from [i] stopped: a marking strictly covers an"
-                        " earlier one on its path (unbounded)")
     places = list(exc.places)
-    graph = coverability_graph_if_any(net, start, max_nodes=max_states, compiled=compiled)
-    if graph is not None:
-        places = graph.unbounded_places
-        report.algorithm += "; Karp-Miller coverability graph for the unbounded places"
+    if probe is not None and probe.unbounded_places:
+        report.algorithm = ("Karp-Miller coverability search from [i] (depth first): a marking"
+                            " strictly covers an earlier one on its path (unbounded)")
+        places = list(dict.fromkeys(probe.unbounded_places + places))
+    else:
+        report.algorithm = ("reachability graph from [i] stopped: a marking strictly covers an"
+                            " earlier one on its path (unbounded)")
+    report.unbounded_places_complete = probe is not None and probe.complete
+    more = "" if report.unbounded_places_complete else " (at least)"
     report.violations.append(Violation(
         "unbounded",
         f"unbounded: firing {' '.join(exc.pump)} from the marking reached by"
         f" [{' '.join(exc.prefix)}] adds tokens to {', '.join(exc.places)} and can be repeated"
-        f" forever; unbounded places: {', '.join(places)}",
+        f" forever; unbounded places{more}: {', '.join(places)}",
         exc.prefix + exc.pump, exc.covering.to_dict(), places))
-    if graph is not None:
-        dead = graph.dead_transitions()
+    if probe is not None and probe.complete:
+        dead = probe.dead_transitions
         report.dead_transitions = dead
         report.no_dead_transitions = not dead
         if dead:

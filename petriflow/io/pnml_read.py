@@ -17,7 +17,10 @@ Dialects read (all without namespace tricks: tags are matched by local name):
 * ISO/IEC 15909-2 (ePNK, the Model Checking Contest): nested ``<page>`` elements are
   flattened (every node kept), ``referencePlace``/``referenceTransition`` chains are
   resolved to their final node, ``<name><text>``, ``<initialMarking><text>``,
-  ``<inscription><text>``; node positions go to ``meta["position"] = [x, y]``.
+  ``<inscription><text>``; node positions go to ``meta["position"] = [x, y]``; the
+  MCC's NUPN unit structure (``<toolspecific tool="nupn">``) goes to
+  ``net.meta["nupn"]`` (units, their places and subunits, root, safe), which the writer
+  keeps with the net's other meta data.
 * PM4Py / ProM (``pnmlcoremodel``): ``<finalmarkings>``, ``$invisible$`` silent
   transitions, ``<arctype>normal``; data Petri net extras are reported, not kept.
 * WoPeD (``ptNetb``): operator parts rebuild :class:`~petriflow.net.Operator`;
@@ -271,6 +274,7 @@ class _Reader:
         self.outcome_arcs: list[tuple[str, Element]] = []
         self.tokens: dict[str, int] = {}
         self.subprocess_pages: list[Element] = []
+        self.nupn: dict[str, Any] | None = None  # the MCC's unit structure, if the file has one
         self.pages: list[str] = []
         self.page_of: dict[Element, str | None] = {}  # the page each node or arc element is on
         self.node_page: dict[str, str | None] = {}   # the page of each node id
@@ -315,6 +319,7 @@ class _Reader:
         self.read_net_annotations(net_element)
         for element in self.places:
             self.read_place(element)
+        self.check_nupn()
         # one marking for all places: adding tokens place by place costs O(places^2)
         self.net.set_initial_marking(self.tokens)
         for element in self.transitions:
@@ -535,10 +540,46 @@ class _Reader:
                 self.read_woped(tool_element, kind, node, found)
             elif tool == "StochasticPetriNet" and kind == "transition":
                 self.read_stochastic(tool_element, node, found)
+            elif tool == "nupn" and kind in ("net", "page"):
+                self.read_nupn(tool_element, kind, node)
             else:
                 self.note(kind, node, f"toolspecific data of tool {tool!r} is not representable;"
                           " ignored")
         return found
+
+    def read_nupn(self, tool: Element, kind: str, node: str | None) -> None:
+        """The Model Checking Contest's unit structure (NUPN 1.1), kept as
+        ``net.meta["nupn"]``: ``{"version", "root", "safe", "units": {unit: {"places": [...],
+        "subunits": [...]}}}`` (the writer keeps it with the net's other meta data)."""
+        structure = _child(tool, "structure")
+        if structure is None or self.nupn is not None:
+            self.note(kind, node, "NUPN data without a <structure>, or a second one, is not"
+                      " representable; ignored")
+            return
+        units: dict[str, dict[str, list[str]]] = {}
+        for unit in _children(structure, "unit"):
+            unit_id = (unit.get("id") or "").strip()
+            places, subunits = _child(unit, "places"), _child(unit, "subunits")
+            units[unit_id] = {
+                "places": ((places.text or "").split() if places is not None else []),
+                "subunits": ((subunits.text or "").split() if subunits is not None else []),
+            }
+        self.nupn = {"version": (tool.get("version") or "").strip(),
+                     "root": (structure.get("root") or "").strip(),
+                     "safe": (structure.get("safe") or "").strip().lower() == "true",
+                     "units": units}
+
+    def check_nupn(self) -> None:
+        """Keep the NUPN units in the net's meta data; one note if they name unknown places."""
+        if self.nupn is None:
+            return
+        self.net.meta["nupn"] = self.nupn
+        named = {p for unit in self.nupn["units"].values() for p in unit["places"]}
+        unknown = sorted(named - set(self.net.places))
+        if unknown:
+            some = f"{len(unknown)} places that are" if len(unknown) > 1 else "a place that is"
+            self.note("net", self.net.id, f"NUPN units name {some} not in the net"
+                      f" (e.g. {unknown[0]!r}); units kept as read")
 
     def read_prom(self, tool: Element, kind: str, node: str | None, found: dict[str, Any]) -> None:
         if kind == "transition" and tool.get("activity") == "$invisible$":

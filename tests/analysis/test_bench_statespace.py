@@ -46,3 +46,17 @@ def test_shared_buffer_is_bounded_by_its_capacity():
     space = reachability_graph(load_bench().shared_buffer(3, 4, 2))
     columns = [space.places.index("buffer"), space.places.index("free")]
     assert (space.markings[:, columns].sum(axis=1) == 4).all()
+
+
+def test_check_mode_times_each_step_and_checks_oracle_answers(tmp_path, capsys):
+    """--check --quick: a row per stress net and per file, each step's CPU seconds, and a
+    file with an answer.json beside it checked against it."""
+    model = Path(__file__).resolve().parents[1] / "data" / "oracle" / "mcc" / "Dekker-PT-010" / "model.pnml"
+    out = tmp_path / "check.json"
+    assert load_bench().main(["--check", "--quick", str(model), "--json", str(out)]) == 0
+    table = capsys.readouterr().out
+    assert "| Lamport fast mutex, 2 processes | 38 | 52 | 310 |" in table
+    assert "Dekker-PT-010/model.pnml | 50 | 120 | 6,144 |" in table and "oracle agrees" in table
+    rows = json.loads(out.read_text())["rows"]
+    unbounded = next(r for r in rows if r["net"].startswith("unbounded"))
+    assert unbounded["verdict"] == "PROBLEM" and unbounded["result"]["unbounded_places"] == ["heap"]

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from petriflow.analysis.coverability import OMEGA, coverability_graph, unbounded_places
+from petriflow.analysis.coverability import OMEGA, coverability_graph, coverability_search, unbounded_places
 from petriflow.analysis.reachability import (
     StateSpaceLimit,
     UnboundedNetError,
@@ -123,3 +123,73 @@ def test_on_the_fly_detection_agrees_with_karp_miller(net):
         with pytest.raises(UnboundedNetError) as caught:
             reachability_graph(net, max_states=10**5)
         assert set(caught.value.places) <= set(graph.unbounded_places)
+
+
+# The budgeted depth-first search -------------------------------------------------------
+
+def _replays(net, prefix, pump, covered, covering):
+    """The witness fires from the initial marking and the pump strictly adds tokens."""
+    from petriflow.engine import fire_sequence
+
+    reached = fire_sequence(net, net.initial_marking, prefix)
+    assert reached == covered
+    assert fire_sequence(net, reached, pump) == covering
+    assert all(covering[p] >= covered[p] for p in net.places) and covering != covered
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(any_nets())
+def test_search_agrees_with_the_textbook_graph(net):
+    """Finished within its budget, the depth-first search finds exactly the unbounded
+    places, dead transitions and bounds of the breadth-first Karp-Miller graph; its
+    witness replays. Stopped early, every place it names is unbounded."""
+    try:
+        graph = coverability_graph(net, max_nodes=5000)
+    except StateSpaceLimit:
+        return
+    found = coverability_search(net)
+    assert found.complete
+    assert found.unbounded_places == graph.unbounded_places
+    assert found.dead_transitions == graph.dead_transitions()
+    assert found.place_bounds == graph.place_bounds()
+    assert found.bounded == graph.bounded
+    if found.witness is not None:
+        w = found.witness
+        _replays(net, w.prefix, w.pump, w.covered, w.covering)
+        assert set(w.places) <= set(graph.unbounded_places)
+    small = coverability_search(net, max_nodes=2)
+    assert set(small.unbounded_places) <= set(graph.unbounded_places)
+    assert small.complete or small.bounded in (None, False)
+
+
+def test_search_finds_a_pump_behind_a_large_bounded_part():
+    """2**20 markings within 20 firings, the pump 30 steps down a chain: a breadth-first
+    search (and the former check) fills 2,000,000 states without reaching it; the
+    depth-first search finds it within its default budget, with a short witness."""
+    from tests.analysis.nets import pumped_after_bounded
+
+    net = pumped_after_bounded(20, 30)
+    found = coverability_search(net)
+    assert found.unbounded_places == ["heap"] and found.bounded is False
+    assert not found.complete and found.stopped == "budget" and found.nodes == 100_000
+    w = found.witness
+    assert w.prefix == [f"step_{s}" for s in range(30)] and w.pump == ["pump"]
+    _replays(net, w.prefix, w.pump, w.covered, w.covering)
+    assert found.dead_transitions is None and "pump" in found.fired
+
+
+def test_search_refuses_reset_arcs_and_bad_budgets():
+    """Reset arcs and a budget under one node are refused; a bounded net is finished."""
+    cancelling = loads_net("""
+petriflow: 1
+places: [{id: a, tokens: 1}, b]
+transitions: [{id: t, in: [a], out: [a, b], cancels: [b]}]
+""")
+    with pytest.raises(PetriflowError, match="reset"):
+        coverability_search(cancelling)
+    net = dining_philosophers(3)
+    with pytest.raises(ValueError):
+        coverability_search(net, max_nodes=0)
+    bounded = coverability_search(net)
+    assert bounded.complete and bounded.bounded and bounded.nodes == 4
+    assert bounded.place_bounds["fork_0"] == 1 and bounded.dead_transitions == []

@@ -477,3 +477,25 @@ def test_degenerate_nets(mode):
     empty.add_transition("tick")
     space = explore(empty, mode=mode)
     assert (space.num_states, space.num_edges) == (1, 1) and space.successors(0) == [("tick", 0)]
+
+
+@pytest.mark.parametrize("bits", [True, False])
+def test_the_limit_keeps_what_was_explored(bits):
+    """StateSpaceLimit.partial: the states found, the first ``expanded`` with all their
+    edges (as in the full graph), the others with none and not counted as deadlocks."""
+    from petriflow.analysis.reachability import _explore
+    from petriflow.engine import CompiledNet
+
+    net = dining_philosophers(10)
+    full = reachability_graph(net)
+    compiled = CompiledNet(net)
+    with pytest.raises(StateSpaceLimit) as caught:
+        _explore(compiled, compiled.vector(net.initial_marking), 40, True, bits=bits)
+    partial = caught.value.partial
+    assert partial.num_states == 40 and not partial.complete
+    assert partial.expanded == caught.value.expanded < 40
+    for state in range(partial.expanded):
+        assert partial.successors(state) == full.successors(state)
+        assert partial.marking(state) == full.marking(state)
+    assert partial.num_edges == full.edge_offsets[partial.expanded]
+    assert partial.deadlocks().size == 0 and full.complete

@@ -163,3 +163,129 @@ def test_check_command_json_counts_states(tmp_path, capsys):
     path.write_text(dumps_net(dining_philosophers(4)))
     assert main(["check", str(path), "--json", "--max-states", "1000"]) == EXIT_OK
     assert json.loads(capsys.readouterr().out)["states"] == 7
+
+
+# Budgets: invariants, unboundedness first, partial answers ------------------------------
+
+def test_unbounded_net_with_a_large_bounded_part_at_the_default_budget():
+    """The pump is three firings away but the bounded part has 2**20 markings: the former
+    check found the pump and then built a Python coverability graph with the 2,000,000
+    node budget of the state space (minutes, a gigabyte). Now the depth-first search
+    answers at the default settings, with the places (exact: the P-semiflows bound all
+    the others) and a witness that replays."""
+    import time
+
+    from petriflow.engine import fire_sequence
+    from petriflow.marking import Marking
+    from tests.analysis.nets import pumped_after_bounded
+
+    net = pumped_after_bounded(20, 2)
+    started = time.process_time()
+    result = check_net(net)
+    assert time.process_time() - started < 20
+    assert result["bounded"] is False and result["complete"] is True
+    assert result["unbounded_places"] == ["heap"] and result["unbounded_places_complete"] is True
+    assert result["states"] is None and exit_code(result) == EXIT_PROBLEM
+    witness = next(v for v in result["violations"] if v["kind"] == "unbounded")
+    assert witness["transitions"] == ["step_0", "step_1", "pump"]
+    assert fire_sequence(net, net.initial_marking, witness["transitions"]) == Marking(witness["marking"])
+    assert result["coverability"]["budget"] == 100_000
+    text = format_report(result)
+    assert "UNBOUNDED: places heap" in text and "witness: step_0 step_1 pump" in text
+
+
+def test_unbounded_places_are_marked_incomplete_when_undecided():
+    """Without P-semiflows to bound the rest and with a tiny coverability budget, the
+    places named are 'at least' these."""
+    from tests.analysis.nets import pumped_after_bounded
+
+    result = check_net(pumped_after_bounded(6, 1), max_coverability=5, invariant_budget=0)
+    assert result["bounded"] is False and "heap" in result["unbounded_places"]
+    assert result["unbounded_places_complete"] is False
+    assert "(at least" in format_report(result)
+
+
+def test_a_deadlock_found_before_the_limit_is_reported():
+    """A deadlock one firing from the start, in a net of 2**16 markings explored to 1000:
+    the deadlock, with its witness, is a definite answer (exit 1); what stays undecided
+    is listed."""
+    from tests.analysis.nets import deadlock_beyond_limit
+
+    result = check_net(deadlock_beyond_limit(16), max_states=1000)
+    assert result["complete"] is False and "max_states=1000" in result["error"]
+    deadlock = next(v for v in result["violations"] if v["kind"] == "deadlock")
+    assert deadlock["transitions"] == ["all_stop"] and deadlock["marking"] == {"stopped": 1}
+    assert result["deadlock_free"] is False and result["states"] is None
+    assert result["partial"]["states_explored"] == 1000
+    assert result["partial"]["deadlock_markings_found"] >= 1
+    assert "all_stop" in result["partial"]["not_dead_transitions"]
+    assert {"states", "live", "dead_transitions"} <= set(result["undecided"])
+    assert "deadlock_free" not in result["undecided"]
+    # P-semiflows bound every place by 1: bounded and safe without the state space
+    assert result["bounded"] is True and result["safe"] is True
+    assert "bounded" not in result["undecided"] and "safe" not in result["undecided"]
+    assert exit_code(result) == EXIT_PROBLEM
+    text = format_report(result)
+    assert "PROBLEM" in text.splitlines()[0] and "found before the limit" in text
+    assert "witness: all_stop" in text
+
+
+def test_a_place_over_its_bound_found_before_the_limit_is_reported():
+    """A buffer that has already held 2 tokens is not safe, whatever is left to explore."""
+    result = check_net(producer_consumer(400), max_states=40)
+    assert result["complete"] is False and result["safe"] is False
+    assert result["partial"]["k_bound_at_least"]["buffer"] >= 2
+    assert result["partial"]["max_tokens_place_at_least"] >= 2
+    assert result["bounded"] is True and "bounded" not in result["undecided"]   # by P-semiflows
+    assert exit_code(result) == EXIT_UNDECIDED
+    unproven = check_net(producer_consumer(400), max_states=40, invariant_budget=0,
+                         max_coverability=10)
+    assert unproven["bounded"] is None and "bounded" in unproven["undecided"]
+    assert unproven["safe"] is False
+    assert "not safe" in format_report(result)
+
+
+def test_a_workflow_net_improper_completion_found_before_the_limit():
+    """A WF-net whose improper completion is near [i] but whose state space is large:
+    unsound (exit 1) from what was explored."""
+    lines = ["petriflow: 1", "places: [i, o, done, " + ", ".join(f"a{k}, b{k}" for k in range(14)) + "]",
+             "transitions:",
+             "  - {id: split, in: [i], out: [done, " + ", ".join(f"a{k}" for k in range(14)) + "]}",
+             "  - {id: early, in: [done], out: [o]}",
+             "  - {id: finish, in: [" + ", ".join(f"a{k}" for k in range(14)) + "], out: [o]}"]
+    for k in range(14):
+        lines += [f"  - {{id: go{k}, in: [a{k}], out: [b{k}]}}", f"  - {{id: back{k}, in: [b{k}], out: [a{k}]}}"]
+    result = check_net(loads_net("\n".join(lines) + "\n"), max_states=200)
+    assert result["complete"] is False and result["workflow_net"]
+    assert result["sound"] is False and "sound" not in result["undecided"]
+    improper = next(v for v in result["violations"] if v["kind"] == "improper_completion")
+    assert improper["transitions"] == ["split", "early"]
+    assert exit_code(result) == EXIT_PROBLEM
+
+
+def test_invariants_over_budget_are_not_computed_and_check_goes_on():
+    """Lamport's fast mutex for 3 processes: T-semiflows over budget, said so; the state
+    space and every other answer are there."""
+    from tests.analysis.nets import lamport_fast_mutex
+
+    result = check_net(lamport_fast_mutex(3))
+    assert result["states"] == 9737 and result["deadlock_free"] is True
+    assert result["invariants"]["t_semiflows"] is None
+    assert result["invariants"]["not_computed"]["t_semiflows"] == "over budget"
+    assert result["invariants"]["covered_by_p_semiflows"] is True
+    assert "T-semiflows: not computed (over budget)" in format_report(result)
+    skipped = check_net(lamport_fast_mutex(2), invariant_budget=0)
+    assert skipped["invariants"]["p_semiflows"] is None and skipped["states"] == 310
+    assert "P-semiflows: not computed (skipped)" in format_report(skipped)
+
+
+def test_check_command_budget_options(tmp_path, capsys):
+    """--max-coverability and --invariant-budget reach check_net; negative values are bad input."""
+    path = tmp_path / "mailbox.yaml"
+    path.write_text(UNBOUNDED)
+    assert main(["check", str(path), "--json", "--max-coverability", "0", "--invariant-budget", "0"]) == EXIT_PROBLEM
+    result = json.loads(capsys.readouterr().out)
+    assert result["coverability"] is None and result["bounded"] is False
+    assert result["invariants"]["not_computed"] == {"p_semiflows": "skipped", "t_semiflows": "skipped"}
+    assert main(["check", str(path), "--max-coverability", "-1"]) == 2
+    assert "--max-coverability must be >= 0" in capsys.readouterr().err

@@ -600,7 +600,7 @@ JSON = st.recursive(
     lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner, max_size=3),
     max_leaves=8,
 )
-ATTRIBUTE_TEXT = st.none() | st.text(st.characters(exclude_categories=("Cs", "Cc", "Cn")), max_size=8)
+ATTRIBUTE_TEXT = st.none() | st.text(st.characters(exclude_categories=("Cs", "Cc", "Cn")), min_size=1, max_size=8)
 
 
 @st.composite
@@ -784,3 +784,48 @@ def test_utf16_without_a_mark_and_undecodable_bytes(tmp_path):
     (tmp_path / "bad.pnml").write_bytes(b"<?xml version='1.0'?><pnml>\xff\xfe\xfa</pnml>")
     with pytest.raises(NetFormatError, match=r"bad.pnml: cannot read: not utf-8 text"):
         load_net(tmp_path / "bad.pnml")
+
+
+# NUPN (the Model Checking Contest's unit structure) ------------------------------------
+
+NUPN = """
+    <place id="a"><initialMarking><text>1</text></initialMarking></place><place id="b"/>
+    <transition id="t"/>
+    <arc id="x" source="a" target="t"/><arc id="y" source="t" target="b"/>
+    <toolspecific tool="nupn" version="1.1">
+      <size places="2" transitions="1" arcs="2"/>
+      <structure units="3" root="u0" safe="true">
+        <unit id="u0"><places/><subunits>u1 u2</subunits></unit>
+        <unit id="u1"><places>a</places><subunits/></unit>
+        <unit id="u2"><places>b</places><subunits/></unit>
+      </structure>
+    </toolspecific>"""
+
+
+def test_nupn_units_are_kept_as_meta_data_without_a_warning():
+    """NUPN is read into net.meta["nupn"], silently, and survives a PNML round trip."""
+    net, warned = read_warned(iso(NUPN))
+    assert warned == []
+    assert net.meta["nupn"] == {"version": "1.1", "root": "u0", "safe": True, "units": {
+        "u0": {"places": [], "subunits": ["u1", "u2"]},
+        "u1": {"places": ["a"], "subunits": []},
+        "u2": {"places": ["b"], "subunits": []}}}
+    again, warned = read_warned(dumps_pnml(net))
+    assert warned == [] and again.meta["nupn"] == net.meta["nupn"]
+
+
+def test_nupn_naming_unknown_places_is_one_note():
+    """Units naming places the net lacks: kept as read, one warning."""
+    net, warned = read_warned(iso(NUPN.replace("<places>b</places>", "<places>b ghost</places>")))
+    assert net.meta["nupn"]["units"]["u2"]["places"] == ["b", "ghost"]
+    assert len(warned) == 1 and "NUPN units name a place that is not in the net (e.g. 'ghost')" in warned[0]
+
+
+@pytest.mark.parametrize("case", [c for c in oracle_cases(legal_only=True) if c.id.startswith("mcc/")])
+def test_mcc_files_with_nupn_read_without_warnings(case):
+    """The MCC models of the corpus (three carry NUPN) load without a single warning."""
+    answer = json.loads((case / "answer.json").read_text())
+    net, warned = load_warned(case / answer["file"])
+    assert warned == []
+    if "nupn" in (case / answer["file"]).read_text():
+        assert net.meta["nupn"]["units"]
