@@ -10,16 +10,18 @@ One concept per module:
 * :mod:`~petriflow.agents.bidding.protocol`: the ten protocol messages, broadcasts and
   the agents' mailboxes.
 * :mod:`~petriflow.agents.bidding.agent`: the operator's, the HMIA's and a robot
-  agent's state.
+  agent's state (agent states the run keeps; the guards read them by key).
 * :mod:`~petriflow.agents.bidding.actions`: the agents' steps as actions, and the
   guards that route their work loops.
-* :mod:`~petriflow.agents.bidding.nets`: the mission as a workflow net for any team.
+* :mod:`~petriflow.agents.bidding.nets`: the mission as a workflow net for any team
+  (built with :class:`~petriflow.netbuild.NetBuilder`).
 * :mod:`~petriflow.agents.bidding.metrics`: mapping time (eq. 9), accuracy (eq. 10),
   messages.
 * :mod:`~petriflow.agents.bidding.laser`: laser returns to world points (eq. 7-8).
 * :mod:`~petriflow.agents.bidding.grid`: the interface agent's global occupancy grid
   and the map accuracy of eq. 10 against a ground truth rasterised from the world.
 * :mod:`~petriflow.agents.bidding.office`: the 32 m x 22 m office of Fig. 6 (and
-  generated ones) as a world description, with a top-view picture.
+  generated ones) as a world description, with a top-view picture; the run's office
+  plan (the ``bidding.office`` resource).
 * :mod:`~petriflow.agents.bidding.figures`: the global maps and the Fig. 10 plots.
 """

@@ -1,9 +1,12 @@
 """Seed 004's agents as actions nets bind by name, and the guards that route them.
 
-Every agent's subnet has a work loop (its state token in ``<agent>_work``) and a
-listening place (the same state in ``<agent>_listen``). ``bidding.receive`` takes one
-message from the agent's mailbox (a channel place) into its state; the work loop's
-transitions act on what arrived, each guarded by the state:
+Every agent's state (:mod:`~petriflow.agents.bidding.agent`) is kept by the run: the
+agent's create action sets it (``ctx.state``), every later action and guard of the
+agent reads it (``ctx.state``), and the tokens of its places are plain. Every agent's
+subnet has a work loop (a token in ``<agent>_work``) and a listening place (a token in
+``<agent>_listen``). ``bidding.receive`` takes one message from the agent's mailbox (a
+channel place) into its state; the work loop's transitions act on what arrived, each
+guarded by the state:
 
 ========================  ===========================================================
 ``bidding.operator``      the operator: the mission (REQUEST, then INFORM)
@@ -24,8 +27,16 @@ transitions act on what arrived, each guarded by the state:
 ========================  ===========================================================
 
 A robot that stops (a ``kill`` fault) stops answering; the HMIA notices (as a missing
-heartbeat: ``ctx.running``), and offers its unmapped zones again to the survivors (a
-re-auction, in both deployments).
+heartbeat: the run's ``core.liveness`` resource), and offers its unmapped zones again to
+the survivors (a re-auction, in both deployments). The office plan and the navigators
+planned on it are the run's ``bidding.office`` resource
+(:class:`~petriflow.agents.bidding.office.Plan`).
+
+The guards read the agent's state and say which of its keys (see
+:class:`~petriflow.agents.bidding.protocol.Mailbox`) they read, so after a firing only
+the guards whose keys changed are asked again: ``bidding.has_message`` reads
+``outbox/{peer}``, the step guards ``step``, ``bidding.idle`` and ``bidding.finished``
+``step`` and ``pending`` (:data:`GUARDS`).
 """
 
 from __future__ import annotations
@@ -38,57 +49,21 @@ import numpy as np
 from petriflow.agents.bidding.agent import Auction, Interface, Operator, RobotAgent
 from petriflow.agents.bidding.auction import best, random_deployment, tour
 from petriflow.agents.bidding.cost import AREA_M2, SPEED_M_S, Weights, bid_costs
-from petriflow.agents.bidding.protocol import Message
+from petriflow.agents.bidding.protocol import Mailbox, Message
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 
-__all__ = ["GUARDS"]
+__all__ = ["GUARDS", "OFFICE", "LIVE"]
+
+#: The run's office plan (:class:`~petriflow.agents.bidding.office.Plan`, or ``None``: the
+#: world has no ``meta.office``), as actions declare it.
+OFFICE = {"office": "bidding.office"}
+#: Which agents run now (what heartbeats tell), as actions declare it.
+LIVE = {"live": "core.liveness"}
 
 
-def _state(ctx: ActionContext, kind: type) -> Any:
-    for tokens in ctx.inputs.values():
-        for data in tokens:
-            if isinstance(data, kind):
-                return data
-    raise ActionFailure(f"{ctx.transition!r}: no {kind.__name__} state among the input tokens")
-
-
-class _Plan:
-    """A world's office plan (``meta.office``) and the navigators planned on it."""
-
-    def __init__(self, meta: dict[str, Any]) -> None:
-        from petriflow.agents.bidding.office import from_meta
-
-        self.meta = meta  # kept so its id stays this world's
-        self.office = from_meta(meta)
-        self.navigators: dict[float, Any] = {}
-
-    def navigator(self, inflate: float) -> Any:
-        if inflate not in self.navigators:
-            from petriflow.agents.mobile.navigate import Navigator
-
-            free, frame = self.office.free_grid(0.1, inflate)
-            self.navigators[inflate] = Navigator(free, frame.origin, frame.resolution)
-        return self.navigators[inflate]
-
-
-_PLANS: dict[int, _Plan] = {}
-
-
-def _plan_of(world: Any) -> _Plan | None:
-    """The world's office plan, read once per world (``None``: the world has none)."""
-    meta = (getattr(world, "meta", None) or {}).get("office")
-    if meta is None:
-        return None
-    plan = _PLANS.get(id(meta))
-    if plan is None or plan.meta is not meta:
-        if len(_PLANS) > 16:
-            _PLANS.clear()
-        plan = _PLANS[id(meta)] = _Plan(meta)
-    return plan
-
-
-def _office(world: Any) -> Any:
-    plan = _plan_of(world)
+def _office(ctx: ActionContext) -> Any:
+    """The world's office (``None``: it has none)."""
+    plan = ctx.resource("office")
     return None if plan is None else plan.office
 
 
@@ -97,6 +72,8 @@ def _office(world: Any) -> Any:
 class MakeOperator(InstantAction):
     """The operator's mission: REQUEST, then INFORM (deployment, team, zones, lists)."""
 
+    agent_state = Operator
+    resources = OFFICE
     params = {
         "hmia": Param(str, "hmia", "the interface agent"),
         "robots": Param(list, doc="the robot agents, in rank order"),
@@ -138,11 +115,11 @@ class MakeOperator(InstantAction):
                 fail("lists", f"{len(lists)} zone lists for {len(checked['robots'])} robots")
         return checked
 
-    def run(self, ctx: ActionContext) -> Operator:
+    def run(self, ctx: ActionContext) -> None:
         p = self.params
         zones = p["zones"]
         if zones is None:
-            office = _office(ctx.world)
+            office = _office(ctx)
             if office is None:
                 raise ActionFailure("bidding.operator: no zones given and the world has no meta.office")
             zones = [list(z) for z in office.zones]
@@ -163,41 +140,42 @@ class MakeOperator(InstantAction):
                     raise ActionFailure("bidding.operator: the zone lists must hold every zone number from 1 to"
                                         f" {len(zones)} once, got {[[z + 1 for z in zs] for zs in lists]}")
         mission = {"deployment": p["deployment"], "robots": robots, "zones": zones, "lists": lists}
-        operator = Operator(ctx.agent or ctx.transition, p["hmia"], mission)
+        operator = ctx.state = Operator(ctx.agent or ctx.transition, p["hmia"], mission)
         operator.queue(Message("REQUEST", operator.name, p["hmia"], body={"task": "map"}))
         operator.queue(Message("INFORM", operator.name, p["hmia"], body={
             "deployment": p["deployment"], "zones": [tuple(z) for z in zones],
             "lists": None if lists is None else [list(zs) for zs in lists], "robots": list(robots)}))
         ctx.emit("bidding.mission", deployment=p["deployment"], robots=len(robots), zones=len(zones),
                  lists=None if lists is None else [[z + 1 for z in zs] for zs in lists])
-        return operator
 
 
 class MakeInterface(InstantAction):
     """The HMIA's state, with an empty global map over the world's office."""
 
+    agent_state = Interface
+    resources = OFFICE
     params = {"resolution": Param(float, 0.1, "global map cell (m)", low=1e-9)}
 
-    def run(self, ctx: ActionContext) -> Interface:
-        hmia = Interface(ctx.agent or ctx.transition)
-        office = _office(ctx.world)
+    def run(self, ctx: ActionContext) -> None:
+        hmia = ctx.state = Interface(ctx.agent or ctx.transition)
+        office = _office(ctx)
         if office is not None:
             from petriflow.agents.bidding.grid import GlobalMap
 
             truth = office.truth(self.params["resolution"])
             hmia.truth = truth
             hmia.global_map = GlobalMap(truth)
-        return hmia
 
 
 class MakeRobot(InstantAction):
     """An RA's state (it waits for INITIALIZE)."""
 
+    agent_state = RobotAgent
     params = {"rank": Param(int, 0, "the robot's rank in the team (ties go to the smallest)"),
               "hmia": Param(str, "hmia", "the interface agent")}
 
-    def run(self, ctx: ActionContext) -> RobotAgent:
-        return RobotAgent(ctx.agent or ctx.transition, self.params["rank"], self.params["hmia"])
+    def run(self, ctx: ActionContext) -> None:
+        ctx.state = RobotAgent(ctx.agent or ctx.transition, self.params["rank"], self.params["hmia"])
 
 
 # Receiving -------------------------------------------------------------------------------
@@ -205,10 +183,12 @@ class MakeRobot(InstantAction):
 class Receive(InstantAction):
     """One message from the agent's mailbox into its state."""
 
-    params = {"box": Param(str, doc="the mailbox (channel place)", places=""), "state": Param(str, doc="the listening place", places="")}
+    agent_state = (Interface, RobotAgent)
+    resources = LIVE
+    params = {"box": Param(str, doc="the mailbox (channel place)", places="")}
 
     def run(self, ctx: ActionContext) -> None:
-        state = ctx.inputs[self.params["state"]][0]
+        state = ctx.state
         packet = ctx.inputs[self.params["box"]][0]
         message = packet.get("message") if isinstance(packet, dict) else None
         if not isinstance(message, Message):
@@ -219,8 +199,7 @@ class Receive(InstantAction):
             _hmia_receive(ctx, state, message)
         elif isinstance(state, RobotAgent):
             _robot_receive(ctx, state, message)
-        ctx.put(self.params["state"], state)
-        return None
+        state.changed()
 
 
 def _hmia_receive(ctx: ActionContext, hmia: Interface, message: Message) -> None:
@@ -233,7 +212,8 @@ def _hmia_receive(ctx: ActionContext, hmia: Interface, message: Message) -> None
         hmia.robots = list(body["robots"])
         hmia.zones = [tuple(z) for z in body["zones"]]
         hmia.lists = body["lists"]
-        hmia.alive = {r for r in hmia.robots if ctx.running(r)}
+        live = ctx.resource("live")
+        hmia.alive = {r for r in hmia.robots if live.alive(r)}
         hmia.requested = True
     elif kind == "INITIALIZED":
         hmia.initialised.add(message.sender)
@@ -272,7 +252,7 @@ def _robot_receive(ctx: ActionContext, ra: RobotAgent, message: Message) -> None
     elif kind == "PROPOSE":
         for auction in ra.auctions:
             if auction.zone == message.zone:
-                auction.proposals[message.sender] = float(body["cost"])
+                auction.propose(message.sender, float(body["cost"]), ra.name, ra.alive)
                 ra.ranks[message.sender] = int(body["rank"])
     elif kind == "MAP":
         ra.mapping = True
@@ -295,8 +275,9 @@ def _hmia_alive(ctx: ActionContext, hmia: Interface) -> None:
         hmia.to_offer.appendleft(hmia.auction)
         hmia.auction = None
         ctx.emit("bidding.reoffer", zone=hmia.to_offer[0] + 1)
+    live = ctx.resource("live")
     for robot in sorted(hmia.alive):
-        if ctx.running(robot):
+        if live.alive(robot):
             continue
         hmia.alive.discard(robot)
         hmia.drop(robot)
@@ -311,11 +292,26 @@ def _hmia_alive(ctx: ActionContext, hmia: Interface) -> None:
         ctx.emit("bidding.breakdown", robot=robot, reoffered=[z + 1 for z in lost])
 
 
-class Team(InstantAction):
+class _HmiaStep(InstantAction):
+    """A step of the HMIA's work loop: :meth:`step` changes its state, which then says
+    its next step may have changed."""
+
+    agent_state = Interface
+    resources = LIVE
+
+    def run(self, ctx: ActionContext) -> None:
+        hmia = ctx.state
+        self.step(ctx, hmia)
+        hmia.changed()
+
+    def step(self, ctx: ActionContext, hmia: Interface) -> None:
+        raise NotImplementedError
+
+
+class Team(_HmiaStep):
     """HMIA: create the team: INITIALIZE (with its start pose) to every RA."""
 
-    def run(self, ctx: ActionContext) -> Interface:
-        hmia = _state(ctx, Interface)
+    def step(self, ctx: ActionContext, hmia: Interface) -> None:
         world = ctx.world
         if world is not None:  # robots of the world that are not in the team are not deployed
             for agent in [a for a in world.agents if a.startswith("robot") and a not in hmia.robots]:
@@ -327,14 +323,12 @@ class Team(InstantAction):
         hmia.initialise_sent = True
         if hmia.mode == "autonomous":
             hmia.to_offer.extend(range(len(hmia.zones)))
-        return hmia
 
 
-class Inform(InstantAction):
+class Inform(_HmiaStep):
     """HMIA, random deployment: every RA's zone list (INFORM)."""
 
-    def run(self, ctx: ActionContext) -> Interface:
-        hmia = _state(ctx, Interface)
+    def step(self, ctx: ActionContext, hmia: Interface) -> None:
         _hmia_alive(ctx, hmia)
         for robot, zones in zip(hmia.robots, hmia.lists or []):
             for zone in zones:
@@ -347,45 +341,39 @@ class Inform(InstantAction):
             if hmia.owner.get(zone) not in hmia.alive and zone not in hmia.to_offer:
                 hmia.owner.pop(zone, None)
                 hmia.to_offer.append(zone)
-        return hmia
 
 
-class Offer(InstantAction):
+class Offer(_HmiaStep):
     """HMIA: a call for proposals for the next zone to every living RA (CFP)."""
 
-    def run(self, ctx: ActionContext) -> Interface:
-        hmia = _state(ctx, Interface)
+    def step(self, ctx: ActionContext, hmia: Interface) -> None:
         _hmia_alive(ctx, hmia)
         if not hmia.to_offer or not hmia.alive:
-            return hmia
+            return
         zone = hmia.to_offer.popleft()
         hmia.auction = zone
         hmia.auction_at = ctx.now
         bidders = [r for r in hmia.robots if r in hmia.alive]
         hmia.broadcast("CFP", hmia.name, bidders, zone, {"position": hmia.zones[zone], "bidders": bidders})
         ctx.emit("bidding.cfp", zone=zone + 1, bidders=len(bidders))
-        return hmia
 
 
-class StartMapping(InstantAction):
+class StartMapping(_HmiaStep):
     """HMIA: every zone has an owner: MAP to every living RA (mapping starts)."""
 
-    def run(self, ctx: ActionContext) -> Interface:
-        hmia = _state(ctx, Interface)
+    def step(self, ctx: ActionContext, hmia: Interface) -> None:
         hmia.broadcast("MAP", hmia.name, [r for r in hmia.robots if r in hmia.alive])
         hmia.map_sent = ctx.now
         ctx.emit("bidding.map", owners={str(z + 1): r for z, r in sorted(hmia.owner.items())})
-        return hmia
 
 
-class End(InstantAction):
+class End(_HmiaStep):
     """HMIA: every zone is mapped: END to every living RA; the map's accuracy (eq. 10)."""
 
     params = {"tolerance": Param(int, 1, "cells between a mapped point and a real obstacle that still count"
                                  " as real (eq. 10's sigma)", low=0)}
 
-    def run(self, ctx: ActionContext) -> Interface:
-        hmia = _state(ctx, Interface)
+    def step(self, ctx: ActionContext, hmia: Interface) -> None:
         _hmia_alive(ctx, hmia)
         hmia.broadcast("END", hmia.name, [r for r in hmia.robots if r in hmia.alive])
         hmia.end_sent = ctx.now
@@ -397,21 +385,35 @@ class End(InstantAction):
             report.update(accuracy_pct=round(score.percent, 4), sigma=int(score.sigma), xi=int(score.xi),
                           coverage=round(score.coverage, 4))
         ctx.emit("bidding.end", **report)
-        return hmia
 
 
 # Robot agents ----------------------------------------------------------------------------
 
-class Ready(InstantAction):
+class _RobotStep(InstantAction):
+    """A step of an RA's work loop: :meth:`step` changes its state, which then says its
+    next step may have changed."""
+
+    agent_state = RobotAgent
+
+    def run(self, ctx: ActionContext) -> None:
+        ra = ctx.state
+        self.step(ctx, ra)
+        ra.changed()
+
+    def step(self, ctx: ActionContext, ra: RobotAgent) -> None:
+        raise NotImplementedError
+
+
+class Ready(_RobotStep):
     """RA, on INITIALIZE: take its pose and laser; INITIALIZED back."""
 
+    resources = LIVE
     params = {"radius": Param(float, 0.1, "wheel radius (m)", low=1e-9),
               "ppr": Param(int, 500, "encoder pulses per turn", low=1),
               "track": Param(float, 0.33, "wheel track (m)", low=1e-9)}
     requires = frozenset({"world"})
 
-    def run(self, ctx: ActionContext) -> RobotAgent:
-        ra = _state(ctx, RobotAgent)
+    def step(self, ctx: ActionContext, ra: RobotAgent) -> None:
         if ctx.world is None:
             raise ActionFailure("bidding.ready: a robot agent needs a world")
         from petriflow.agents.mobile.kinematic import KinematicRobot
@@ -427,12 +429,12 @@ class Ready(InstantAction):
         x, y, yaw = ra.robot.pose
         ra.queue(Message("INITIALIZED", ra.name, ra.hmia, body={"pose": (x, y, yaw)}))
         ctx.emit("bidding.ready", pose=[round(x, 3), round(y, 3), round(yaw, 4)])
-        return ra
 
 
-class Bid(InstantAction):
+class Bid(_RobotStep):
     """RA, on CFP: its cost for the zone by eq. 6, to every other bidder (PROPOSE)."""
 
+    resources = OFFICE
     params = {
         "speed": Param(float, SPEED_M_S, "the speed turning distance into travel time P_ij (m/s)",
                        low=1e-9),
@@ -443,8 +445,7 @@ class Bid(InstantAction):
         "area": Param((float, type(None)), None, "L x W (m^2); default: the world's office, else 32 x 22"),
     }
 
-    def run(self, ctx: ActionContext) -> RobotAgent:
-        ra = _state(ctx, RobotAgent)
+    def step(self, ctx: ActionContext, ra: RobotAgent) -> None:
         auction = ra.auction()
         if auction is None:
             raise ActionFailure("bidding.bid: no call for proposals")
@@ -455,7 +456,7 @@ class Bid(InstantAction):
         weights = Weights(p["alpha"], p["beta"], p["gamma"])
         area = p["area"]
         if area is None:
-            office = _office(ctx.world)
+            office = _office(ctx)
             area = office.size[0] * office.size[1] if office is not None else AREA_M2
         cost = float(bid_costs([[travel]], [held], [p["accuracy"]], area=area, weights=weights)[0, 0])
         auction.own = cost
@@ -463,15 +464,13 @@ class Bid(InstantAction):
         if others:
             ra.broadcast("PROPOSE", ra.name, others, auction.zone, {"cost": cost, "rank": ra.rank})
         ctx.emit("bidding.bid", zone=auction.zone + 1, cost=round(cost, 6), held=held)
-        return ra
 
 
-class Decide(InstantAction):
+class Decide(_RobotStep):
     """RA, every proposal in: the lowest cost wins (ties: smallest rank); the winner
     takes the zone and tells the HMIA (ALLOCATED)."""
 
-    def run(self, ctx: ActionContext) -> RobotAgent:
-        ra = _state(ctx, RobotAgent)
+    def step(self, ctx: ActionContext, ra: RobotAgent) -> None:
         auction = ra.auctions.popleft()
         names = [ra.name] + [b for b in auction.proposals if b in ra.alive or not ra.alive]
         costs = [auction.own] + [auction.proposals[b] for b in names[1:]]
@@ -482,11 +481,11 @@ class Decide(InstantAction):
                 ra.mine.append(auction.zone)
             ra.queue(Message("ALLOCATED", ra.name, ra.hmia, zone=auction.zone, body={"cost": auction.own}))
         ctx.emit("bidding.decided", zone=auction.zone + 1, won=winner_rank == ra.rank)
-        return ra
 
 
 def _robot_alive(ctx: ActionContext, ra: RobotAgent) -> None:
-    ra.alive = {r for r in ra.team if ctx.running(r)}
+    live = ctx.resource("live")
+    ra.set_alive({r for r in ra.team if live.alive(r)})
 
 
 class Explore(Action):
@@ -521,15 +520,19 @@ class Explore(Action):
         "inflate": Param(float, 0.35, "obstacle margin for path planning (m)", low=0),
     }
     needs_world = True
+    agent_state = RobotAgent
+    resources = {**OFFICE, **LIVE}
 
     def start(self, ctx: ActionContext) -> None:
-        self.ra = ra = _state(ctx, RobotAgent)
+        self.ra = ra = ctx.state
         ra.now = ctx.now
         self.left = self.params["step"]
         self.at = ctx.now
-        ctx.result = ra
         if ra.robot is None:
             raise ActionFailure("bidding.explore: the robot agent is not initialised")
+        # how far a teammate may drive between two questions of one time step (one step of
+        # its own at this speed), plus slack: the margin of the robots' positions per step
+        self._margin = 0.5 + 2.0 * self.params["speed"] * float(getattr(ctx.world, "dt", 0.1) or 0.1)
         _robot_alive(ctx, ra)
 
     def poll(self, ctx: ActionContext) -> Status:
@@ -542,6 +545,7 @@ class Explore(Action):
         self.left -= dt
         if not ra.route and ra.spin_left <= 0:
             if not self._next(ctx):
+                ra.changed()
                 return Status.OK
         if ra.spin_left > 0:
             w = self.params["turn_rate"]
@@ -562,6 +566,7 @@ class Explore(Action):
         if not ra.route and ra.spin_left <= 0 and not ra.waypoints and ra.plan:
             self._zone_done(ctx)
         if ra.pending() or self.left <= 1e-9:
+            ra.changed()
             return Status.OK
         return Status.RUNNING
 
@@ -576,18 +581,18 @@ class Explore(Action):
             listed = [z for z in ra.order if z in left]
             zone = listed[0] if listed else left[tour((x, y), [ra.zones[z] for z in left])[0]]
             ra.plan = [zone]
-            office = _office(ctx.world)
+            office = _office(ctx)
             if office is not None and self.params["visit"] == "room":
                 points = [tuple(p) for p in office.waypoints(zone)]
             else:
                 points = [ra.zones[zone]]
             ra.waypoints = [points[k] for k in tour((x, y), points)]
         goal = ra.waypoints.pop(0)
-        office = _office(ctx.world)
-        if office is None:
+        plan = ctx.resource("office")
+        if plan is None:
             ra.route = [goal]
             return True
-        route = _plan_of(ctx.world).navigator(self.params["inflate"]).route(ra.robot.pose[:2], goal)
+        route = plan.navigator(self.params["inflate"]).route(ra.robot.pose[:2], goal)
         if route is None:
             ctx.emit("bidding.unreachable", goal=[round(goal[0], 3), round(goal[1], 3)])
             return bool(ra.waypoints) or self._finish_zone(ctx)
@@ -610,7 +615,7 @@ class Explore(Action):
         """Hold while a robot of smaller rank is close ahead (no two robots wait for
         each other: ranks order them); after ``patience`` s, drive around it."""
         ra = self.ra
-        blocker = self._blocker(ctx.world)
+        blocker = self._blocker(ctx)
         if blocker is None:
             ra.held = 0.0
             return False
@@ -618,11 +623,11 @@ class Explore(Action):
         if ra.held < self.params["patience"]:
             return True
         ra.held = 0.0
-        office = _office(ctx.world)
-        if office is None or not ra.route:
+        plan = ctx.resource("office")
+        if plan is None or not ra.route:
             return False
         where = ctx.world.position(blocker)
-        navigator = _plan_of(ctx.world).navigator(self.params["inflate"])
+        navigator = plan.navigator(self.params["inflate"])
         detour = navigator.around([(where[0], where[1], self.params["clearance"])]).route(ra.robot.pose[:2],
                                                                                            ra.route[-1])
         ctx.emit("bidding.detour", around=blocker, found=detour is not None)
@@ -631,18 +636,26 @@ class Explore(Action):
             ra.passing = blocker
         return False
 
-    def _blocker(self, world: Any) -> str | None:
+    def _blocker(self, ctx: ActionContext) -> str | None:
         ra = self.ra
+        world = ctx.world
         x, y, yaw = ra.robot.pose
+        clearance = self.params["clearance"]
+        plan = ctx.resource("office")
+        # who can be that close: the team's positions read once per step (margin: a step
+        # of every robot between two questions of one step), instead of every robot's here
+        near = None if plan is None else plan.near(world, ctx.now, x, y, clearance + self._margin)
         for other in ra.alive:
             if other == ra.name or other == ra.passing or ra.ranks.get(other, ra.rank) >= ra.rank:
+                continue
+            if near is not None and other not in near:
                 continue
             where = world.position(other)
             if where is None:
                 continue
             dx, dy = where[0] - x, where[1] - y
             distance = math.hypot(dx, dy)
-            if distance < self.params["clearance"]:
+            if distance < clearance:
                 bearing = math.atan2(dy, dx) - yaw
                 if math.cos(bearing) > 0.3:
                     return other
@@ -675,123 +688,67 @@ class Explore(Action):
 
 
 class Send(InstantAction):
-    """Any agent: the next message waiting for ``peer`` into its mailbox."""
+    """Any agent: the next message waiting for ``peer`` into its mailbox. (Only the
+    outbox changes: the guards reading ``outbox/<peer>`` and ``pending`` are asked again,
+    not the agent's step guards.)"""
 
-    params = {"peer": Param(str, doc="the receiving agent"), "box": Param(str, doc="its mailbox (channel place)", places=""),
-              "state": Param(str, doc="the work place the state goes back to", places="")}
+    agent_state = Mailbox
+    params = {"peer": Param(str, doc="the receiving agent"),
+              "box": Param(str, doc="its mailbox (channel place)", places="")}
 
-    def run(self, ctx: ActionContext) -> Any:
-        state = ctx.inputs[self.params["state"]][0]
-        message = state.take(self.params["peer"])
+    def run(self, ctx: ActionContext) -> None:
+        message = ctx.state.take(self.params["peer"])
         if message is None:
             raise ActionFailure(f"bidding.send: nothing waits for {self.params['peer']!r}")
-        ctx.put(self.params["box"], message.token())
-        ctx.put(self.params["state"], state)
-        ctx.emit("bidding.sent", message=message.kind, to=message.receiver, bytes=message.size,
+        token = message.token()
+        ctx.put(self.params["box"], token)
+        ctx.emit("bidding.sent", message=message.kind, to=message.receiver, bytes=token["size"],
                  broadcast=message.cast)
-        return state
 
 
 class Wait(Action):
     """An agent with nothing to do: wait until something is (at most ``period`` s)."""
 
+    agent_state = (Interface, RobotAgent)
+    resources = LIVE
     params = {"period": Param(float, 1.0, "longest wait (s)", low=1e-9)}
 
     def start(self, ctx: ActionContext) -> None:
-        self.state = ctx.token()
+        self.state = ctx.state
         self.until = ctx.now + self.params["period"]
-        ctx.result = self.state
 
     def poll(self, ctx: ActionContext) -> Status:
         state = self.state
         state.now = ctx.now
         if isinstance(state, Interface):
             _hmia_alive(ctx, state)
-        elif isinstance(state, RobotAgent):
+        else:
             _robot_alive(ctx, state)
-        if ctx.world is None or ctx.now >= self.until - 1e-9 or (ctx.now > ctx.started and _busy(state)):
+        if ctx.world is None or ctx.now >= self.until - 1e-9 or (ctx.now > ctx.started and state.busy()):
+            state.changed()
             return Status.OK
         return Status.RUNNING
 
 
 # Guards ----------------------------------------------------------------------------------
-
-def _find(tokens: dict[str, list[Any]], kind: type = object) -> Any:
-    for ts in tokens.values():
-        for d in ts:
-            if d is not None and isinstance(d, kind):
-                return d
-    return None
-
-
-def _hmia_next(h: Interface) -> str | None:
-    """What the HMIA should do now, or ``None``."""
-    if h.end_sent is not None:
-        return None
-    if h.requested and not h.initialise_sent:
-        return "team"
-    if not h.initialise_sent:
-        return None
-    if not h.alive:
-        return "end" if h.map_sent is not None or h.initialised else None
-    if not (h.initialised >= h.alive):
-        return None
-    if h.mode == "random" and not h.informed:
-        return "inform"
-    if h.to_offer and h.auction is None:
-        return "cfp"
-    if h.map_sent is None and h.deployed():
-        return "map"
-    if h.done():
-        return "end"
-    return None
-
-
-def _robot_next(r: RobotAgent) -> str | None:
-    if r.ended:
-        return None
-    if r.initialise is not None and not r.initialised:
-        return "ready"
-    if r.bids_in():
-        return "decide"
-    if r.to_bid():
-        return "bid"
-    if r.mapping and (r.left() or r.route or r.spin_left > 0):
-        return "explore"
-    return None
-
-
-def _busy(state: Any) -> bool:
-    if state.pending():
-        return True
-    if isinstance(state, Interface):
-        return _hmia_next(state) is not None or state.end_sent is not None
-    if isinstance(state, RobotAgent):
-        return _robot_next(state) is not None or state.ended
-    return True
-
+# Each is f(state, params) over the agent's state, with the state keys it reads (GUARDS).
 
 def _guard(step: str):
-    def guard(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
-        state = _find(tokens, (Interface, RobotAgent))
-        if state is None:
-            return False
-        return (_hmia_next(state) if isinstance(state, Interface) else _robot_next(state)) == step
+    def guard(state: Any, params: dict[str, Any]) -> bool:
+        return isinstance(state, (Interface, RobotAgent)) and state.next_step() == step
     guard.__name__ = f"next_is_{step}"
     guard.__doc__ = f"Guard: the agent's next step is {step!r}."
     return guard
 
 
-def has_message(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+def has_message(state: Any, params: dict[str, Any]) -> bool:
     """Guard: a message waits for ``params['peer']``."""
-    state = _find(tokens, (Operator, Interface, RobotAgent))
     return state is not None and state.has_for(params["peer"])
 
 
-def finished(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+def finished(state: Any, params: dict[str, Any]) -> bool:
     """Guard: the agent's part is over (operator: sent everything; HMIA: END sent;
     RA: END received) and nothing waits to be sent."""
-    state = _find(tokens, (Operator, Interface, RobotAgent))
     if state is None or state.pending():
         return False
     if isinstance(state, Operator):
@@ -801,16 +758,17 @@ def finished(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
     return state.ended
 
 
-def idle(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
+def idle(state: Any, params: dict[str, Any]) -> bool:
     """Guard: nothing to do now (the agent waits for news)."""
-    state = _find(tokens, (Interface, RobotAgent))
-    return state is not None and not _busy(state)
+    return isinstance(state, (Interface, RobotAgent)) and not state.busy()
 
 
+#: ``{name: (guard, the state keys it reads)}``: a message for the peer; the step the
+#: state calls for; whether anything waits to be sent.
 GUARDS = {
-    "bidding.has_message": has_message,
-    "bidding.finished": finished,
-    "bidding.idle": idle,
-    **{f"bidding.next_{step}": _guard(step) for step in
+    "bidding.has_message": (has_message, ("outbox/{peer}",)),
+    "bidding.finished": (finished, ("step", "pending")),
+    "bidding.idle": (idle, ("step", "pending")),
+    **{f"bidding.next_{step}": (_guard(step), ("step",)) for step in
        ("team", "inform", "cfp", "map", "end", "ready", "bid", "decide", "explore")},
 }

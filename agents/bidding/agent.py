@@ -10,8 +10,12 @@
   (lowest cost, ties to the smallest rank) on every CFP, then maps its zones nearest
   first, sending what its laser sees.
 
-Each is a :class:`~petriflow.agents.bidding.protocol.Mailbox`; the actions of
-:mod:`~petriflow.agents.bidding.actions` change them and the guards read them.
+Each is a :class:`~petriflow.agents.bidding.protocol.Mailbox`, an agent state the run
+keeps (``ctx.state``; registered as ``bidding.operator``, ``bidding.interface`` and
+``bidding.robot``): the actions of :mod:`~petriflow.agents.bidding.actions` change
+them and the guards read them. What a guard asks costs the same whatever the team's
+size: :meth:`Interface.next_step` and :meth:`RobotAgent.next_step` read counters kept
+as messages arrive, not the team.
 """
 
 from __future__ import annotations
@@ -71,16 +75,67 @@ class Interface(Mailbox):
     def done(self) -> bool:
         return self.map_sent is not None and len(self.finished) == len(self.zones)
 
+    def next_step(self) -> str | None:
+        """What the HMIA should do now (``team``, ``inform``, ``cfp``, ``map``, ``end``), or ``None``."""
+        if self.end_sent is not None:
+            return None
+        if self.requested and not self.initialise_sent:
+            return "team"
+        if not self.initialise_sent:
+            return None
+        if not self.alive:
+            return "end" if self.map_sent is not None or self.initialised else None
+        if not (self.initialised >= self.alive):
+            return None
+        if self.mode == "random" and not self.informed:
+            return "inform"
+        if self.to_offer and self.auction is None:
+            return "cfp"
+        if self.map_sent is None and self.deployed():
+            return "map"
+        if self.done():
+            return "end"
+        return None
+
+    def busy(self) -> bool:
+        """Something to do or to send (else the HMIA waits for news)."""
+        return self.queued > 0 or self.end_sent is not None or self.next_step() is not None
+
+    def signature(self) -> tuple[str | None, bool]:
+        return self.next_step(), self.end_sent is not None
+
 
 @dataclass
 class Auction:
-    """One zone under auction, as a robot agent sees it."""
+    """One zone under auction, as a robot agent sees it.
+
+    ``missing`` counts the living bidders (other than the robot itself) whose proposal
+    has not come (``None``: to be counted again, after the team's liveness changed), so
+    whether every proposal is in costs nothing per message.
+    """
 
     zone: int
     position: tuple[float, float]
     bidders: list[str]
     own: float | None = None
     proposals: dict[str, float] = field(default_factory=dict)
+    missing: int | None = None
+    among: frozenset[str] = frozenset()
+
+    def __post_init__(self) -> None:
+        self.among = frozenset(self.bidders)
+
+    def count(self, me: str, alive: set[str]) -> int:
+        """The living bidders but ``me`` still to propose (counted once, then kept)."""
+        if self.missing is None:
+            self.missing = sum(1 for b in self.among if b != me and b in alive and b not in self.proposals)
+        return self.missing
+
+    def propose(self, sender: str, cost: float, me: str, alive: set[str]) -> None:
+        if self.missing is not None and sender not in self.proposals and sender != me and sender in alive \
+                and sender in self.among:
+            self.missing -= 1
+        self.proposals[sender] = cost
 
 
 class RobotAgent(Mailbox):
@@ -127,7 +182,37 @@ class RobotAgent(Mailbox):
         a = self.auction()
         if a is None or a.own is None:
             return False
-        return all(b in a.proposals or b == self.name or b not in self.alive for b in a.bidders)
+        return a.count(self.name, self.alive) == 0
+
+    def set_alive(self, alive: set[str]) -> None:
+        """The teammates running now (what the heartbeats say); counts of missing
+        proposals are made again when this changed."""
+        if alive != self.alive:
+            self.alive = alive
+            for auction in self.auctions:
+                auction.missing = None
+            self.changed()
 
     def left(self) -> list[int]:
         return [z for z in self.mine if z not in self.done]
+
+    def next_step(self) -> str | None:
+        """What the RA should do now (``ready``, ``decide``, ``bid``, ``explore``), or ``None``."""
+        if self.ended:
+            return None
+        if self.initialise is not None and not self.initialised:
+            return "ready"
+        if self.bids_in():
+            return "decide"
+        if self.to_bid():
+            return "bid"
+        if self.mapping and (self.route or self.spin_left > 0 or self.left()):
+            return "explore"
+        return None
+
+    def busy(self) -> bool:
+        """Something to do or to send (else the RA waits for news)."""
+        return self.queued > 0 or self.ended or self.next_step() is not None
+
+    def signature(self) -> tuple[str | None, bool]:
+        return self.next_step(), self.ended

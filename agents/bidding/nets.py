@@ -1,12 +1,14 @@
-"""Seed 004's mission as a workflow net, generated for any team size.
+"""Seed 004's mission as a workflow net, built for any team size.
 
-:func:`build` writes the net (petriflow YAML): an operator, the interface agent (HMIA)
-and ``robots`` robot agents (RAs), each a subnet. Every agent but the operator has a
-mailbox, a channel place every other agent sends into, bounded by one slot token
-(a sender takes it, the receiver gives it back), so the net is bounded and its state
-space small enough to check. The protocol is the net's structure:
+:func:`build` builds the net (a :class:`~petriflow.net.Net`, with
+:class:`~petriflow.netbuild.NetBuilder`): an operator, the interface agent (HMIA) and
+``robots`` robot agents (RAs), each an agent subnet whose state the run keeps
+(``bidding.operator``, ``bidding.interface``, ``bidding.robot``). Every agent but the
+operator has a mailbox, a channel place every other agent sends into, bounded by one
+slot token (a sender takes it, the receiver gives it back), so the net is bounded and
+its state space small enough to check. The protocol is the net's structure:
 
-* operator: ``request`` (REQUEST, INFORM), ``send``, ``finish``;
+* operator: ``request`` (REQUEST, INFORM), ``send_hmia``, ``finish``;
 * HMIA: ``create``, then a work loop of ``team`` (INITIALIZE), ``inform`` (random
   deployment), ``cfp`` (CFP, one zone at a time), ``map`` (MAP), ``end`` (END),
   ``send_<robot>`` and ``wait``; ``receive`` takes its mail;
@@ -14,18 +16,19 @@ space small enough to check. The protocol is the net's structure:
   (ALLOCATED when it won), ``explore`` (MAPPED), ``send_<peer>`` and ``wait``;
   ``receive`` takes its mail.
 
-Guards (``bidding.next_*``) pick the one step the agent's state calls for; ``begin``
-hands out the start tokens and the slots, ``end`` collects them.
+Guards (``bidding.next_*``) pick the one step the agent's state calls for; the
+envelope's ``begin`` hands out the start tokens and the slots, ``end`` collects them.
 
 Used directly by sweep files (``net: {builder: petriflow.agents.bidding.nets:build}``);
 ``python -m petriflow.agents.bidding.nets`` writes the shipped nets and worlds of
 ``nets/bidding/``.
 
 Examples:
-    >>> from petriflow.io.yaml import loads_net
-    >>> net = loads_net(build(robots=2))
-    >>> sorted(s.id for s in net.subnets.values()), sorted(p.id for p in net.places.values() if p.channel)
+    >>> net = build(robots=2)
+    >>> sorted(net.subnets), sorted(p.id for p in net.places.values() if p.channel)
     (['hmia', 'operator', 'robot1', 'robot2'], ['box_hmia', 'box_robot1', 'box_robot2'])
+    >>> net.subnets["robot1"].state, net.transitions["robot1_send_robot2"].params
+    ('bidding.robot', {'peer': 'robot2', 'box': 'box_robot2'})
 """
 
 from __future__ import annotations
@@ -36,43 +39,64 @@ from typing import Any
 
 import yaml
 
+from petriflow.net import Net
+from petriflow.netbuild import AgentBuilder, Mailbox, NetBuilder
+
 __all__ = ["build", "main"]
 
+#: Priorities of an agent's transitions: taking mail first, then ending, sending, the
+#: protocol's steps, and waiting last.
+RECEIVE, FINISH, SEND, STEP, WAIT = 6, 5, 4, 3, 0
 
-def _loop(name: str, peers: list[str], steps: list[tuple[str, str, str, dict[str, Any]]],
-          wait: float) -> tuple[list[Any], list[dict[str, Any]]]:
-    work, listen, done = f"{name}_work", f"{name}_listen", f"{name}_done"
-    places: list[Any] = [f"{name}_start", work, listen, done]
-    transitions: list[dict[str, Any]] = []
+
+def _agent(b: NetBuilder, name: str, label: str, state: str, *,
+           listens: bool = True) -> tuple[AgentBuilder, Mailbox | None]:
+    """An agent's places (start, work, listen, done) and its mailbox ``box_<name>``."""
+    agent = b.agent(name, label=label, state=state)
+    for local in ("start", "work", "listen", "done") if listens else ("start", "work", "done"):
+        agent.place(local)
+    agent.start("start")
+    if not listens:
+        agent.done("done")
+        return agent, None
+    agent.done("done", "listen")
+    return agent, b.mailbox(agent, channel="lan", id=f"box_{name}", label=f"{name}'s mailbox",
+                            slot=f"slot_{name}", slot_label=f"{name}'s mailbox is free")
+
+
+def _loop(b: NetBuilder, agent: AgentBuilder, create: tuple[str, str, dict[str, Any]],
+          steps: list[tuple[str, str, str, dict[str, Any]]], peers: list[Mailbox], wait: float) -> None:
+    """An agent's transitions: ``create`` (its state), the work loop's protocol steps,
+    a send per peer, ``wait``, ``finish``, and ``receive`` on the listening place."""
+    action, label, params = create
+    agent.transition("create", label=label, action=action, params=params or None, inputs=["start"],
+                     outputs=["work", "listen"])
     for step, action, label, params in steps:
-        t: dict[str, Any] = {"id": f"{name}_{step}", "label": label, "action": action, "guard": f"bidding.next_{step}",
-                             "priority": 3, "in": [work], "out": [work]}
-        if params:
-            t["params"] = params
-        transitions.append(t)
-    for peer in peers:
-        transitions.append({
-            "id": f"{name}_send_{peer}", "label": f"send to {peer}", "action": "bidding.send",
-            "params": {"peer": peer, "box": f"box_{peer}", "state": work}, "guard": "bidding.has_message",
-            "priority": 4, "in": [work, f"slot_{peer}"], "out": [work, f"box_{peer}"]})
-    transitions += [
-        {"id": f"{name}_wait", "label": "wait for news", "action": "bidding.wait", "params": {"period": wait},
-         "guard": "bidding.idle", "priority": 0, "in": [work], "out": [work]},
-        {"id": f"{name}_finish", "label": "mission over", "guard": "bidding.finished", "priority": 5,
-         "in": [work], "out": [done]},
-        {"id": f"{name}_receive", "label": "take a message", "action": "bidding.receive",
-         "params": {"box": f"box_{name}", "state": listen}, "priority": 6,
-         "in": [f"box_{name}", listen], "out": [listen, f"slot_{name}"]},
-    ]
-    places += [{"id": f"box_{name}", "channel": "lan", "label": f"{name}'s mailbox"},
-               {"id": f"slot_{name}", "label": f"{name}'s mailbox is free"}]
-    return places, transitions
+        agent.transition(step, label=label, action=action, params=params or None,
+                         guard=f"bidding.next_{step}", priority=STEP, inputs=["work"], outputs=["work"])
+    _sends(b, agent, peers)
+    agent.transition("wait", label="wait for news", action="bidding.wait", params={"period": wait},
+                     guard="bidding.idle", priority=WAIT, inputs=["work"], outputs=["work"])
+    agent.transition("finish", label="mission over", guard="bidding.finished", priority=FINISH,
+                     inputs=["work"], outputs=["done"])
+    b.receive(agent.transition("receive", label="take a message", action="bidding.receive",
+                               params={"box": f"box_{agent.name}"}, priority=RECEIVE, inputs=["listen"],
+                               outputs=["listen"]), f"box_{agent.name}")
+
+
+def _sends(b: NetBuilder, agent: AgentBuilder, peers: list[Mailbox]) -> None:
+    for box in peers:
+        peer = box.owner
+        b.send(agent.transition(f"send_{peer}", label=f"send to {peer}", action="bidding.send",
+                                params={"peer": peer, "box": box.id}, guard="bidding.has_message",
+                                priority=SEND, inputs=["work"], outputs=["work"]), box)
 
 
 def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[int]] | None = None,
           zones: list[list[float]] | None = None, speed: float = 0.5, scan_period: float = 1.0,
-          filter_teammates: bool = False, spin: bool = True, visit: str = "centre", wait: float = 1.0, **ignored: Any) -> str:
-    """The mission's net as petriflow YAML (see the module).
+          filter_teammates: bool = False, spin: bool = True, visit: str = "centre", wait: float = 1.0,
+          **ignored: Any) -> Net:
+    """The mission's net (see the module).
 
     Args:
         robots: robot agents in the team (1..200).
@@ -99,60 +123,35 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
         mission["lists"] = lists
     if zones is not None:
         mission["zones"] = zones
-    subnets = [{"id": "operator", "agent": "operator", "label": "the human operator",
-                "places": ["operator_start", "operator_work", "operator_done"],
-                "transitions": [
-                    {"id": "operator_request", "label": "REQUEST and INFORM", "action": "bidding.operator",
-                     "params": mission, "in": ["operator_start"], "out": ["operator_work"]},
-                    {"id": "operator_send_hmia", "label": "send to hmia", "action": "bidding.send",
-                     "params": {"peer": "hmia", "box": "box_hmia", "state": "operator_work"},
-                     "guard": "bidding.has_message", "priority": 4,
-                     "in": ["operator_work", "slot_hmia"], "out": ["operator_work", "box_hmia"]},
-                    {"id": "operator_finish", "label": "mission sent", "guard": "bidding.finished", "priority": 5,
-                     "in": ["operator_work"], "out": ["operator_done"]}]}]
-    places, transitions = _loop("hmia", team, [
+    b = NetBuilder(f"bidding-{deployment}-{robots}", label=f"seed 004 collaborative mapping: {robots}"
+                   f" robot{'s' if robots > 1 else ''}, {deployment} deployment")
+    operator, _ = _agent(b, "operator", "the human operator", "bidding.operator", listens=False)
+    hmia, hmia_box = _agent(b, "hmia", "human/machine interface agent", "bidding.interface")
+    ras = [_agent(b, name, f"robot agent {name}", "bidding.robot") for name in team]
+    boxes = {box.owner: box for box in [hmia_box] + [box for _, box in ras]}
+    operator.transition("request", label="REQUEST and INFORM", action="bidding.operator", params=mission,
+                        inputs=["start"], outputs=["work"])
+    _sends(b, operator, [boxes["hmia"]])
+    operator.transition("finish", label="mission sent", guard="bidding.finished", priority=FINISH,
+                        inputs=["work"], outputs=["done"])
+    _loop(b, hmia, ("bidding.interface", "the interface agent", {}), [
         ("team", "bidding.team", "INITIALIZE the team", {}),
         ("inform", "bidding.inform", "random deployment: INFORM zone lists", {}),
         ("cfp", "bidding.cfp", "CFP: offer the next zone", {}),
         ("map", "bidding.map", "MAP: start mapping", {}),
         ("end", "bidding.end", "END: every zone mapped", {}),
-    ], wait)
-    transitions.insert(0, {"id": "hmia_create", "label": "the interface agent", "action": "bidding.interface",
-                           "in": ["hmia_start"], "out": ["hmia_work", "hmia_listen"]})
-    subnets.append({"id": "hmia", "agent": "hmia", "label": "human/machine interface agent",
-                    "places": places, "transitions": transitions})
+    ], [boxes[name] for name in team], wait)
     explore = {"speed": speed, "scan_period": scan_period, "filter_teammates": filter_teammates, "spin": spin,
                "visit": visit}
-    for rank, name in enumerate(team):
-        places, transitions = _loop(name, ["hmia"] + [r for r in team if r != name], [
+    for rank, (ra, _) in enumerate(ras):
+        _loop(b, ra, ("bidding.robot", "robot agent", {"rank": rank}), [
             ("ready", "bidding.ready", "INITIALIZED: laser and pose", {}),
             ("bid", "bidding.bid", "PROPOSE: eq. 6 cost", {"speed": speed}),
             ("decide", "bidding.decide", "best proposal; ALLOCATED if won", {}),
             ("explore", "bidding.explore", "map the zones: MAPPED", explore),
-        ], wait)
-        transitions.insert(0, {"id": f"{name}_create", "label": "robot agent", "action": "bidding.robot",
-                               "params": {"rank": rank}, "in": [f"{name}_start"],
-                               "out": [f"{name}_work", f"{name}_listen"]})
-        subnets.append({"id": name, "agent": name, "label": f"robot agent {name}", "places": places,
-                        "transitions": transitions})
-    agents = ["operator", "hmia"] + team
-    mailboxes = ["hmia"] + team
-    net = {
-        "petriflow": 1,
-        "net": f"bidding-{deployment}-{robots}",
-        "label": f"seed 004 collaborative mapping: {robots} robot{'s' if robots > 1 else ''}, {deployment} deployment",
-        "subnets": subnets,
-        "places": [{"id": "i", "tokens": 1}, "o"],
-        "transitions": [
-            {"id": "begin", "label": "REQUEST from the operator",
-             "in": ["i"], "out": [f"{a}_start" for a in agents] + [f"slot_{m}" for m in mailboxes]},
-            {"id": "end", "label": "mission over",
-             "in": [f"{a}_done" for a in agents] + [f"{a}_listen" for a in agents if a != "operator"]
-             + [f"slot_{m}" for m in mailboxes], "out": ["o"]},
-        ],
-        "final": {"o": 1},
-    }
-    return yaml.safe_dump(net, sort_keys=False, width=120)
+        ], [boxes[name] for name in ["hmia"] + team if name != ra.name], wait)
+    b.envelope(begin_label="REQUEST from the operator", end_label="mission over")
+    return b.build()
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -161,6 +160,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", default="nets/bidding")
     args = parser.parse_args(argv)
     from petriflow.agents.bidding.office import draw, generated_office, paper_office
+    from petriflow.io.yaml import dumps_net
 
     out = Path(args.out)
     office = paper_office()
@@ -177,12 +177,14 @@ def main(argv: list[str] | None = None) -> None:
     draw(big, out / "world-20.png", title="generated office: 20 rooms, 20 robots", robots=20)
     for robots in range(1, 6):
         for deployment in ("autonomous", "random"):
-            name = f"bidding-{deployment}-{robots}.yaml"
-            (out / name).write_text("# Generated by python -m petriflow.agents.bidding.nets; the run configuration"
-                                    f" is run.yaml.\nrun: run.yaml\n{build(robots, deployment)}")
-    (out / "bidding-autonomous-20.yaml").write_text(
-        "# Generated by python -m petriflow.agents.bidding.nets: 20 robots in the generated office.\n"
-        f"run: run-20.yaml\n{build(20, 'autonomous')}")
+            net = build(robots, deployment)
+            net.run = "run.yaml"
+            (out / f"{net.id}.yaml").write_text("# Generated by python -m petriflow.agents.bidding.nets; the"
+                                                f" run configuration is run.yaml.\n{dumps_net(net)}")
+    net = build(20, "autonomous")
+    net.run = "run-20.yaml"
+    (out / f"{net.id}.yaml").write_text("# Generated by python -m petriflow.agents.bidding.nets: 20 robots in"
+                                        f" the generated office.\n{dumps_net(net)}")
     print(f"wrote the worlds and nets under {out}")
 
 

@@ -61,6 +61,8 @@ __all__ = [
     "paper_office",
     "generated_office",
     "from_meta",
+    "Plan",
+    "plan_resource",
     "robot_colour",
     "draw_boxes",
     "draw",
@@ -322,6 +324,72 @@ def from_meta(meta: dict[str, Any]) -> Office:
         )
     except (KeyError, TypeError) as exc:
         raise BiddingError(f"meta.office is not an office description: {exc!r}") from None
+
+
+class Plan:
+    """A run's office plan and the navigators planned on it: the ``bidding.office``
+    resource (one per run, made from the run's world by :func:`plan_resource`), so the
+    free-space grids the robots plan on are built once per run and obstacle margin, not
+    once per robot; and where the robots stood at the current time step (:meth:`near`),
+    read once per step for the whole team.
+
+    Attributes:
+        office: the :class:`Office` of the world's ``meta.office``.
+    """
+
+    #: Side (m) of the cells :meth:`near` buckets the robots' positions in.
+    CELL = 2.0
+
+    def __init__(self, office: Office) -> None:
+        self.office = office
+        self._navigators: dict[float, Any] = {}
+        self._seen_at: float | None = None
+        self._cells: dict[tuple[int, int], list[str]] = {}
+
+    def near(self, world: Any, now: float, x: float, y: float, radius: float) -> set[str]:
+        """The agents whose robots stood within ``radius`` m of ``(x, y)`` (a box test:
+        a superset of the disc) at the time step ``now``, as the world's positions were
+        read at the first question of that step (every robot's, once per step, not once
+        per robot asking). Robots move between two questions of one step by at most one
+        step of their own, so a ``radius`` with that margin misses nobody."""
+        if self._seen_at != now:
+            self._seen_at = now
+            self._cells = cells = {}
+            for agent in world.agents:
+                where = world.position(agent)
+                if where is not None:
+                    cells.setdefault((math.floor(where[0] / self.CELL), math.floor(where[1] / self.CELL)),
+                                     []).append(agent)
+        reach = math.ceil(radius / self.CELL)
+        cx, cy = math.floor(x / self.CELL), math.floor(y / self.CELL)
+        found: set[str] = set()
+        for i in range(cx - reach, cx + reach + 1):
+            for j in range(cy - reach, cy + reach + 1):
+                found.update(self._cells.get((i, j), ()))
+        return found
+
+    def navigator(self, inflate: float) -> Any:
+        """The :class:`~petriflow.agents.mobile.navigate.Navigator` on the free space with
+        obstacles grown by ``inflate`` m (made on first use)."""
+        navigator = self._navigators.get(inflate)
+        if navigator is None:
+            from petriflow.agents.mobile.navigate import Navigator
+
+            free, frame = self.office.free_grid(0.1, inflate)
+            navigator = self._navigators[inflate] = Navigator(free, frame.origin, frame.resolution)
+        return navigator
+
+
+def plan_resource(context: Any) -> Plan | None:
+    """The ``bidding.office`` resource of a run: the :class:`Plan` of its world's
+    ``meta.office`` (``None``: no world, or a world without an office; the actions then
+    need their zones given).
+
+    Raises:
+        BiddingError: ``meta.office`` is not an office description.
+    """
+    meta = (getattr(context.world, "meta", None) or {}).get("office")
+    return None if meta is None else Plan(from_meta(meta))
 
 
 # Building offices ---------------------------------------------------------------------

@@ -1,5 +1,8 @@
-"""Registers seed 004's agents (the ``petriflow.actions`` entry point): actions, guards
-and the mission's metrics."""
+"""Registers seed 004's agents (the ``petriflow.actions`` entry point): actions, the
+agent-state types subnets declare (``bidding.operator``, ``bidding.interface``,
+``bidding.robot``), guards over those states with the keys each reads, the
+``bidding.office`` resource (the run's office plan and navigators, made once per run
+from its world) and the mission's metrics."""
 
 from __future__ import annotations
 
@@ -28,9 +31,14 @@ ACTIONS = {
 def register(registry) -> None:
     from petriflow.agents.bidding import metrics
     from petriflow.agents.bidding.actions import GUARDS
+    from petriflow.agents.bidding.agent import Interface, Operator, RobotAgent
 
     for name, (target, doc) in ACTIONS.items():
         registry.register(name, target, doc=doc)
-    for name, function in GUARDS.items():
-        registry.predicate(name)(function)
+    for name, cls in (("bidding.operator", Operator), ("bidding.interface", Interface),
+                      ("bidding.robot", RobotAgent)):
+        registry.register_state(name, cls)
+    for name, (function, reads) in GUARDS.items():
+        registry.predicate(name, reads=reads)(function)
+    registry.register_resource("bidding.office", "petriflow.agents.bidding.office:plan_resource")
     metrics.register(registry)

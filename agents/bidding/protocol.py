@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from petriflow.agents.bidding.errors import BiddingError
+from petriflow.runtime.agents import AgentState
 
 __all__ = ["KINDS", "Mailbox", "Message"]
 
@@ -80,14 +81,31 @@ class Message:
         return {"kind": self.kind, "size": self.size, "message": self}
 
 
-class Mailbox:
-    """Messages waiting to be sent, per receiver (oldest first), and those received."""
+class Mailbox(AgentState):
+    """Messages waiting to be sent, per receiver (oldest first), and those received.
+
+    The base of an agent's state (:class:`~petriflow.runtime.agents.AgentState`, kept
+    by the run, never a token). It says what changed, so guards are asked again only
+    when what they read did:
+
+    * ``outbox/<peer>``: a message for ``peer`` was queued, sent or dropped (the guard of
+      the send transition to that peer, ``bidding.has_message``, reads it);
+    * ``pending``: the outbox went from empty to not, or back (:meth:`pending`, which
+      costs nothing whatever the team's size: the messages waiting are counted);
+    * ``step``: the step the agent's state calls for, or whether its part is over,
+      changed (:meth:`changed`, which the agents' actions call when they end, compares
+      :meth:`signature` with what it was: a message that changes neither, a proposal
+      among many, asks no guard again).
+    """
 
     def __init__(self) -> None:
+        super().__init__()
         self.casts = 0
         self.outbox: dict[str, deque[Message]] = {}
+        self.queued = 0  # messages in the outbox, all peers together
         self.sent: dict[str, int] = {}
         self.received: dict[str, int] = {}
+        self._signature: Any = None
 
     def to_token(self) -> dict[str, Any]:
         """What a trace records of an agent's state: who it is and its message counts."""
@@ -95,7 +113,15 @@ class Mailbox:
                 "sent": sum(self.sent.values()), "received": sum(self.received.values())}
 
     def queue(self, message: Message) -> None:
-        self.outbox.setdefault(message.receiver, deque()).append(message)
+        box = self.outbox.get(message.receiver)
+        if box is None:
+            box = self.outbox[message.receiver] = deque()
+        box.append(message)
+        self.queued += 1
+        if self.queued == 1:
+            self.touch("outbox/" + message.receiver, "pending")
+        else:
+            self.touch("outbox/" + message.receiver)
 
     def broadcast(self, kind: str, sender: str, receivers: list[str], zone: int | None = None,
                   body: dict[str, Any] | None = None) -> None:
@@ -109,17 +135,46 @@ class Mailbox:
         return bool(box)
 
     def pending(self) -> bool:
-        return any(self.outbox.values())
+        return self.queued > 0
 
     def take(self, peer: str) -> Message | None:
         box = self.outbox.get(peer)
         if not box:
             return None
         message = box.popleft()
+        self.queued -= 1
         self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
+        if self.queued == 0:
+            self.touch("outbox/" + peer, "pending")
+        else:
+            self.touch("outbox/" + peer)
         return message
 
     def drop(self, peer: str) -> int:
         """Forget what waits for ``peer`` (it stopped); how many were dropped."""
         box = self.outbox.pop(peer, None)
-        return len(box) if box else 0
+        if not box:
+            return 0
+        self.queued -= len(box)
+        if self.queued == 0:
+            self.touch("outbox/" + peer, "pending")
+        else:
+            self.touch("outbox/" + peer)
+        return len(box)
+
+    def signature(self) -> Any:
+        """What the agent's step guards answer by (subclasses: the next step, whether
+        the agent's part is over)."""
+        return None
+
+    def changed(self) -> None:
+        """The state may have changed: touch ``step`` if its :meth:`signature` did."""
+        signature = self.signature()
+        if signature != self._signature:
+            self._signature = signature
+            self.touch("step")
+
+    def clear(self) -> None:
+        """Forget every message waiting (a test's reset)."""
+        for peer in list(self.outbox):
+            self.drop(peer)

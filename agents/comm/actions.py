@@ -4,15 +4,16 @@ Start-up, in order (seed 000 §3.2), each a transition of every agent's subnet:
 
 * ``comm.characterise`` (process 1): the robot's wheels and encoders give ``dpp``
   (eq. 2); its start on the odometry grid ``pg`` (eq. 3) is reported. Makes the
-  agent's state (:class:`~petriflow.agents.comm.agent.CommAgent`), the token data of
-  its subnet from then on.
+  agent's state (:class:`~petriflow.agents.comm.agent.CommAgent`, ``ctx.state``), which
+  the run keeps and every later action and guard of the agent reads (the subnet
+  declares ``state: comm.agent``); tokens carry no data.
 * ``comm.analyse`` (process 2): the Fig. 5 sweep on the radio model of one of its
   channel places: the distance up to which nothing is lost behind a wall, and the RSSI
   threshold it will use.
 * ``comm.initialise`` (process 3): its address by eq. 4 (or, for a late joiner, the
   first free address of a peer's DHCP pool, eq. 5).
-* ``comm.history`` (process 4): empty ``Ad`` and ``Ah``; puts the state into the
-  agent's work loop and its listening place.
+* ``comm.history`` (process 4): empty ``Ad`` and ``Ah``; marks the agent's work loop
+  and its listening place.
 
 Then the task, as a loop per agent: ``comm.explore`` (a robot moves to the next cell,
 senses its walls with four distance rays, adds a vertex, and plans what to send with
@@ -20,8 +21,15 @@ Algorithm 1 for each peer it hears above the threshold) or ``comm.listen`` (a st
 agent: a monitor or the central unit, waits ``period`` s and plans); ``comm.send`` puts
 one waiting message into the channel place towards a peer (process 5: a token sized in
 bytes); ``comm.receive`` takes one from a channel place into the agent's history.
-Guards route the loop: ``comm.has_message`` (for the transition's ``peer``),
-``comm.going_on`` and ``comm.finished``.
+Guards route the loop: ``comm.has_message`` (for the transition's ``peer``; it reads
+the state key ``outbox/{peer}``, so it is asked again only when that peer's queue or
+hearing changed), ``comm.going_on`` and ``comm.finished`` (they read the whole state,
+``*``: asked again after each firing of the agent).
+
+Whether a peer runs (what its radio beacon tells) comes from the run's
+``core.liveness`` resource; every place an action names is a declared parameter
+(``Param(..., places=...)``), the peers' boxes inside ``comm.initialise``'s mapping
+included, so a misspelt place fails when the net is loaded, naming its file and line.
 """
 
 from __future__ import annotations
@@ -34,6 +42,7 @@ from petriflow.agents.comm.framework import History, addresses, dhcp_pools, dpp,
 from petriflow.agents.comm.radio import RadioChannel, pick_threshold, threshold_sweep
 
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
+from petriflow.runtime.resources import LIVENESS, Liveness
 
 __all__ = [
     "GUARDS",
@@ -48,15 +57,10 @@ __all__ = [
 ]
 
 
-def _state(ctx: ActionContext) -> CommAgent:
-    state = ctx.token()
-    if not isinstance(state, CommAgent):
-        raise ActionFailure(f"{ctx.transition!r}: the input token carries no agent state (got {type(state).__name__})")
-    return state
-
-
 class Characterise(InstantAction):
     """Process 1: make the agent's state; a robot's dpp (eq. 2) and start on the grid (eq. 3)."""
+
+    agent_state = CommAgent
 
     params = {
         "kind": Param(str, "robot", "robot, monitor or central", choices=("robot", "monitor", "central")),
@@ -73,7 +77,7 @@ class Characterise(InstantAction):
     def requirements(cls, params: dict[str, Any]) -> frozenset[str]:
         return frozenset({"world"}) if params["kind"] == "robot" else frozenset()
 
-    def run(self, ctx: ActionContext) -> CommAgent:
+    def run(self, ctx: ActionContext) -> None:
         p = self.params
         agent = ctx.agent or ctx.transition
         state = CommAgent(agent, p["kind"], cell=p["cell"], origin=tuple(p["origin"]), cols=p["cols"],
@@ -92,7 +96,7 @@ class Characterise(InstantAction):
             report.update(dpp_mm=round(step * 1000, 4), grid=list(grid_size(tuple(p["area"]), [step])),
                           pg=list(grid_position((x - state.origin[0], y - state.origin[1]), step)))
         ctx.emit("comm.characterised", **report)
-        return state
+        ctx.state = state
 
     @staticmethod
     def _cell(state: CommAgent, x: float, y: float) -> tuple[int, int]:
@@ -108,8 +112,7 @@ class Analyse(InstantAction):
         "trials": Param(int, 100, "frames per distance", low=1),
     }
 
-    def run(self, ctx: ActionContext) -> CommAgent:
-        state = _state(ctx)
+    def run(self, ctx: ActionContext) -> None:
         model, _ = ctx.link(self.params["channel_place"])
         if isinstance(model, RadioChannel):
             rows = threshold_sweep(model, range(1, self.params["distances"] + 1), walls=1,
@@ -117,11 +120,12 @@ class Analyse(InstantAction):
             distance, level = pick_threshold(rows)
             ctx.emit("comm.analysed", lossless_behind_wall_m=distance, rssi_there_dbm=level,
                      threshold_dbm=model.threshold_dbm, range_m=round(model.range(), 3))
-        return state
 
 
 class Initialise(InstantAction):
     """Process 3: the agent's address (eq. 4), or one from a peer's DHCP pool (eq. 5)."""
+
+    agent_state = CommAgent
 
     params = {
         "index": Param(int, 0, "this agent's index i among the initial agents", low=0),
@@ -132,8 +136,8 @@ class Initialise(InstantAction):
         "peers": Param(dict, {}, "peer agent -> {address: A, box: channel place towards it}", places="*.box"),
     }
 
-    def run(self, ctx: ActionContext) -> CommAgent:
-        state = _state(ctx)
+    def run(self, ctx: ActionContext) -> None:
+        state = ctx.state
         p = self.params
         team = addresses(p["agents"], p["available"])
         if p["address"] is not None:
@@ -148,31 +152,42 @@ class Initialise(InstantAction):
         for name, peer in p["peers"].items():
             state.peers[name] = Peer(name, int(peer["address"]), str(peer["box"]))
         ctx.emit("comm.initialised", address=f"192.168.1.{state.address}")
-        return state
 
 
 class MakeHistory(InstantAction):
     """Process 4: the empty data and history arrays."""
 
-    def run(self, ctx: ActionContext) -> CommAgent:
-        state = _state(ctx)
+    agent_state = CommAgent
+
+    def run(self, ctx: ActionContext) -> None:
+        state = ctx.state
         state.history = History(state.address)
         state.last_news = state.since = ctx.now  # a late joiner waits for news from when it joined
-        return state
 
 
-def _plan(ctx: ActionContext, state: CommAgent) -> None:
-    """Algorithm 1 towards every peer heard above the threshold now."""
+def _plan(ctx: ActionContext, state: CommAgent, links: dict[str, Any]) -> None:
+    """Algorithm 1 towards every peer heard above the threshold now.
+
+    ``links`` keeps, per channel place, the model carrying it (the same for the whole
+    run); the agents' positions are read once per plan (nothing moves during it)."""
     state.now = ctx.now
-    state.in_range = set()
-    for peer in state.peers.values():
-        if not ctx.running(peer.name):  # no beacon: switched off, not joined yet, or dead
-            continue
-        model, _ = ctx.link(peer.box)
-        usable = model.usable(state.name, peer.name) if isinstance(model, RadioChannel) else True
+    live: Liveness = ctx.resource("live")
+    peers = [peer for peer in state.peers.values() if live.alive(peer.name)]  # the others: no beacon
+    world = ctx.world
+    positions = None
+    if peers and world is not None and hasattr(world, "position"):
+        positions = {state.name: world.position(state.name)}
+        positions.update((peer.name, world.position(peer.name)) for peer in peers)
+    heard = set()
+    for peer in peers:
+        model = links.get(peer.box)
+        if model is None:
+            model = links[peer.box] = ctx.link(peer.box)[0]
+        usable = model.usable(state.name, peer.name, positions) if isinstance(model, RadioChannel) else True
         if usable:
-            state.in_range.add(peer.name)
+            heard.add(peer.name)
             state.plan_for(peer)
+    state.hear(heard)
 
 
 class Explore(Action):
@@ -196,16 +211,29 @@ class Explore(Action):
                          " moving for good, its radio goes on"),
     }
     needs_world = True
+    agent_state = CommAgent
+    resources = {"live": LIVENESS}
+
+    def setup(self, world: Any) -> None:
+        self.links: dict[str, Any] = {}  # channel place -> the model carrying it (see _plan)
 
     def start(self, ctx: ActionContext) -> None:
-        self.state = state = _state(ctx)
+        self.state = state = ctx.state
         state.now = ctx.now
         state.patience = self.params["give_up"]
         if state.robot is None:
             raise ActionFailure("comm.explore: the agent has no robot (use comm.listen for static agents)")
+        self.needs_world = True  # polled at every world step while it drives
+        self.wake_at = None
         self.goal = None
         self.waiting = 0.0
         self.at = ctx.now
+        self._start(ctx)
+        if self.goal is None:
+            self._sleep(ctx)
+
+    def _start(self, ctx: ActionContext) -> None:
+        state = self.state
         jitter = min(max(self.params["jitter"], 0.0), 0.9)
         self.speed = self.params["speed"] * (1.0 + jitter * (2.0 * ctx.rng.random() - 1.0))
         explorer = state.explorer
@@ -215,7 +243,6 @@ class Explore(Action):
                 state.broken = True
                 ctx.emit("comm.broken", distance_m=round(state.robot.travelled, 3))
             self.waiting = self.params["wait"]
-            ctx.result = state
             return
         if not state.explored:
             if not explorer.visited:
@@ -226,7 +253,26 @@ class Explore(Action):
                     self._explored(ctx)
         if state.explored:
             self._route(ctx)
-        ctx.result = state
+
+    def _sleep(self, ctx: ActionContext) -> None:
+        """A robot that waits is woken once, at the world step where counting its wait
+        down step by step (as :meth:`poll` would) reaches zero, instead of being polled
+        at every step: the same step, the same remainder, for a fraction of the cost."""
+        step = getattr(ctx.world, "dt", None)
+        if not step:
+            return
+        tick = round(ctx.now / step)
+        at, left = ctx.now, self.waiting
+        while True:
+            tick += 1
+            now = tick * step
+            left -= now - at
+            at = now
+            if left <= 0:
+                break
+        self.needs_world = False
+        self.wake_at = now
+        self.waiting = left
 
     def _explored(self, ctx: ActionContext) -> None:
         state = self.state
@@ -334,6 +380,12 @@ class Explore(Action):
 
     def poll(self, ctx: ActionContext) -> Status:
         state = self.state
+        if not self.needs_world:  # woken when its wait is over (see _sleep)
+            if ctx.now < self.wake_at - 1e-9:
+                return Status.RUNNING
+            self.at = ctx.now
+            _plan(ctx, state, self.links)
+            return Status.OK
         robot = state.robot
         dt = ctx.now - self.at  # the first poll comes at the start: no time has passed yet
         if dt <= 1e-12:
@@ -343,7 +395,7 @@ class Explore(Action):
             self.waiting -= dt
             if self.waiting > 0:
                 return Status.RUNNING
-            _plan(ctx, state)
+            _plan(ctx, state, self.links)
             return Status.OK
         cell = self.goal
         target = (state.origin[0] + (cell[1] + 0.5) * state.cell, state.origin[1] + (cell[0] + 0.5) * state.cell)
@@ -353,7 +405,7 @@ class Explore(Action):
         ctx.emit("comm.step", cell=list(cell), distance_m=round(robot.travelled, 3))
         if state.explorer.stack and state.explorer.stack[-1] != cell and not state.explored:
             state.explorer.stack.append(cell)  # arrived by a route, not by the explorer
-        _plan(ctx, state)
+        _plan(ctx, state, self.links)
         return Status.OK
 
     def _sense(self, ctx: ActionContext, cell: tuple[int, int]) -> None:
@@ -381,13 +433,17 @@ class Listen(InstantAction):
     params = {"period": Param(float, 1.0, "seconds between plans", low=1e-9),
               "give_up": Param(float, 240.0, "seconds without news after which missing robots are given up",
                                  low=0)}
+    agent_state = CommAgent
+    resources = {"live": LIVENESS}
+
+    def setup(self, world: Any) -> None:
+        self.links: dict[str, Any] = {}  # channel place -> the model carrying it (see _plan)
 
     def start(self, ctx: ActionContext) -> None:
-        self.state = _state(ctx)
+        self.state = ctx.state
         self.state.now = ctx.now
         self.state.patience = self.params["give_up"]
         self.until = ctx.now + self.params["period"]
-        ctx.result = self.state
 
     def poll(self, ctx: ActionContext) -> Status:
         if ctx.world is not None and ctx.now < self.until - 1e-9:
@@ -398,42 +454,43 @@ class Listen(InstantAction):
             if not state.gave_up >= set(missing):
                 state.gave_up |= set(missing)
                 ctx.emit("comm.gave_up", silent=sorted(missing))
-        _plan(ctx, state)
+        _plan(ctx, state, self.links)
         return Status.OK
 
     needs_world = True
 
 
 class Send(InstantAction):
-    """Process 5: the next message waiting for ``peer`` into the channel place towards it."""
+    """Process 5: the next message waiting for ``peer`` into the channel place towards it
+    (the packet is that place's token; the agent's work loop gets a plain token back)."""
 
-    params = {"peer": Param(str, doc="the peer agent"), "box": Param(str, doc="the channel place towards it", places=""),
-              "loop": Param(str, doc="the place the state goes back to", places="")}
+    params = {"peer": Param(str, doc="the peer agent"),
+              "box": Param(str, doc="the channel place towards it", places="")}
+    agent_state = CommAgent
 
-    def run(self, ctx: ActionContext) -> CommAgent:
-        state = _state(ctx)
+    def run(self, ctx: ActionContext) -> None:
+        state = ctx.state
         message = state.take(self.params["peer"])
         if message is None:
             raise ActionFailure(f"comm.send: nothing waiting for {self.params['peer']!r}")
         ctx.put(self.params["box"], {"size": message.size, "payload": message.payload, "code": message.code,
                                      "message": message})
-        ctx.put(self.params["loop"], state)
         ctx.emit("comm.sent", to=self.params["peer"], code=message.code, bytes=message.size,
                  payload=message.payload, source=message.source)
-        return state
 
 
 class Receive(InstantAction):
     """Take one message from a channel place into this agent's history and map."""
 
-    params = {"box": Param(str, doc="the channel place", places=""), "state": Param(str, doc="the listening place", places="")}
+    params = {"box": Param(str, doc="the channel place", places="")}
+    agent_state = CommAgent
 
-    def run(self, ctx: ActionContext) -> CommAgent:
-        state = ctx.inputs[self.params["state"]][0]
+    def run(self, ctx: ActionContext) -> None:
+        state = ctx.state
         packet = ctx.inputs[self.params["box"]][0]
         message = packet["message"] if isinstance(packet, dict) else None
-        if not isinstance(state, CommAgent) or message is None:
-            raise ActionFailure("comm.receive: needs the agent's state and a message")
+        if message is None:
+            raise ActionFailure(f"comm.receive: the token of {self.params['box']!r} carries no message")
         state.now = ctx.now
         new = state.receive(message)
         if new or message.final:
@@ -442,28 +499,28 @@ class Receive(InstantAction):
             if state.explorer is not None:
                 state.explorer.learn((v // state.cols, v % state.cols) for v in new)
             ctx.emit("comm.learnt", ids=new)
-        ctx.put(self.params["state"], state)
-        return None
 
 
-def has_message(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
-    """Guard: the agent has a message waiting for ``params['peer']`` and hears it."""
-    state = next((d for ts in tokens.values() for d in ts if isinstance(d, CommAgent)), None)
+def has_message(state: CommAgent | None, params: dict[str, Any]) -> bool:
+    """Guard (reads ``outbox/{peer}``): the agent has a message waiting for
+    ``params['peer']`` and hears it."""
     return state is not None and state.has_for(params["peer"])
 
 
 def _done(state: CommAgent) -> bool:
     if state.kind == "robot" and not state.explored:
         return False
+    if not state.complete_sources(state.gave_up):  # the cheap test first: most often it decides
+        return False
     silent = {name for name, peer in state.peers.items()
               if peer.address in state.gave_up or state.now - state.heard.get(name, state.since) > state.patience}
     waiting = any(box for name, box in state.outbox.items() if name not in silent)
-    return state.complete_sources(state.gave_up) and not waiting and not state.untold()
+    return not waiting and not state.untold()
 
 
-def finished(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
-    """Guard: the agent holds the whole map and has nothing left to send (or gave up)."""
-    state = next((d for ts in tokens.values() for d in ts if isinstance(d, CommAgent)), None)
+def finished(state: CommAgent | None, params: dict[str, Any]) -> bool:
+    """Guard (reads ``*``): the agent holds the whole map and has nothing left to send
+    (or gave up)."""
     if state is None:
         return False
     if state.finished or _done(state):
@@ -472,9 +529,13 @@ def finished(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
     return False
 
 
-def going_on(tokens: dict[str, list[Any]], params: dict[str, Any]) -> bool:
-    """Guard: the agent is not finished."""
-    return not finished(tokens, params)
+def going_on(state: CommAgent | None, params: dict[str, Any]) -> bool:
+    """Guard (reads ``*``): the agent is not finished."""
+    return not finished(state, params)
 
 
-GUARDS = {"comm.has_message": has_message, "comm.finished": finished, "comm.going_on": going_on}
+#: ``{name: (guard, the state keys it reads)}``: ``f(state, params) -> bool`` over the
+#: agent's :class:`CommAgent`, asked again only when one of its keys changed.
+GUARDS = {"comm.has_message": (has_message, ("outbox/{peer}",)),
+          "comm.finished": (finished, ("*",)),
+          "comm.going_on": (going_on, ("*",))}

@@ -1,10 +1,18 @@
 """One agent of seed 000's framework: what it knows, what it has to send, its robot.
 
-A :class:`CommAgent` travels as the data of its subnet's tokens (the same object in
-its work loop and in its listening place), so every transition of the agent sees and
-updates one state: the history (:class:`~petriflow.agents.comm.framework.History`),
-the topological map, the messages waiting for each peer, and, for a robot, its body,
-odometry and exploration.
+A :class:`CommAgent` is the agent's state (:class:`~petriflow.runtime.agents.AgentState`,
+registered as ``comm.agent``; the subnets declare ``state: comm.agent``): the run keeps
+it, ``comm.characterise`` makes it (``ctx.state = ...``), and every later transition of
+the agent sees and updates it through ``ctx.state``: the history
+(:class:`~petriflow.agents.comm.framework.History`), the topological map, the messages
+waiting for each peer, and, for a robot, its body, odometry and exploration. Tokens
+carry no state.
+
+**What changed, for the guards.** ``comm.has_message`` reads the key ``outbox/{peer}``:
+whether a message waits for that peer and the peer is heard (in range, running). The
+state touches that key whenever one peer's queue or hearing changes (:meth:`queue`,
+:meth:`take`, :meth:`hear`), so after a step only the send guards of the peers whose
+queue or hearing changed are asked again, not every peer's.
 
 Map data is the history's data: an item is a vertex ``(id, x, y)`` whose id is the
 maze cell the robot's odometry puts it in (one byte). A source's data is final when
@@ -20,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from petriflow.agents.comm.framework import History, Message, plan
+from petriflow.runtime.agents import AgentState
 
 __all__ = ["CommAgent", "Peer"]
 
@@ -33,8 +42,8 @@ class Peer:
     box: str
 
 
-@dataclass
-class CommAgent:
+@dataclass(eq=False)
+class CommAgent(AgentState):
     """The state of one agent (see the module)."""
 
     name: str
@@ -69,6 +78,9 @@ class CommAgent:
     since: float = 0.0                           # simulated time the agent started its task
     sent_bytes: int = 0
     payload_bytes: int = 0
+
+    def __post_init__(self) -> None:
+        AgentState.__init__(self)
 
     def to_token(self) -> dict[str, Any]:
         """What a trace records of this state: who it is and how far it got (cheap,
@@ -141,6 +153,15 @@ class CommAgent:
         peer = self.by_address(message.receiver)
         if peer is not None:
             self.outbox.setdefault(peer.name, deque()).append(message)
+            self.touch(f"outbox/{peer.name}")
+
+    def hear(self, names: set[str]) -> None:
+        """The peers heard now (above the threshold and running); the send guards of
+        those whose hearing changed are asked again."""
+        changed = names ^ self.in_range
+        self.in_range = names
+        if changed:
+            self.touch(*(f"outbox/{name}" for name in sorted(changed)))
 
     def plan_for(self, peer: Peer) -> None:
         """Algorithm 1 towards ``peer`` (in range): queue what it should get, unless a
@@ -179,6 +200,7 @@ class CommAgent:
         if not box:
             return None
         message = box.popleft()
+        self.touch(f"outbox/{peer}")
         self.sent_bytes += message.size
         self.payload_bytes += message.payload
         return message

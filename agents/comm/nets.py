@@ -1,24 +1,27 @@
-"""The mapping mission of seed 000 as a workflow net, generated for any team.
+"""The mapping mission of seed 000 as a workflow net, built for any team.
 
-:func:`build` writes the net (petriflow YAML) for ``robots`` robots, an optional
-monitor agent and, in the ``centralised`` mode, a central unit that relays everything.
-Each agent is a subnet: the four start-up processes in order, then its work loop
-(``step``: a robot explores one cell, a static agent listens; one ``send`` transition
-per peer, guarded by ``comm.has_message``; back to the loop, or ``finish`` when the agent
-holds the whole map); and a ``receive`` transition per peer taking that peer's messages
-from the channel place between them. A channel place holds at most one message: the
-sender takes a slot token, the receiver gives it back, so the net is bounded and its
-analysis finite, and ``end`` collects every slot (``begin`` hands them out), so no
-message is left in flight.
+:func:`build` builds the net (a :class:`~petriflow.net.Net`, with
+:class:`~petriflow.netbuild.NetBuilder`) for ``robots`` robots, an optional monitor
+agent and, in the ``centralised`` mode, a central unit that relays everything. Each
+agent is a subnet whose state is a ``comm.agent``
+(:class:`~petriflow.agents.comm.agent.CommAgent`, kept by the run): the four start-up
+processes in order, then its work loop (``step``: a robot explores one cell, a static
+agent listens; one ``send`` transition per peer, guarded by ``comm.has_message``; back
+to the loop, or ``finish`` when the agent holds the whole map); and a ``receive``
+transition per peer taking that peer's messages from the mailbox between them. A
+mailbox (``box_S_R``, the channel place in the receiver's subnet) holds at most one
+message: its slot (``slot_S_R``, with the sender) is taken by the sender and given back
+by the receiver, so the net is bounded and its analysis finite; the WF envelope's
+``begin`` hands out every slot and ``end`` collects them, so no message is left in
+flight.
 
 Used directly by sweep files (``net: {builder: petriflow.agents.comm.nets:build}``);
 ``python -m petriflow.agents.comm.nets`` writes the shipped nets of ``nets/comm/``.
 
 Examples:
-    >>> from petriflow.io.yaml import loads_net
-    >>> net = loads_net(build(robots=2))
-    >>> len(net.subnets), len([p for p in net.places.values() if p.channel])
-    (2, 2)
+    >>> net = build(robots=2)
+    >>> len(net.subnets), len([p for p in net.places.values() if p.channel]), net.subnets["robot1"].state
+    (2, 2, 'comm.agent')
 """
 
 from __future__ import annotations
@@ -30,6 +33,8 @@ from typing import Any
 import yaml
 
 from petriflow.agents.comm.framework import addresses, dhcp_pools
+from petriflow.net import Net
+from petriflow.netbuild import NetBuilder
 
 __all__ = ["build", "ROBOT_STARTS", "MONITOR", "CENTRAL"]
 
@@ -56,17 +61,15 @@ def _agents(robots: int, monitor: bool, mode: str) -> list[dict[str, Any]]:
 
 def _peers(agent: dict[str, Any], agents: list[dict[str, Any]], mode: str) -> list[dict[str, Any]]:
     others = [a for a in agents if a["name"] != agent["name"]]
-    if mode == "decentralised":
-        return others
-    if agent["kind"] == "central":
+    if mode == "decentralised" or agent["kind"] == "central":
         return others
     return [a for a in others if a["kind"] == "central"]
 
 
 def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *, cell: float = 5 / 6,
           cols: int = 6, area: float = 5.0, speed: float = 0.15, give_up: float = 240.0,
-          listen_give_up: float = 900.0, **ignored: Any) -> str:
-    """The mission's net as petriflow YAML (see the module).
+          listen_give_up: float = 900.0, **ignored: Any) -> Net:
+    """The mission's net (see the module).
 
     Args:
         robots: robots in the team (1..126).
@@ -85,78 +88,64 @@ def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *
     if not 1 <= robots <= 126:
         raise ValueError(f"robots must be from 1 to 126, got {robots}")
     agents = _agents(robots, monitor, mode)
-    subnets = []
-    end_in = []
+    peers = {a["name"]: [p["name"] for p in _peers(a, agents, mode)] for a in agents}
+    b = NetBuilder(f"comm-{mode}-{robots}{'-monitor' if monitor else ''}",
+                   label=f"seed 000 mapping mission: {robots} robots, {mode}{', a monitor' if monitor else ''}")
+    subnets = {a["name"]: b.agent(a["name"], label=f"{a['kind']} {a['name']} (192.168.1.{a['address']})",
+                                  state="comm.agent") for a in agents}
+    address = {a["name"]: a["address"] for a in agents}
+    for a in subnets.values():
+        for local in ("start", "c1", "c2", "c3", "idle", "out", "listen", "done"):
+            a.place(local)
+    # one mailbox per ordered pair that talks: the channel place with the receiver, the slot with the sender
+    boxes = {(name, other): b.mailbox(other, channel="radio", id=f"box_{name}_{other}", label=f"{name} to {other}",
+                                      slot=f"slot_{name}_{other}", slot_label=f"{name} may send to {other}",
+                                      slot_agent=name)
+             for name in peers for other in peers[name]}
     for agent in agents:
-        name = agent["name"]
-        peers = _peers(agent, agents, mode)
-        places: list[Any] = [f"{name}_start", f"{name}_c1", f"{name}_c2", f"{name}_c3", f"{name}_idle",
-                             f"{name}_out", f"{name}_listen", f"{name}_done"]
-        kind = agent["kind"]
+        name, kind = agent["name"], agent["kind"]
+        a = subnets[name]
         characterise = {"kind": kind, "cell": round(cell, 6), "cols": cols, "area": [area, area]}
         initialise: dict[str, Any] = {"agents": robots, "peers": {
-            p["name"]: {"address": p["address"], "box": f"box_{name}_{p['name']}"} for p in peers}}
+            other: {"address": address[other], "box": boxes[name, other].id} for other in peers[name]}}
         if kind == "robot":
             initialise["index"] = agent["index"]
         elif kind == "monitor":
             initialise["pool_of"] = agent["pool_of"]
         else:
             initialise["address"] = agent["address"]
-        first_box = f"box_{peers[0]['name']}_{name}" if peers else None
-        transitions: list[dict[str, Any]] = [
-            {"id": f"{name}_characterise", "label": "process 1: characterisation", "action": "comm.characterise",
-             "params": characterise, "in": [f"{name}_start"], "out": [f"{name}_c1"]},
-            {"id": f"{name}_analyse", "label": "process 2: transmission analysis",
-             **({"action": "comm.analyse", "params": {"channel_place": first_box}} if first_box else {}),
-             "in": [f"{name}_c1"], "out": [f"{name}_c2"]},
-            {"id": f"{name}_initialise", "label": "process 3: initialisation", "action": "comm.initialise",
-             "params": initialise, "in": [f"{name}_c2"], "out": [f"{name}_c3"]},
-            {"id": f"{name}_history", "label": "process 4: history", "action": "comm.history",
-             "in": [f"{name}_c3"], "out": [f"{name}_idle", f"{name}_listen"]},
-            {"id": f"{name}_step", "label": "explore a cell" if kind == "robot" else "listen",
-             "action": "comm.explore" if kind == "robot" else "comm.listen",
-             "params": ({"speed": speed, "give_up": give_up, "reexplore": mode == "decentralised"}
-                        if kind == "robot" else {"give_up": listen_give_up}),
-             "in": [f"{name}_idle"], "out": [f"{name}_out"]},
-            {"id": f"{name}_loop", "label": "go on", "guard": "comm.going_on", "priority": 1,
-             "in": [f"{name}_out"], "out": [f"{name}_idle"]},
-            {"id": f"{name}_finish", "label": "map complete", "guard": "comm.finished", "priority": 1,
-             "in": [f"{name}_out"], "out": [f"{name}_done"]},
-        ]
-        for peer in peers:
-            other = peer["name"]
-            box, slot = f"box_{name}_{other}", f"slot_{name}_{other}"
-            places.append({"id": slot, "label": f"{name} may send to {other}"})
-            transitions.append({
-                "id": f"{name}_send_{other}", "label": f"process 5: send to {other}", "action": "comm.send",
-                "params": {"peer": other, "box": box, "loop": f"{name}_out"}, "guard": "comm.has_message",
-                "priority": 2, "in": [f"{name}_out", slot], "out": [f"{name}_out", box]})
-            end_in.append(slot)
-        for peer in peers:
-            other = peer["name"]
-            box, slot = f"box_{other}_{name}", f"slot_{other}_{name}"
-            places.append({"id": box, "channel": "radio", "label": f"{other} to {name}"})
-            transitions.append({
-                "id": f"{name}_receive_{other}", "label": f"receive from {other}", "action": "comm.receive",
-                "params": {"box": box, "state": f"{name}_listen"}, "priority": 3,
-                "in": [box, f"{name}_listen"], "out": [f"{name}_listen", slot]})
-        subnets.append({"id": name, "agent": name, "label": f"{kind} {name} (192.168.1.{agent['address']})",
-                        "places": places, "transitions": transitions})
-        end_in += [f"{name}_done", f"{name}_listen"]
-    net = {
-        "petriflow": 1,
-        "net": f"comm-{mode}-{robots}{'-monitor' if monitor else ''}",
-        "label": f"seed 000 mapping mission: {robots} robots, {mode}{', a monitor' if monitor else ''}",
-        "subnets": subnets,
-        "places": [{"id": "i", "tokens": 1}, "o"],
-        "transitions": [
-            {"id": "begin", "label": "start-up", "in": ["i"],
-             "out": [f"{a['name']}_start" for a in agents] + [p for p in end_in if p.startswith("slot_")]},
-            {"id": "end", "label": "every agent holds the map", "in": end_in, "out": ["o"]},
-        ],
-        "final": {"o": 1},
-    }
-    return yaml.safe_dump(net, sort_keys=False, width=120)
+        a.transition("characterise", label="process 1: characterisation", action="comm.characterise",
+                     params=characterise, inputs=["start"], outputs=["c1"])
+        analyse = {}
+        if peers[name]:  # process 2 on the radio of the first peer's channel towards this agent
+            analyse = {"action": "comm.analyse", "params": {"channel_place": f"box_{peers[name][0]}_{name}"}}
+        a.transition("analyse", label="process 2: transmission analysis", inputs=["c1"], outputs=["c2"], **analyse)
+        a.transition("initialise", label="process 3: initialisation", action="comm.initialise",
+                     params=initialise, inputs=["c2"], outputs=["c3"])
+        a.transition("history", label="process 4: history", action="comm.history", inputs=["c3"],
+                     outputs=["idle", "listen"])
+        a.transition("step", label="explore a cell" if kind == "robot" else "listen",
+                     action="comm.explore" if kind == "robot" else "comm.listen",
+                     params=({"speed": speed, "give_up": give_up, "reexplore": mode == "decentralised"}
+                             if kind == "robot" else {"give_up": listen_give_up}),
+                     inputs=["idle"], outputs=["out"])
+        a.transition("loop", label="go on", guard="comm.going_on", priority=1, inputs=["out"], outputs=["idle"])
+        a.transition("finish", label="map complete", guard="comm.finished", priority=1, inputs=["out"],
+                     outputs=["done"])
+        for other in peers[name]:
+            send = a.transition(f"send_{other}", label=f"process 5: send to {other}", action="comm.send",
+                                params={"peer": other, "box": boxes[name, other].id}, guard="comm.has_message",
+                                priority=2, inputs=["out"], outputs=["out"])
+            b.send(send, boxes[name, other])
+        for other in peers[name]:
+            box = boxes[other, name]
+            receive = a.transition(f"receive_{other}", label=f"receive from {other}", action="comm.receive",
+                                   params={"box": box.id}, priority=3, inputs=["listen"], outputs=["listen"])
+            b.receive(receive, box)
+        a.start("start")
+        a.done("done", "listen")
+    b.envelope(begin_label="start-up", end_label="every agent holds the map")
+    return b.build()
 
 
 #: The maze of the shipped world: a perfect maze (one path between any two cells) of
@@ -241,6 +230,8 @@ def draw_world(description: dict[str, Any], path: str | Path) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     """Write the shipped world and nets (``nets/comm/``)."""
+    from petriflow.io.yaml import dumps_net
+
     parser = argparse.ArgumentParser(description="write seed 000's world and nets")
     parser.add_argument("--out", default="nets/comm")
     args = parser.parse_args(argv)
@@ -255,10 +246,11 @@ def main(argv: list[str] | None = None) -> None:
     print(f"wrote {out / 'world.yaml'} and {out / 'world.png'}")
     for robots, mode, monitor in ((2, "decentralised", False), (2, "centralised", False), (3, "decentralised", False),
                                   (3, "centralised", False), (3, "decentralised", True)):
-        name = f"comm-{mode}-{robots}{'-monitor' if monitor else ''}.yaml"
-        text = build(robots, mode, monitor)
+        net = build(robots, mode, monitor)
+        net.run = "run.yaml"
+        name = f"{net.id}.yaml"
         (out / name).write_text("# Generated by python -m petriflow.agents.comm.nets; the run configuration is"
-                                f" run.yaml.\nrun: run.yaml\n{text}")
+                                f" run.yaml.\n{dumps_net(net)}")
         print(f"wrote {out / name}")
 
 

@@ -1,5 +1,7 @@
 """Registers seed 000's framework (the ``petriflow.actions`` entry point): actions,
-guards, the ``comm.radio`` channel model and the mission's metrics."""
+guards over the agent's state (with the state keys each reads), the agent-state type
+``comm.agent`` (:class:`~petriflow.agents.comm.agent.CommAgent`; subnets declare
+``state: comm.agent``), the ``comm.radio`` channel model and the mission's metrics."""
 
 from __future__ import annotations
 
@@ -20,10 +22,12 @@ ACTIONS = {
 def register(registry) -> None:
     from petriflow.agents.comm import metrics
     from petriflow.agents.comm.actions import GUARDS
+    from petriflow.agents.comm.agent import CommAgent
 
     for name, (target, doc) in ACTIONS.items():
         registry.register(name, target, doc=doc)
-    for name, function in GUARDS.items():
-        registry.predicate(name)(function)
+    registry.register_state("comm.agent", CommAgent)
+    for name, (function, reads) in GUARDS.items():
+        registry.predicate(name, reads=reads)(function)
     registry.register_channel("comm.radio", "petriflow.agents.comm.radio:RadioChannel")
     metrics.register(registry)

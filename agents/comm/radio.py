@@ -99,8 +99,27 @@ class RadioChannel(ChannelModel):
             return None
         return self.rssi(*found) + float(self.gains_db.get(a, 0.0)) + float(self.gains_db.get(b, 0.0))
 
-    def usable(self, a: str, b: str) -> bool:
-        """Whether the framework would use the link (RSSI above the threshold)."""
+    def usable(self, a: str, b: str, positions: dict[str, Any] | None = None) -> bool:
+        """Whether the framework would use the link (RSSI above the threshold).
+
+        Walls only take power away, so a pair whose RSSI in free space (antenna gains
+        included) is already at or below the threshold is out of range without
+        counting its walls: the ray tests are made only for pairs near enough to be
+        heard, and the answer is the one :meth:`link_rssi` gives. ``positions``: the
+        agents' ``(x, y)`` now, when the caller has read them already (one read per
+        agent for a whole plan instead of two per pair).
+        """
+        world = self.world
+        if self._walls is not None and world is not None and hasattr(world, "position"):
+            if positions is not None and a in positions and b in positions:
+                pa, pb = positions[a], positions[b]
+            else:
+                pa, pb = world.position(a), world.position(b)
+            if pa is not None and pb is not None:
+                free = self.path.rssi(math.dist(pa, pb)) + float(self.gains_db.get(a, 0.0)) \
+                    + float(self.gains_db.get(b, 0.0))
+                if free <= self.threshold_dbm:
+                    return False
         level = self.link_rssi(a, b)
         return level is None or level > self.threshold_dbm
 

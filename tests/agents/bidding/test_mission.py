@@ -7,14 +7,16 @@ import pytest
 import yaml
 
 from petriflow import examples
+from petriflow.agents.bidding.agent import Interface, Operator, RobotAgent
 from petriflow.agents.bidding.auction import autonomous
 from petriflow.agents.bidding.nets import build
 from petriflow.agents.bidding.office import paper_office
+from petriflow.agents.bidding.protocol import Message
 from petriflow.analysis import check_net
 from petriflow.io import load_net
-from petriflow.io.yaml import loads_net
+from petriflow.io.yaml import dumps_net
 from petriflow.runtime.config import load_config
-from petriflow.testing import fire_one
+from petriflow.runtime.scheduler import Scheduler
 from petriflow.world import World
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
@@ -23,13 +25,56 @@ pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 @pytest.mark.parametrize("robots", [1, 2, 3, 4, 5])
 def test_nets_are_sound_workflow_nets(robots):
     for deployment in ("autonomous", "random"):
-        result = check_net(loads_net(build(robots, deployment)))
+        result = check_net(build(robots, deployment))
         assert result["workflow_net"] and result["sound"], result["violations"]
 
 
-def test_shipped_nets_are_the_builders():
-    shipped = load_net(examples.path("bidding", "bidding-autonomous-3.yaml"))
-    assert shipped.structure() == loads_net("run: run.yaml\n" + build(3, "autonomous")).structure()
+@pytest.mark.parametrize("robots, deployment, run", [(3, "autonomous", "run.yaml"), (5, "random", "run.yaml"),
+                                                     (20, "autonomous", "run-20.yaml")])
+def test_shipped_nets_are_the_builders(robots, deployment, run):
+    built = build(robots, deployment)
+    built.run = run
+    shipped = load_net(examples.path("bidding", f"bidding-{deployment}-{robots}.yaml"))
+    assert shipped.structure() == built.structure()
+    assert {s.id: s.state for s in shipped.subnets.values()} == {
+        "operator": "bidding.operator", "hmia": "bidding.interface",
+        **{f"robot{i + 1}": "bidding.robot" for i in range(robots)}}
+
+
+def test_actions_name_only_declared_places_and_no_state_place():
+    """Send and receive name their mailbox (a declared place parameter); no action is
+    told where a state token lives: the state is the run's."""
+    net = build(2)
+    for t in net.transitions.values():
+        assert "state" not in t.params
+        if t.action in ("bidding.send", "bidding.receive"):
+            assert t.params["box"] in net.places and net.places[t.params["box"]].channel == "lan"
+    from petriflow.errors import NetFormatError
+    from petriflow.runtime.registry import default_registry
+
+    net.transitions["robot1_send_robot2"].params["box"] = "box_robot9"
+    with pytest.raises(NetFormatError, match="box_robot9"):
+        default_registry.bind(net)
+
+
+def fire(net, transition, tokens, *, states=None, world=None, config=None):
+    """Fire one transition with its real action, the agents' states given (``{agent:
+    state}``; ``petriflow.testing.fire_one`` takes token data only, and the states are the
+    run's): ``(result, events, scheduler)``."""
+    scheduler = Scheduler(net, world=world, config=config, seed=0)
+    scheduler.set_tokens({p: list(v) for p, v in tokens.items()})
+    agents = scheduler.firer.agents
+    for agent, state in (states or {}).items():
+        agents.set_state(agent, state, scheduler.index.state_type.get(agent))
+    events = []
+    scheduler.on_event(events.append)
+    with scheduler:
+        result = scheduler.fire_one(transition)
+    return result, events, scheduler
+
+
+def _outcome(events, transition):
+    return [e.data["outcome"] for e in events if e.kind == "end" and e.transition == transition][-1]
 
 
 def test_builder_refuses_nonsense():
@@ -43,7 +88,7 @@ def _run(tmp_path, robots=2, deployment="autonomous", faults=(), **options):
     from petriflow.runtime.session import run_files
 
     net = tmp_path / "net.yaml"
-    net.write_text(build(robots, deployment, **options))
+    net.write_text(dumps_net(build(robots, deployment, **options)))
     (tmp_path / "world.yaml").write_text(examples.path("bidding", "world.yaml").read_text())
     config = {"seed": 3, "until": 900, "world": "world.yaml", "stall": 120,
               "channels": {"lan": {"model": "ideal", "latency": 0.0}}, "faults": list(faults)}
@@ -67,45 +112,62 @@ def test_transitions_fire_one_at_a_time():
     config = load_config(examples.path("bidding", "run.yaml"))
     world = World(yaml.safe_load(examples.path("bidding", "world.yaml").read_text()))
     try:
-        op = fire_one(net, "operator_request", world=world, config=config, tokens={"operator_start": [None]})
-        operator = op.tokens["operator_work"][0]
-        assert [m.kind for m in operator.outbox["hmia"]] == ["REQUEST", "INFORM"]
-        sent = fire_one(net, "operator_send_hmia", world=world, config=config,
-                        tokens={"operator_work": [operator], "slot_hmia": [None]})
+        result, _, run = fire(net, "operator_request", {"operator_start": [None]}, world=world, config=config)
+        operator = run.firer.agents.states["operator"]
+        assert isinstance(operator, Operator) and result.tokens == {"operator_work": [None]}  # a plain token
+        mission = list(operator.outbox["hmia"])
+        assert [m.kind for m in mission] == ["REQUEST", "INFORM"]
+        sent, _, _ = fire(net, "operator_send_hmia", {"operator_work": [None], "slot_hmia": [None]},
+                          states={"operator": operator}, world=world, config=config)
         assert sent.marking["operator_work"] == 1 and "slot_hmia" not in sent.marking
-        hmia = fire_one(net, "hmia_create", world=world, config=config,
-                        tokens={"hmia_start": [None]}).tokens["hmia_work"][0]
-        for message in operator.outbox["hmia"]:
-            got = fire_one(net, "hmia_receive", world=world, config=config,
-                           tokens={"box_hmia": [message.token()], "hmia_listen": [hmia]})
-            assert got.marking["slot_hmia"] == 1
+        assert [m.kind for m in operator.outbox["hmia"]] == ["INFORM"]
+        _, _, run = fire(net, "hmia_create", {"hmia_start": [None]}, world=world, config=config)
+        hmia = run.firer.agents.states["hmia"]
+        for message in mission:
+            got, _, _ = fire(net, "hmia_receive", {"box_hmia": [message.token()], "hmia_listen": [None]},
+                             states={"hmia": hmia}, world=world, config=config)
+            assert got.marking["slot_hmia"] == 1 and got.tokens["hmia_listen"] == [None]
         assert hmia.requested and hmia.robots == ["robot1", "robot2"] and len(hmia.zones) == 8
-        team = fire_one(net, "hmia_team", world=world, config=config, tokens={"hmia_work": [hmia]})
-        assert team.outcome == "ok" and [m.kind for m in hmia.outbox["robot1"]] == ["INITIALIZE"]
+        team, events, _ = fire(net, "hmia_team", {"hmia_work": [None]}, states={"hmia": hmia}, world=world,
+                               config=config)
+        assert _outcome(events, "hmia_team") == "ok"
+        assert [m.kind for m in hmia.outbox["robot1"]] == ["INITIALIZE"]
         # robot1 initialises, then bids on a CFP for Z6 with its eq. 6 cost
-        robot = fire_one(net, "robot1_create", world=world, config=config,
-                         tokens={"robot1_start": [None]}).tokens["robot1_work"][0]
-        fire_one(net, "robot1_receive", world=world, config=config,
-                 tokens={"box_robot1": [hmia.outbox["robot1"][0].token()], "robot1_listen": [robot]})
-        assert fire_one(net, "robot1_ready", world=world, config=config, tokens={"robot1_work": [robot]}).outcome == "ok"
-        assert robot.initialised and robot.outbox["hmia"][0].kind == "INITIALIZED"
-        from petriflow.agents.bidding.protocol import Message
+        _, _, run = fire(net, "robot1_create", {"robot1_start": [None]}, world=world, config=config)
+        robot = run.firer.agents.states["robot1"]
 
+        def receive(message):
+            fire(net, "robot1_receive", {"box_robot1": [message.token()], "robot1_listen": [None]},
+                 states={"robot1": robot}, world=world, config=config)
+
+        def step(name):
+            return _outcome(fire(net, f"robot1_{name}", {"robot1_work": [None]}, states={"robot1": robot},
+                                 world=world, config=config)[1], f"robot1_{name}")
+
+        receive(hmia.outbox["robot1"][0])
+        assert step("ready") == "ok"
+        assert robot.initialised and robot.outbox["hmia"][0].kind == "INITIALIZED"
         cfp = Message("CFP", "hmia", "robot1", zone=5, body={"position": (0.5, -5.5), "bidders": ["robot1", "robot2"]})
-        fire_one(net, "robot1_receive", world=world, config=config,
-                 tokens={"box_robot1": [cfp.token()], "robot1_listen": [robot]})
-        fire_one(net, "robot1_bid", world=world, config=config, tokens={"robot1_work": [robot]})
+        receive(cfp)
+        step("bid")
         propose = robot.outbox["robot2"][0]
         assert propose.kind == "PROPOSE" and propose.body["cost"] == pytest.approx(((6 - 0.5) ** 2 + 3.5 ** 2) ** 0.5
                                                                                   / 0.5 / 3)
+        assert not robot.bids_in()  # robot2's proposal is missing
         # robot2 bids lower: robot1 loses and sends no ALLOCATED
-        theirs = Message("PROPOSE", "robot2", "robot1", zone=5, body={"cost": 1.0, "rank": 1})
-        fire_one(net, "robot1_receive", world=world, config=config,
-                 tokens={"box_robot1": [theirs.token()], "robot1_listen": [robot]})
-        fire_one(net, "robot1_decide", world=world, config=config, tokens={"robot1_work": [robot]})
+        receive(Message("PROPOSE", "robot2", "robot1", zone=5, body={"cost": 1.0, "rank": 1}))
+        assert robot.bids_in() and robot.next_step() == "decide"
+        step("decide")
         assert robot.mine == [] and [m.kind for m in robot.outbox["hmia"]] == ["INITIALIZED"]
     finally:
         world.close()
+
+
+def test_a_step_the_state_does_not_call_for_cannot_fire():
+    net = build(2)
+    robot = RobotAgent("robot1", 0, "hmia")
+    with pytest.raises(Exception, match="cannot fire"):
+        fire(net, "robot1_bid", {"robot1_work": [None]}, states={"robot1": robot})
 
 
 def test_two_robot_mission_maps_every_zone_with_the_central_auctions_result(tmp_path):
@@ -158,44 +220,85 @@ def test_filtering_teammates_removes_the_fictitious_obstacles(tmp_path):
 
 
 def test_hmia_steps_and_a_robots_exploration_fire_alone():
-    from petriflow.agents.bidding.agent import Interface, RobotAgent
-    from petriflow.agents.bidding.protocol import Message
-
     net = load_net(examples.path("bidding", "bidding-autonomous-2.yaml"))
     config = load_config(examples.path("bidding", "run.yaml"))
     world = World(yaml.safe_load(examples.path("bidding", "world.yaml").read_text()))
+
+    def step(agent, name, state):
+        result, events, _ = fire(net, f"{agent}_{name}", {f"{agent}_work": [None]}, states={agent: state},
+                                 world=world, config=config)
+        return result, events
+
     try:
-        hmia = fire_one(net, "hmia_create", world=world, config=config,
-                        tokens={"hmia_start": [None]}).tokens["hmia_work"][0]
+        _, _, run = fire(net, "hmia_create", {"hmia_start": [None]}, world=world, config=config)
+        hmia = run.firer.agents.states["hmia"]
         assert isinstance(hmia, Interface) and hmia.global_map is not None
+        assert run.resources.get("bidding.office").office == paper_office()  # the run's office resource
         hmia.requested, hmia.robots, hmia.alive = True, ["robot1", "robot2"], {"robot1", "robot2"}
         hmia.zones = [tuple(z) for z in paper_office().zones]
         hmia.initialise_sent, hmia.initialised = True, {"robot1", "robot2"}
         hmia.to_offer.extend(range(8))
-        cfp = fire_one(net, "hmia_cfp", world=world, config=config, tokens={"hmia_work": [hmia]})
-        assert cfp.outcome == "ok" and hmia.auction == 0
+        result, events = step("hmia", "cfp", hmia)
+        assert _outcome(events, "hmia_cfp") == "ok" and hmia.auction == 0
+        assert result.tokens["hmia_work"] == [None]  # a plain token
         calls = [hmia.outbox[r][0] for r in ("robot1", "robot2")]
         assert {m.kind for m in calls} == {"CFP"} and calls[0].cast == calls[1].cast  # one broadcast
-        hmia.outbox.clear()
+        hmia.clear()
+        assert not hmia.pending()
         hmia.auction, hmia.to_offer = None, type(hmia.to_offer)()
         hmia.owner = {z: "robot1" for z in range(8)}
-        fire_one(net, "hmia_map", world=world, config=config, tokens={"hmia_work": [hmia]})
+        step("hmia", "map", hmia)
         assert hmia.map_sent is not None and hmia.outbox["robot2"][0].kind == "MAP"
+        hmia.clear()
         hmia.finished = set(range(8))
-        end = fire_one(net, "hmia_end", world=world, config=config, tokens={"hmia_work": [hmia]})
-        report = [e.data["data"] for e in end.events if e.kind == "custom" and e.data["name"] == "bidding.end"][0]
+        _, events = step("hmia", "end", hmia)
+        report = [e.data["data"] for e in events if e.kind == "custom" and e.data["name"] == "bidding.end"][0]
         assert report["accuracy_pct"] == 100.0 and report["sigma"] == 0  # nothing mapped, nothing wrong
 
         robot = RobotAgent("robot1", 0, "hmia")
         robot.initialise = Message("INITIALIZE", "hmia", "robot1", body={"rank": 0, "team": ["robot1", "robot2"]})
-        fire_one(net, "robot1_ready", world=world, config=config, tokens={"robot1_work": [robot]})
-        robot.outbox.clear()
+        step("robot1", "ready", robot)
+        robot.clear()
         robot.mapping, robot.mine, robot.zones = True, [4], {4: (13.0, -8.1)}
         before = robot.robot.pose
-        step = fire_one(net, "robot1_explore", world=world, config=config, tokens={"robot1_work": [robot]})
-        assert step.outcome == "ok" and 0.0 < step.time <= 1.0 + 1e-9  # at most one step of 1 s
+        result, events = step("robot1", "explore", robot)
+        assert _outcome(events, "robot1_explore") == "ok"
+        assert 0.0 < result.time <= 1.0 + 1e-9  # at most one step of 1 s
         assert robot.robot.pose != before and robot.outbox["hmia"][0].kind == "MAPPED"  # turning towards Z5
         points = robot.outbox["hmia"][0].body["points"]
         assert len(points) > 50 and abs(points).max() < 17  # world points inside the office
     finally:
         world.close()
+
+
+def _auction(robots, until=3.0):
+    """The first seconds of a mission in the paper's office (the auction's start): the
+    scheduler after the run."""
+    world = World(yaml.safe_load(examples.path("bidding", "world.yaml").read_text()))
+    config = load_config(examples.path("bidding", "run.yaml"))
+    scheduler = Scheduler(build(robots), world=world, config=config, seed=1)
+    try:
+        with scheduler:
+            scheduler.run(until=until)
+    finally:
+        world.close()
+    return scheduler
+
+
+def test_states_are_the_runs_and_tokens_stay_plain():
+    run = _auction(2)
+    states = run.firer.agents.states
+    assert {a: type(s) for a, s in states.items()} == {"operator": Operator, "hmia": Interface,
+                                                        "robot1": RobotAgent, "robot2": RobotAgent}
+    for place, tokens in run.tokens.tokens().items():  # work, listen, slots: no state among the tokens
+        if not run.net.places[place].channel:
+            assert all(t is None for t in tokens), place
+
+
+def test_guards_are_asked_again_only_when_what_they_read_changed():
+    """Guard calls per firing do not grow with the team: an agent's send guards are asked
+    again when a message for that peer comes or goes, its step guards when its state's
+    next step may have changed, not after every firing of the agent."""
+    small, large = _auction(2), _auction(5)
+    per_firing = [run.enabled_set.evaluations / run.firer.count for run in (small, large)]
+    assert per_firing[1] < 1.3 * per_firing[0] and per_firing[1] < 6, per_firing

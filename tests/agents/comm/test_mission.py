@@ -8,24 +8,60 @@ from petriflow import examples
 from petriflow.agents.comm.nets import build
 from petriflow.analysis.report import check_net
 from petriflow.io import load_net
-from petriflow.io.yaml import loads_net
 from petriflow.runtime.config import load_config
-from petriflow.testing import fire_one
+from petriflow.runtime.scheduler import Scheduler
 from petriflow.world import load_world
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
+SHIPPED = [(2, "decentralised", False), (2, "centralised", False), (3, "decentralised", False),
+           (3, "centralised", False), (3, "decentralised", True)]
 
-@pytest.mark.parametrize("robots, mode, monitor", [(2, "decentralised", False), (2, "centralised", False),
-                                                   (3, "decentralised", False)])
+
+def fire(net, transition, tokens, *, states=None, world=None, config=None, timeout=60.0):
+    """Fire one transition with its real action, the agents' states given (``{agent:
+    CommAgent}``): ``(result, events, scheduler)``. (``petriflow.testing.fire_one`` takes
+    token data only; the states are the run's, not tokens.)"""
+    scheduler = Scheduler(net, world=world, config=config, seed=0)
+    scheduler.set_tokens({p: list(v) for p, v in tokens.items()})
+    agents = scheduler.firer.agents
+    for agent, state in (states or {}).items():
+        agents.set_state(agent, state, scheduler.index.state_type.get(agent))
+    events = []
+    scheduler.on_event(events.append)
+    with scheduler:
+        result = scheduler.fire_one(transition, timeout=timeout)
+    return result, events, scheduler
+
+
+def outcome(events, transition):
+    return [e.data["outcome"] for e in events if e.kind == "end" and e.transition == transition][-1]
+
+
+@pytest.mark.parametrize("robots, mode, monitor", SHIPPED[:3])
 def test_generated_nets_are_sound_workflow_nets(robots, mode, monitor):
-    result = check_net(loads_net(build(robots, mode, monitor)))
+    result = check_net(build(robots, mode, monitor))
     assert result["workflow_net"] and result["sound"], result["violations"]
 
 
-def test_shipped_nets_are_the_builders():
-    shipped = load_net(examples.path("comm", "comm-decentralised-3.yaml"))
-    assert shipped.structure() == loads_net("run: run.yaml\n" + build(3, "decentralised")).structure()
+@pytest.mark.parametrize("robots, mode, monitor", SHIPPED)
+def test_shipped_nets_are_the_builders(robots, mode, monitor):
+    built = build(robots, mode, monitor)
+    built.run = "run.yaml"
+    shipped = load_net(examples.path("comm", f"{built.id}.yaml"))
+    assert shipped.structure() == built.structure()
+    assert {s.state for s in shipped.subnets.values()} == {"comm.agent"}
+
+
+def test_tokens_of_the_work_loop_carry_no_state():
+    """The state is the run's (ctx.state): the loop, listening and done places hold plain tokens."""
+    from petriflow.runtime.session import run_files
+
+    outcome = run_files(examples.path("comm", "comm-decentralised-2.yaml"), keep_events=True, until=60)
+    carried = [e for e in outcome.events if e.kind in ("start", "end") and e.agent is not None
+               and (e.data.get("inputs") or e.data.get("result") is not None)
+               and not str(e.transition).split("_", 1)[1].startswith("receive")]
+    assert carried == []  # only a receive takes data: the packet from its channel place
 
 
 def test_the_start_up_transitions_one_by_one():
@@ -33,21 +69,23 @@ def test_the_start_up_transitions_one_by_one():
     config = load_config(examples.path("comm", "run.yaml"))
     world = load_world(examples.path("comm", "world.yaml"))
     try:
-        first = fire_one(net, "robot1_characterise", world=world, config=config, tokens={"robot1_start": [None]})
-        assert first.outcome == "ok"
-        state = first.tokens["robot1_c1"][0]
+        _, events, run = fire(net, "robot1_characterise", {"robot1_start": [None]}, world=world, config=config)
+        assert outcome(events, "robot1_characterise") == "ok"
+        state = run.firer.agents.state("robot1")  # ctx.state, kept by the run
         assert state.robot is not None and state.explorer.cell == (0, 0)
-        assert [e.data["data"]["pg"] for e in first.events if e.kind == "custom"] == [[318, 318]]
-        analysed = fire_one(net, "robot1_analyse", world=world, config=config, tokens={"robot1_c1": [state]})
-        report = [e.data["data"] for e in analysed.events if e.kind == "custom"][0]
+        assert [e.data["data"]["pg"] for e in events if e.kind == "custom"] == [[318, 318]]
+        _, events, _ = fire(net, "robot1_analyse", {"robot1_c1": [None]}, states={"robot1": state}, world=world,
+                            config=config)
+        report = [e.data["data"] for e in events if e.kind == "custom"][0]
         assert report["lossless_behind_wall_m"] == 7 and report["range_m"] == pytest.approx(2.0)
-        init = fire_one(net, "robot1_initialise", world=world, config=config, tokens={"robot1_c2": [state]})
-        assert init.tokens["robot1_c3"][0].address == 2
-        history = fire_one(net, "robot1_history", world=world, config=config, tokens={"robot1_c3": [state]})
-        assert set(history.tokens) == {"robot1_idle", "robot1_listen"}
-        step = fire_one(net, "robot1_step", world=world, config=config, tokens={"robot1_idle": [state]},
-                        timeout=60)
-        assert step.outcome == "ok" and state.vertices  # it drove to its cell's centre and mapped a vertex
+        fire(net, "robot1_initialise", {"robot1_c2": [None]}, states={"robot1": state}, world=world, config=config)
+        assert state.address == 2 and state.peers["robot2"].box == "box_robot1_robot2"
+        result, _, _ = fire(net, "robot1_history", {"robot1_c3": [None]}, states={"robot1": state}, world=world,
+                            config=config)
+        assert result.tokens == {"robot1_idle": [None], "robot1_listen": [None]}
+        _, events, _ = fire(net, "robot1_step", {"robot1_idle": [None]}, states={"robot1": state}, world=world,
+                            config=config)
+        assert outcome(events, "robot1_step") == "ok" and state.vertices  # it drove to its cell and mapped a vertex
     finally:
         world.close()
 
@@ -129,21 +167,40 @@ def test_send_and_receive_move_one_message_through_the_channel_place():
     config = load_config(examples.path("comm", "run.yaml"))
     sender = CommAgent("robot1", "robot", address=2, history=History(2))
     sender.peers["robot2"] = Peer("robot2", 128, "box_robot1_robot2")
-    sender.in_range = {"robot2"}
+    sender.hear({"robot2"})
     sender.queue(Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))
-    sent = fire_one(net, "robot1_send_robot2", config=config,
-                    tokens={"robot1_out": [sender], "slot_robot1_robot2": [None]})
-    assert sent.outcome == "ok" and sent.marking["robot1_out"] == 1
-    on_air = [e.data for e in sent.events if e.kind == "message"]
+    sent, events, _ = fire(net, "robot1_send_robot2", {"robot1_out": [None], "slot_robot1_robot2": [None]},
+                           states={"robot1": sender}, config=config)
+    assert outcome(events, "robot1_send_robot2") == "ok" and sent.marking["robot1_out"] == 1
+    assert sent.tokens["robot1_out"] == [None]  # the loop's token carries nothing
+    on_air = [e.data for e in events if e.kind == "message"]
     assert on_air[0]["fate"] == "sent" and on_air[0]["size"] == 8 and on_air[0]["receiver"] == "robot2"
     assert not sender.outbox["robot2"]
     packet = {"size": 8, "payload": 5, "code": 3, "message": Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)])}
     receiver = CommAgent("robot2", "robot", address=128, history=History(128))
     receiver.peers["robot1"] = Peer("robot1", 2, "box_robot2_robot1")
-    got = fire_one(net, "robot2_receive_robot1", config=config,
-                   tokens={"box_robot1_robot2": [packet], "robot2_listen": [receiver]})
-    assert got.outcome == "ok" and got.marking["slot_robot1_robot2"] == 1   # the slot goes back to the sender
+    got, events, _ = fire(net, "robot2_receive_robot1", {"box_robot1_robot2": [packet], "robot2_listen": [None]},
+                          states={"robot2": receiver}, config=config)
+    assert outcome(events, "robot2_receive_robot1") == "ok"
+    assert got.marking["slot_robot1_robot2"] == 1 and got.tokens["robot2_listen"] == [None]  # the slot goes back
     assert receiver.vertices == {0: (0.4, 0.4)}
+
+
+def test_a_send_is_not_enabled_while_nothing_waits_or_the_peer_is_not_heard():
+    from petriflow.agents.comm.agent import CommAgent, Peer
+    from petriflow.agents.comm.framework import History, Message
+
+    net = load_net(examples.path("comm", "comm-decentralised-2.yaml"))
+    sender = CommAgent("robot1", "robot", address=2, history=History(2))
+    sender.peers["robot2"] = Peer("robot2", 128, "box_robot1_robot2")
+    run = Scheduler(net, seed=0)
+    run.set_tokens({"robot1_out": [None], "slot_robot1_robot2": [None]})
+    run.firer.agents.set_state("robot1", sender, CommAgent)
+    assert "robot1_send_robot2" not in run.enabled()
+    sender.queue(Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))  # waiting, but robot2 not heard
+    assert "robot1_send_robot2" not in run.enabled()
+    sender.hear({"robot2"})  # touches outbox/robot2: the kept answer is forgotten
+    assert "robot1_send_robot2" in run.enabled()
 
 
 def test_walls_between_two_agents_are_counted_by_ray_tests():

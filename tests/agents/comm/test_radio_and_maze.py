@@ -82,3 +82,30 @@ def test_the_drive_follows_the_icc_and_the_encoders_count_pulses():
     assert encoders.advance(0.01, 0.0) == (12, 0)  # 0.01 m / 0.785 mm = 12.7 pulses
     encoders.advance(0.001, 0.0)
     assert encoders.left_pulses == math.floor(0.011 / encoders.dpp) == 14  # fractions carry over
+
+
+def test_a_link_out_of_free_space_range_is_refused_without_a_ray_test():
+    """usable() answers as link_rssi() does; a pair beyond the threshold's free-space
+    range (gains included) is refused before its walls are counted."""
+    from petriflow.world import World
+
+    world = World({"plane": True, "gravity": 0.0,
+                   "boxes": [{"id": "w1", "size": [0.04, 2, 0.3], "position": [1, 0, 0.15]}],
+                   "robots": [{"id": "a", "urdf": "petriflow.agents:robots/diffdrive.urdf", "position": [0.5, 0]},
+                              {"id": "b", "urdf": "petriflow.agents:robots/diffdrive.urdf", "position": [1.5, 0]},
+                              {"id": "c", "urdf": "petriflow.agents:robots/diffdrive.urdf", "position": [4.5, 0]}]})
+    try:
+        radio = RadioChannel()
+        radio.bind(world)
+        counted = []
+        between = radio._walls.between
+        radio._walls.between = lambda x, y: counted.append((x, y)) or between(x, y)
+        for a, b in (("a", "b"), ("a", "c"), ("b", "c")):
+            assert radio.usable(a, b) == (radio.link_rssi(a, b) > radio.threshold_dbm)
+        counted.clear()
+        assert not radio.usable("a", "c") and counted == []      # 4 m apart: beyond 2 m, no ray test
+        assert radio.usable("a", "b") and counted == [("a", "b")]  # 1 m through one wall: counted, heard
+        radio.gains_db = {"c": 20}                                 # a 20 dB antenna: 20 m in free space
+        assert radio.usable("a", "c") == (radio.link_rssi("a", "c") > radio.threshold_dbm) is True
+    finally:
+        world.close()
