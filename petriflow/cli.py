@@ -287,7 +287,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         outcome = run_files(args.net, world=args.world, config=args.config, seed=args.seed,
                             until=args.until, trace=args.trace, xes=args.xes, db=args.db,
                             realtime=args.realtime, gui=args.gui, progress=_progress(args),
-                            max_firings=args.max_firings)
+                            max_firings=args.max_firings, metrics=_metric_names(args.metrics),
+                            picture=args.picture)
     result = outcome.result
     summary = {
         "net": outcome.net.id,
@@ -300,6 +301,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         "seed": outcome.seed,
         "marking": result.marking.to_dict(),
         "error": result.error,
+        "metrics": outcome.metrics,
         "written": outcome.written,
     }
     if args.json:
@@ -313,12 +315,32 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"  marking at the end: {_format_marking(result.marking)}")
         if result.error:
             print(f"  error: {result.error}")
+        _print_metrics(outcome.metrics)
         for path in outcome.written:
             print(f"  wrote {path}")
     problem = result.reason in ("failed", "stalled") or (
         outcome.net.final_marking is not None and result.reason != "final"
     )
     return EXIT_PROBLEM if problem else EXIT_OK
+
+
+def _metric_names(given: str | None) -> list[str] | None:
+    """``--metrics``: ``None`` (the configuration's), ``[]`` for 'none', else the names."""
+    if given is None:
+        return None
+    names = [n.strip() for n in given.split(",") if n.strip()]
+    return [] if names == ["none"] else names
+
+
+def _print_metrics(metrics: dict) -> None:
+    """The run's metrics, one per line, aligned."""
+    if not metrics:
+        return
+    print("  metrics:")
+    width = max(len(name) for name in metrics)
+    for name, value in metrics.items():
+        text = "-" if value is None else f"{value:.6g}" if isinstance(value, float) else str(value)
+        print(f"    {name:{width}}  {text}")
 
 
 def cmd_actions(args: argparse.Namespace) -> int:
@@ -454,6 +476,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--realtime", action="store_true", help="pace simulated time to the wall clock")
     run.add_argument("--gui", action="store_true", help="open pybullet's GUI (needs a display)")
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
+    run.add_argument("--metrics", metavar="NAMES",
+                     help="report these registered metrics at the end (comma-separated; 'none': no metric)"
+                          " instead of the ones the run configuration names")
+    run.add_argument("--picture", metavar="OUT.png",
+                     help="draw the world's top view with the robots' trajectories (.png, .svg or .pdf)")
     run.add_argument("--quiet", action="store_true", help="no progress on standard error")
     run.add_argument("--progress-every", type=float, default=30.0, metavar="S",
                      help="off a terminal (a log, CI): a progress line every S wall seconds (default 30)")

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
+
+import pytest
 
 from petriflow.sweep.report import deviation, fixed, text_table
 from tests.conftest import NETS
@@ -82,3 +85,85 @@ def test_small_gaps_of_the_command_line(tmp_path):
                    "transitions: [{id: t, action: core.wait, params: {seconds: 1000}, in: [i], out: [o]}]\n")
     done = _petriflow("run", net)
     assert "too quick to time" in done.stdout and "x real time" not in done.stdout
+
+
+# run reports the scenario's metrics and draws its picture ------------------------------
+
+def test_run_prints_the_metrics_its_run_configuration_names(tmp_path):
+    done = _petriflow("run", NETS / "passage" / "passage.yaml", "--json")
+    assert done.returncode == 0, done.stderr
+    import json
+
+    summary = json.loads(done.stdout)
+    metrics = summary["metrics"]
+    assert set(metrics) == {"time_s", "completed", "blue_enters_s", "red_enters_s"}
+    assert metrics["completed"] == 1 and metrics["time_s"] == summary["time"]
+    assert 0 < metrics["red_enters_s"] < metrics["time_s"]   # a time_of metric, from the run's events
+    text = _petriflow("run", NETS / "passage" / "passage.yaml")
+    assert "  metrics:" in text.stdout and "blue_enters_s" in text.stdout
+
+
+def test_run_metrics_chosen_on_the_command_line_or_none(tmp_path):
+    chosen = _petriflow("run", NETS / "passage" / "passage.yaml", "--metrics", "core.firings", "--json")
+    assert chosen.returncode == 0, chosen.stderr
+    import json
+
+    assert json.loads(chosen.stdout)["metrics"] == {"core.firings": 6}
+    none = _petriflow("run", NETS / "passage" / "passage.yaml", "--metrics", "none")
+    assert none.returncode == 0 and "metrics:" not in none.stdout
+
+
+def test_an_unknown_metric_is_one_line_naming_the_file_and_nothing_is_written(tmp_path):
+    net = tmp_path / "ticker.yaml"
+    net.write_text(TICKER)
+    (tmp_path / "run.yaml").write_text("until: 1\nmetrics:\n  - core.firngs\n")
+    trace = tmp_path / "out" / "t.jsonl"
+    done = _petriflow("run", net, "--trace", trace)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "run.yaml:2" in done.stderr and "core.firings" in done.stderr
+    assert not trace.exists()
+    flag = _petriflow("run", net, "--metrics", "bogus.metric")
+    assert flag.returncode == 2 and "unknown metric 'bogus.metric'" in flag.stderr
+
+
+def test_picture_draws_the_world_and_where_the_robots_went(tmp_path):
+    from petriflow.runtime.session import run_files
+
+    out = tmp_path / "pictures" / "passage.png"
+    outcome = run_files(NETS / "passage" / "passage.yaml", picture=out)
+    assert str(out) in outcome.written and out.stat().st_size > 10_000
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not [p for p in out.parent.iterdir() if p.name != out.name]   # no partial file left
+
+
+def test_trajectories_follow_the_robots(tmp_path):
+    from petriflow.runtime.assembly import open_run, validate
+    from petriflow.runtime.session import prepare
+    from petriflow.runtime.trajectories import Trajectories
+    from petriflow.world import load_world
+
+    prepared = prepare(NETS / "passage" / "passage.yaml")
+    world = load_world(prepared.world)
+    try:
+        binding = validate(prepared.net, prepared.config, binding=prepared.binding, has_world=True)
+        track = Trajectories(every=0.25)
+        with open_run(prepared.net, binding, prepared.config, seed=1, world=world) as scheduler:
+            scheduler.on_instant(track)
+            scheduler.run()
+            track.sample(world, scheduler.now)
+            ends = {agent: world.position(agent) for agent in world.agents}
+        assert set(track.paths) == set(world.agents)
+        for agent, path in track.paths.items():
+            assert path[-1][1:] == pytest.approx(ends[agent])
+            steps = [b[0] - a[0] for a, b in zip(path, path[1:])]
+            assert all(s > 0 for s in steps) and min(steps[:-1]) >= 0.25 - 1e-9
+            assert math.dist(path[0][1:], path[-1][1:]) > 1.0   # they crossed the passage
+    finally:
+        world.close()
+
+
+def test_a_picture_without_a_world_is_refused(tmp_path):
+    net = tmp_path / "ticker.yaml"
+    net.write_text(TICKER)
+    done = _petriflow("run", net, "--until", "1", "--picture", tmp_path / "p.png")
+    assert done.returncode == 2 and "has none" in done.stderr and not (tmp_path / "p.png").exists()

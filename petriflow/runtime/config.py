@@ -14,6 +14,9 @@ or the net's own ``run:`` mapping) or built in code::
       - {kill: robot3, at: 110}                       # agent stops; its actions are cancelled
       - {join: monitor, at: 50}                       # agent starts late
       - {drop_link: [robot1, robot2], at: 10, until: 20}
+    metrics:            # what `petriflow run` prints at the end (a sweep file's syntax)
+      - core.messages
+      - done_at: {metric: core.time_of, transition: done}
 
 Examples:
     >>> config = RunConfig.from_dict({"seed": 3, "faults": [{"kill": "r1", "at": 5}]})
@@ -35,10 +38,11 @@ from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.outcome import Name
 from petriflow.runtime.channels import ChannelModel, build_channel
+from petriflow.runtime.metrics import MetricRef, parse_refs
 
 __all__ = ["RunConfig", "Fault", "FaultKind", "load_config"]
 
-_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall"}
+_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall", "metrics"}
 
 #: Default of :attr:`RunConfig.stall`: simulated seconds a run may step tick by tick
 #: with actions running and no firing starting or ending before it is stopped.
@@ -126,6 +130,9 @@ class RunConfig:
             beside the configuration) or importable module names.
         stall: simulated seconds a run may step with actions running and no firing
             starting or ending before it stops (``stalled``); ``None``: never.
+        metrics: the registered metrics ``petriflow run`` reports at the end (the
+            scenario's own measures: bytes sent, map accuracy...), as a sweep file
+            names them (:func:`petriflow.runtime.metrics.parse_refs`).
 
     The files a configuration names (``world``, ``.py`` action modules) must be in its
     own folder (or below it), or in a folder listed in ``PETRIFLOW_PATH``: a
@@ -142,6 +149,7 @@ class RunConfig:
     actions: list[str] = field(default_factory=list)
     stall: float | None = DEFAULT_STALL
     lines: dict[str, int | None] = field(default_factory=dict, compare=False, repr=False)
+    metrics: list[MetricRef] = field(default_factory=list)
 
     @classmethod
     def from_dict(cls, data: Any, path: str | None = None, *, base: str | None = None,
@@ -183,12 +191,14 @@ class RunConfig:
         lines = {f"faults/{i}": getattr(entry, "line", None) for i, entry in enumerate(entries)}
         lines.update({f"channels/{name}": getattr(channels, "key_lines", {}).get(name) for name in channels})
         lines["actions"] = getattr(data, "key_lines", {}).get("actions")
+        lines["metrics"] = getattr(data, "key_lines", {}).get("metrics")
         lines = {key: at or getattr(data, "key_lines", {}).get(key.split("/")[0]) or line
                  for key, at in lines.items()}
         world, located = _files(data, folder, fail)
+        metrics = [] if data.get("metrics") is None else parse_refs(data["metrics"], fail)
         config = cls(seed, None if until is None else float(until), float(dt), world,
                      {str(k): dict(v) for k, v in channels.items()}, faults, path, located,
-                     None if stall is None else float(stall), lines)
+                     None if stall is None else float(stall), lines, metrics)
         try:
             config.channel_models()  # fail early on a bad model
         except NetFormatError as exc:
@@ -280,8 +290,11 @@ class RunConfig:
             if f.until is not None:
                 entry["until"] = f.until
             faults.append(entry)
-        return {"seed": self.seed, "until": self.until, "dt": self.dt, "world": self.world,
+        data = {"seed": self.seed, "until": self.until, "dt": self.dt, "world": self.world,
                 "channels": self.channels, "faults": faults, "actions": list(self.actions), "stall": self.stall}
+        if self.metrics:
+            data["metrics"] = [{m.name: {"metric": m.metric, **m.params}} for m in self.metrics]
+        return data
 
 
 def _times(data: Any, fail: Callable[..., Any]) -> tuple[int, Any, Any, Any]:

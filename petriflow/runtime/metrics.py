@@ -59,7 +59,8 @@ from typing import Any
 
 from petriflow.errors import PetriflowError
 
-__all__ = ["RunRecord", "register", "messages", "messages_per_agent", "messages_per_channel", "cpu_s_per_sim_s"]
+__all__ = ["RunRecord", "MetricRef", "register", "parse_refs", "measure", "plain_value", "messages",
+           "messages_per_agent", "messages_per_channel", "cpu_s_per_sim_s"]
 
 
 @dataclass
@@ -265,3 +266,108 @@ def register(registry: Any) -> None:
     ):
         registry.register_metric(name, function, events=events,
                                  wall_clock=name in ("core.wall_s", "core.cpu_s_per_sim_s"))
+
+
+# Naming metrics in files, and measuring them -------------------------------------------
+
+@dataclass(frozen=True)
+class MetricRef:
+    """A metric a file asks for: reported as ``name``, the registered ``metric`` with ``params``."""
+
+    name: str
+    metric: str
+    params: dict[str, Any] = field(default_factory=dict)
+
+
+_REF_HELP = ("each entry is a registered metric name, or {name: metric} or"
+             " {name: {metric: NAME, PARAM: VALUE}}")
+
+
+def parse_refs(given: Any, fail: Any, key: str = "metrics") -> list[MetricRef]:
+    """The metrics a sweep file or a run configuration names, checked for form (not
+    against a registry). ``fail(message, item=..., key=...)`` raises the file's error.
+
+    Examples:
+        >>> def fail(message, **where): raise ValueError(message)
+        >>> [r.name for r in parse_refs(["core.end_time", {"bytes": "core.messages"}], fail)]
+        ['core.end_time', 'bytes']
+        >>> parse_refs([{"t": {"metric": "core.time_of", "transition": "done"}}], fail)[0].params
+        {'transition': 'done'}
+    """
+    import re
+
+    entries: list[tuple[Any, Any]] = []
+    if isinstance(given, dict):
+        entries = list(given.items())
+    elif isinstance(given, list) and given:
+        for entry in given:
+            if isinstance(entry, str):
+                entries.append((entry, entry))
+            elif isinstance(entry, dict) and len(entry) == 1:
+                entries.append(next(iter(entry.items())))
+            else:
+                fail(f"{key}: {_REF_HELP}", item=entry, key=key)
+    else:
+        fail(f"{key} must be a non-empty list or mapping of registered metrics", key=key)
+    refs: list[MetricRef] = []
+    for name, spec in entries:
+        if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z_][\w.\-]*", name):
+            fail(f"{key}: {name!r} is not a metric name", key=key)
+        if isinstance(spec, str):
+            metric, params = spec, {}
+        elif isinstance(spec, dict) and isinstance(spec.get("metric"), str):
+            metric, params = spec["metric"], {k: v for k, v in spec.items() if k != "metric"}
+            if not _plain(params):
+                fail(f"{key}: {name}: parameters must be plain data", item=spec, key=key)
+        else:
+            fail(f"{key}: {name}: give a registered metric name or {{metric: NAME, ...}}", item=spec, key=key)
+        if any(r.name == name for r in refs):
+            fail(f"{key}: {name!r} is listed twice", key=key)
+        refs.append(MetricRef(name, metric, dict(params)))
+    return refs
+
+
+def _plain(value: Any) -> bool:
+    """Whether ``value`` is plain data (what a YAML file holds)."""
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return True
+    if isinstance(value, (list, tuple)):
+        return all(_plain(v) for v in value)
+    if isinstance(value, dict):
+        return all(isinstance(k, str) and _plain(v) for k, v in value.items())
+    return False
+
+
+def plain_value(name: str, value: Any, into: dict[str, Any]) -> None:
+    """Store a metric's value in ``into`` as plain data: numbers, text or ``None``; a
+    mapping flattened to ``name.key``; non-finite floats as ``None``."""
+    import math
+
+    if isinstance(value, dict):
+        for key, item in value.items():
+            plain_value(f"{name}.{key}", item, into)
+        return
+    if hasattr(value, "item") and not isinstance(value, (str, bytes)):  # numpy scalars
+        value = value.item()
+    if isinstance(value, bool):
+        value = int(value)
+    if isinstance(value, float) and not math.isfinite(value):
+        value = None
+    if value is not None and not isinstance(value, (int, float, str)):
+        raise PetriflowError(f"metric {name}: returned {type(value).__name__}, not a number, text or mapping")
+    into[name] = value
+
+
+def measure(resolved: list[tuple[MetricRef, Any]], record: RunRecord) -> dict[str, Any]:
+    """Each metric of ``resolved`` (``(ref, MetricSpec)`` pairs) computed on ``record``,
+    as plain values under the refs' names (mappings flattened)."""
+    measured: dict[str, Any] = {}
+    for ref, spec in resolved:
+        try:
+            value = spec.load()(record, **ref.params)
+        except PetriflowError as exc:
+            raise PetriflowError(f"metric {ref.name} ({spec.name}): {exc}") from None
+        except Exception as exc:
+            raise PetriflowError(f"metric {ref.name} ({spec.name}): {type(exc).__name__}: {exc}") from None
+        plain_value(ref.name, value, measured)
+    return measured

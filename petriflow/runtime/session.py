@@ -47,6 +47,7 @@ from petriflow.runtime.config import RunConfig, load_config
 from petriflow.runtime.journal import Journal, JournalError
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.scheduler import RunResult, Scheduler
+from petriflow.runtime.summary import RunExtras, extras_for
 from petriflow.runtime.trace import Event, TraceWriter, XesWriter, read_trace
 
 __all__ = ["run", "run_files", "resume", "prepare", "Prepared", "RunOutcome", "Progress", "read_trace"]
@@ -74,6 +75,10 @@ class RunOutcome:
     wall: float
     written: list[str] = field(default_factory=list)
     seed: int | None = None
+    #: the metrics the run configuration (or ``metrics=``) asked for, by name
+    metrics: dict[str, Any] = field(default_factory=dict)
+    #: CPU seconds of the run itself (``time.process_time``), ``None`` when not measured
+    cpu: float | None = None
 
     @property
     def realtime_factor(self) -> float:
@@ -337,12 +342,25 @@ def _observed_run(scheduler: Scheduler, net: Net, *, journal: Journal | None, tr
 
 def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, Any], *,
              journal: Journal | None, trace: Path | None, xes: Path | None, realtime: bool, gui: bool,
-             progress: bool | float, max_firings: int | None, keep_events: bool = False) -> RunOutcome:
+             progress: bool | float, max_firings: int | None, keep_events: bool = False,
+             extras: RunExtras | None = None) -> RunOutcome:
+    extras = extras or RunExtras()
+    keep = keep_events or extras.needs_events()
     with open_run(net, binding, config, seed=inputs["seed"], world_data=_world_data(inputs),
                   world_file=inputs.get("world_file"), world_base=inputs.get("world_base"), gui=gui,
                   realtime=realtime) as scheduler:
+        if inputs.get("poses"):  # the world's body poses as trace events (petriflow.runtime.poses)
+            from petriflow.runtime.poses import PoseSampler
+
+            scheduler.on_instant(PoseSampler(inputs["poses"]))
+        extras.watch(scheduler)
+        cpu = wallclock.process_time()
         outcome = _observed_run(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
-                                keep_events=keep_events, until=inputs["until"], max_firings=max_firings)
+                                keep_events=keep, until=inputs["until"], max_firings=max_firings)
+        outcome.cpu = wallclock.process_time() - cpu
+        extras.finish(scheduler, outcome, config)
+    if not keep_events:
+        outcome.events = []
     if journal is not None:
         journal.finish()
         outcome.written.append(str(journal.path))
@@ -364,6 +382,17 @@ def _inputs(prepared: Prepared, net_path: Path, seed: int | None, until: float |
     }
 
 
+def _pose_interval(every: Any) -> float:
+    """``poses``: simulated seconds between pose samples, checked (> 0)."""
+    from petriflow import limits
+    from petriflow.errors import PetriflowError
+
+    seconds = limits.check_seconds(every, "--poses")
+    if seconds <= 0:
+        raise PetriflowError(f"--poses must be a number of seconds > 0, got {every!r}")
+    return seconds
+
+
 def _make_folders(*outputs: str | Path | None) -> None:
     """Create the folders the output files go into (before anything is written)."""
     for output in outputs:
@@ -378,13 +407,19 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
               seed: int | None = None, until: float | None = None, trace: str | Path | None = None,
               xes: str | Path | None = None, db: str | Path | None = None, realtime: bool = False,
               gui: bool = False, registry: Registry | None = None, progress: bool | float = False,
-              max_firings: int | None = None, keep_events: bool = False) -> RunOutcome:
+              max_firings: int | None = None, keep_events: bool = False, metrics: list[str] | None = None,
+              picture: str | Path | None = None, poses: float | None = None) -> RunOutcome:
     """Run the net in ``net_path`` (what ``petriflow run`` does).
 
     The run configuration is ``config``, else the one the net names, else
     ``run.yaml`` beside the net; ``world``, ``seed`` and ``until`` override what the
     configuration says. ``progress``: ``True`` shows a live line on a terminal; a
     number of seconds also prints a line that often off a terminal (a log, CI).
+    ``outcome.metrics`` holds the metrics the configuration names (``metrics``: these
+    registered metrics instead); ``picture`` draws the world's top view with the
+    robots' trajectories at the end (see :mod:`petriflow.runtime.summary`). ``poses``:
+    record the world's body poses as ``pose`` events every so many simulated seconds
+    (:mod:`petriflow.runtime.poses`; what ``petriflow view`` draws the world from).
 
     Raises:
         NetFormatError: a file is missing or malformed, an action is unknown...
@@ -396,20 +431,26 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
                        has_world=prepared.world is not None)
     inputs = _inputs(prepared, net_path, seed, until)
     inputs["max_firings"] = max_firings
+    if poses is not None:  # journaled, so a resumed run samples them too
+        inputs["poses"] = _pose_interval(poses)
     inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())
                          for name, path in (("trace", trace), ("xes", xes))}
+    extras = extras_for(prepared.config, metrics=metrics, picture=picture, registry=prepared.binding.registry)
+    if picture is not None and prepared.world is None:
+        raise NetFormatError("--picture draws the run's world, and this run has none (give --world, or a run"
+                             " configuration with world:)", path=str(net_path))
     # everything is checked before the first file is made: the world too (a journal
     # must never hold a run that cannot start)
-    _check_outputs({"--trace": trace, "--xes": xes, "--db": db},
+    _check_outputs({"--trace": trace, "--xes": xes, "--db": db, "--picture": picture},
                    [net_path, prepared.world, prepared.config.path])
     _world_data(inputs)
-    _make_folders(trace, xes, db)
+    _make_folders(trace, xes, db, picture)
     journal = Journal(db, inputs) if db is not None else None
     try:
         return _execute(prepared.net, binding, prepared.config, inputs, journal=journal,
                         trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
                         realtime=realtime, gui=gui, progress=progress, max_firings=max_firings,
-                        keep_events=keep_events)
+                        keep_events=keep_events, extras=extras)
     except BaseException:
         if journal is not None and journal.journaled == 0:  # it never started: leave no journal behind
             journal.close()
@@ -451,7 +492,8 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
         binding = validate(net, config, registry=registry, path=inputs["net_file"])
         return _execute(net, binding, config, inputs, journal=journal,
                         trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
-                        realtime=realtime, gui=gui, progress=progress, max_firings=inputs.get("max_firings"))
+                        realtime=realtime, gui=gui, progress=progress, max_firings=inputs.get("max_firings"),
+                        extras=extras_for(config, registry=binding.registry))
     finally:
         journal.close()
 
