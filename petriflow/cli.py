@@ -254,7 +254,7 @@ def cmd_export(args: argparse.Namespace) -> int:
                    " tokens: the marking it reaches")
         print(witness["message"])
     export_net(net, args.output, format, marking=marking, highlight=highlight, caption=caption,
-               rankdir=args.rankdir, size=size)
+               rankdir=args.rankdir, size=size, fold=args.fold)
     print(f"wrote {args.output}")
     return EXIT_OK
 
@@ -449,6 +449,11 @@ def build_parser() -> argparse.ArgumentParser:
                         help="pictures: left to right, top to bottom, or auto (top to bottom when left to"
                         " right would be too wide; the default)")
     export.add_argument("--size", metavar="W,H", help="pictures: at most this size in inches (PNG at 150 dpi)")
+    folding = export.add_mutually_exclusive_group()
+    folding.add_argument("--fold", dest="fold", action="store_true", default=None,
+                         help="pictures: one box per agent subnet, the places between agents as circles"
+                              " (the default for team nets of over 150 nodes)")
+    folding.add_argument("--full", dest="fold", action="store_false", help="pictures: every node, however big")
     export.add_argument("--marking", help="marking to draw, as JSON (default: initial)")
     export.add_argument("--highlight", metavar="IDS", help="comma-separated node ids to highlight")
     export.add_argument("--violation", action="store_true",

@@ -510,6 +510,7 @@ def export_net(
     running: Mapping[str, Mapping[str, int]] | None = None,
     rankdir: str = "auto",
     size: tuple[float, float] | None = None,
+    fold: bool | None = None,
 ) -> None:
     """Write ``net`` to ``path`` as ``pnml``, ``yaml``, ``dot``, ``svg`` or ``png``.
 
@@ -530,6 +531,10 @@ def export_net(
         rankdir: ``LR``, ``TB``, or ``auto``: left to right unless that layout would be
             more than :data:`AUTO_RATIO` times wider than high, then top to bottom.
         size: for pictures, the largest size ``(width, height)`` in inches.
+        fold: for pictures and DOT, draw one box per agent subnet
+            (:mod:`petriflow.fold`); ``None``: fold a big team net
+            (:func:`~petriflow.fold.should_fold`) unless something is highlighted or
+            running; ``False``: every node.
 
     Raises:
         PetriflowError: unknown format, a format the file's ending contradicts,
@@ -554,6 +559,21 @@ def export_net(
             save_net(net, path, format)
         except OSError as exc:
             raise PetriflowError(f"{path}: cannot write: {getattr(exc, 'strerror', None) or exc}") from None
+        return
+    from petriflow.fold import folded_dot, should_fold
+
+    if fold is None:
+        fold = not highlight and not running and should_fold(net)
+    if fold:
+        source = folded_dot(net, marking, rankdir="LR" if rankdir == "auto" else rankdir)
+        if rankdir == "auto":
+            extent = _layout_size(source)
+            if extent is not None and extent[0] > AUTO_RATIO * extent[1]:
+                source = folded_dot(net, marking, rankdir="TB")
+        if format == "dot":
+            _write(path, source.encode("utf-8"))
+        else:
+            render(source, path, format, size=size)
         return
     options = {"highlight": highlight, "caption": caption, "running": running}
     source = to_dot(net, marking, rankdir="LR" if rankdir == "auto" else rankdir, **options)

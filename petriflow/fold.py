@@ -1,0 +1,174 @@
+"""Folded drawings of big nets: one box per agent, the places between agents as circles.
+
+A team net (20 robots, each a subnet with its work loop and a mailbox) drawn node by node
+is a hairball: thousands of arcs into a few hub places. Folded, each agent subnet is one
+box naming the agent, its label, how many places and transitions it holds and the tokens
+in them; a place stays a circle when it joins more than one agent or the envelope (a
+mailbox other agents send into, a shared resource, the net's source and sink);
+transitions outside every subnet stay as they are. Arcs between the same two nodes are
+drawn once, with how many they stand for.
+
+:func:`folded_dot` makes the DOT text; ``petriflow export NET -o net.png --fold`` draws
+it, and :func:`should_fold` says when ``export`` folds without being asked (a net of more
+than :data:`FOLD_ABOVE` nodes that has agent subnets). Layout stays Graphviz's ``dot``:
+folding is what removes the hairball, and ``dot`` lays out the folded graph (tens of
+nodes) cleanly.
+
+Examples:
+    >>> from petriflow.net import Net
+    >>> net = Net("team")
+    >>> for r in ("r1", "r2"):
+    ...     _ = net.add_subnet(r, agent=r)
+    ...     _ = net.add_place(f"{r}_idle", tokens=1, subnet=r)
+    ...     _ = net.add_transition(f"{r}_send", subnet=r)
+    ...     _ = net.add_arc(f"{r}_idle", f"{r}_send"); _ = net.add_arc(f"{r}_send", f"{r}_idle")
+    >>> _ = net.add_place("box", subnet="r2", channel="radio")
+    >>> _ = net.add_arc("r1_send", "box"); _ = net.add_transition("r2_take", subnet="r2")
+    >>> _ = net.add_arc("box", "r2_take")
+    >>> source = folded_dot(net)
+    >>> '"agent:r1" -> "box"' in source, '"box" -> "agent:r2"' in source, '"r1_idle"' in source
+    (True, True, False)
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from typing import Mapping
+
+from petriflow.export import _CLUSTER_COLOURS, _FONT, _html, _quote, _tokens_text
+from petriflow.net import Net
+
+__all__ = ["folded_dot", "should_fold", "FOLD_ABOVE"]
+
+#: ``export`` folds a picture without being asked when the net has more nodes than this
+#: and at least two agent subnets.
+FOLD_ABOVE = 150
+#: Arcs between one node and this many agents or more are drawn as a note, not arcs.
+FAN = 4
+
+
+def should_fold(net: Net) -> bool:
+    """Whether a picture of ``net`` is folded by default (see :data:`FOLD_ABOVE`)."""
+    return len(net.places) + len(net.transitions) > FOLD_ABOVE and len(net.subnets) >= 2
+
+
+def _groups(net: Net) -> tuple[dict[str, str], set[str]]:
+    """``({node: drawn node}, kept places)``: what each node is drawn as."""
+    owner: dict[str, str] = {}
+    for t in net.transitions.values():
+        owner[t.id] = f"agent:{t.subnet}" if t.subnet is not None else t.id
+    neighbours: dict[str, set[str]] = {p: set() for p in net.places}
+    for arc in net.arcs:
+        place, transition = (arc.source, arc.target) if arc.source in net.places else (arc.target, arc.source)
+        neighbours[place].add(owner[transition])
+    kept = set()
+    for p in net.places.values():
+        home = f"agent:{p.subnet}" if p.subnet is not None else None
+        if home is None or (p.channel is not None and neighbours[p.id] - {home}):
+            kept.add(p.id)
+            owner[p.id] = p.id
+        else:
+            owner[p.id] = home
+    return owner, kept
+
+
+def _arcs(net: Net, owner: dict[str, str]) -> tuple[Counter, dict[str, str]]:
+    """The folded arcs (``{(source, target): arcs folded into it}``) and the notes that
+    replace fans: a place that :data:`FAN` or more agents send into (or take from) gets
+    "from N agents" instead of N arcs, and an agent coupled to that many other agents
+    through their places gets "coupled to N agents" instead of arcs between boxes."""
+    arcs: Counter[tuple[str, str]] = Counter()
+    for arc in net.arcs:
+        source, target = owner[arc.source], owner[arc.target]
+        if source != target:
+            arcs[source, target] += 1
+    agent = lambda node: node.startswith("agent:")  # noqa: E731
+    notes: dict[str, list[str]] = {}
+    for node in {n for pair in arcs for n in pair if not agent(n)}:
+        for side, word in ((0, "from"), (1, "to")):
+            fan = [pair for pair in arcs if pair[1 - side] == node and agent(pair[side])]
+            if len(fan) >= FAN:
+                notes.setdefault(node, []).append(f"{word} {len(fan)} agents")
+                for pair in fan:
+                    del arcs[pair]
+    coupled: dict[str, set[str]] = {}
+    for source, target in arcs:
+        if agent(source) and agent(target):
+            coupled.setdefault(source, set()).add(target)
+            coupled.setdefault(target, set()).add(source)
+    for node, others in coupled.items():
+        if len(others) >= FAN:
+            notes.setdefault(node, []).append(f"coupled to {len(others)} agents")
+    for pair in [p for p in arcs if agent(p[0]) and agent(p[1])]:
+        if len(coupled[pair[0]]) >= FAN or len(coupled[pair[1]]) >= FAN:
+            del arcs[pair]
+    return arcs, {node: ", ".join(words) for node, words in notes.items()}
+
+
+def _xlabel(name: str, note: str | None) -> str:
+    """The small text beside a kept place: its name and its note."""
+    text = _html(name) + (f"<BR/><I>{_html(note)}</I>" if note else "")
+    return f'<FONT POINT-SIZE="8">{text}</FONT>'
+
+
+def _components(net: Net, owner: dict[str, str], arcs: Counter) -> int:
+    """How many pieces the folded drawing falls into (Graphviz packs them in a grid:
+    with about three times as many rows as columns left to right, where the pieces are
+    wide, and the other way top to bottom)."""
+    import networkx as nx
+
+    graph = nx.Graph()
+    graph.add_nodes_from(set(owner.values()))
+    graph.add_edges_from(arcs)
+    return nx.number_connected_components(graph)
+
+
+def folded_dot(net: Net, marking: Mapping[str, int] | None = None, *, title: str | None = None,
+               rankdir: str = "LR") -> str:
+    """Graphviz DOT text of ``net`` folded (see the module)."""
+    marking = net.initial_marking if marking is None else net.check_marking(marking)
+    owner, kept = _groups(net)
+    arcs, notes = _arcs(net, owner)
+    title = (net.label or net.id) if title is None else title
+    out = [f"digraph {_quote(net.id)} {{"]
+    label = f' label=<<B>{_html(title)}</B><BR/><FONT POINT-SIZE="10">folded: one box per agent</FONT>>,' \
+            f' labelloc=t,' if title else ""
+    pieces = _components(net, owner, arcs)
+    columns = max(1, round(math.sqrt(pieces / 3 if rankdir == "LR" else pieces * 1.5)))
+    out.append(f'  graph [rankdir={rankdir}, nodesep=0.25, ranksep=0.6,{label}'
+               f' fontname="{_FONT}", fontsize=14, pad=0.2, pack=true, packmode="array_u{columns}"];')
+    out.append(f'  node [fontname="{_FONT}", fontsize=10];')
+    out.append(f'  edge [fontname="{_FONT}", fontsize=9, arrowsize=0.6, penwidth=0.9, color="#555555"];')
+    for number, subnet in enumerate(net.subnets.values()):
+        fill, border = _CLUSTER_COLOURS[number % len(_CLUSTER_COLOURS)]
+        places, transitions = net.nodes_of(subnet.id)
+        inside = [p for p in places if p not in kept]
+        tokens = sum(marking[p] for p in inside)
+        name = subnet.agent or subnet.id
+        text = f"<B>{_html(name)}</B>"
+        if subnet.label and subnet.label != name:
+            text += f'<BR/><FONT POINT-SIZE="9">{_html(subnet.label)}</FONT>'
+        text += (f'<BR/><FONT POINT-SIZE="8">{len(inside)} places, {len(transitions)} transitions'
+                 f'{f", {tokens} token" + ("s" if tokens != 1 else "") if tokens else ""}</FONT>')
+        if f"agent:{subnet.id}" in notes:
+            text += f'<BR/><FONT POINT-SIZE="8"><I>{_html(notes[f"agent:{subnet.id}"])}</I></FONT>'
+
+        out.append(f'  {_quote("agent:" + subnet.id)} [shape=box, style="rounded,filled", fillcolor="{fill}",'
+                   f' color="{border}", penwidth=1.4, label=<{text}>];')
+    for p in net.places.values():
+        if p.id in kept:
+            count = marking[p.id]
+            inner = _tokens_text(count) if count else ""
+            out.append(f'  {_quote(p.id)} [shape=circle, fixedsize=true, width=0.3, height=0.3,'
+                       f' label=<{inner}>, xlabel=<{_xlabel(p.label or p.id, notes.get(p.id))}>];')
+    for t in net.transitions.values():
+        if t.subnet is None:
+            note = f'<BR/><FONT POINT-SIZE="8"><I>{_html(notes[t.id])}</I></FONT>' if t.id in notes else ""
+            out.append(f'  {_quote(t.id)} [shape=box, style="filled", fillcolor="#dfe6ee", height=0.3,'
+                       f' label=<<B>{_html(t.label or t.id)}</B>{note}>];')
+    for (source, target), count in arcs.items():
+        attrs = f' [label="{count}"]' if count > 1 else ""
+        out.append(f"  {_quote(source)} -> {_quote(target)}{attrs};")
+    out.append("}")
+    return "\n".join(out) + "\n"
