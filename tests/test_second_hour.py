@@ -167,3 +167,14 @@ def test_a_picture_without_a_world_is_refused(tmp_path):
     net.write_text(TICKER)
     done = _petriflow("run", net, "--until", "1", "--picture", tmp_path / "p.png")
     assert done.returncode == 2 and "has none" in done.stderr and not (tmp_path / "p.png").exists()
+
+
+def test_the_inspection_example_runs_on_its_shipped_site():
+    """nets/examples/inspection.yaml needs a camera and two marked robots: its run.yaml
+    names the shipped site, so it runs as it is (the camera finds both robots)."""
+    from petriflow.runtime.session import run_files
+
+    outcome = run_files(NETS / "examples" / "inspection.yaml", until=2.0, keep_events=True)
+    assert outcome.result.error is None and outcome.result.reason == "until"
+    ended = {e.transition for e in outcome.events if e.kind == "end" and e.data.get("outcome", "ok") == "ok"}
+    assert {"capture", "segment", "dispatch"} <= ended
