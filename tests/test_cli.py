@@ -41,7 +41,7 @@ def test_info_lists_subnets_and_actions(capsys):
     assert code == 0
     assert (data["places"], data["transitions"]) == (9, 8)
     assert set(data["subnets"]) == {"camera", "planner", "red", "blue"}
-    assert data["actions"]["capture"] == "vision.capture"
+    assert data["actions"]["capture"] == "smart.capture"
 
 
 def test_simulate_is_deterministic_for_a_seed(capsys):
