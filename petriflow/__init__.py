@@ -43,6 +43,7 @@ from petriflow.runtime.resources import Liveness, ResourceContext
 from petriflow.runtime.scheduler import RunResult, Scheduler
 from petriflow.runtime.session import RunOutcome, run
 from petriflow.workflow import add_operator
+from petriflow.view import view
 
 __version__ = "0.1.0"
 
@@ -53,5 +54,5 @@ __all__ = [
     "RealtimeClock", "Registry", "ResourceContext", "RunConfig", "RunOutcome", "RunResult", "Scheduler",
     "Simulation", "SimulatedClock", "Status", "StopReason", "Subnet", "Transition", "UnknownElementError",
     "action", "add_operator", "default_registry", "enabled", "fire", "fire_sequence", "guard", "load_net",
-    "metric", "run", "save_net",
+    "metric", "run", "save_net", "view",
 ]

@@ -271,6 +271,9 @@ def _progress(args: argparse.Namespace) -> bool | float:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from petriflow.runtime.session import resume, run_files
+    from petriflow.view.command import run_view_finish, run_view_start
+
+    made_up_trace = run_view_start(args)  # --view: a trace (and poses) for the page
 
     if args.resume:
         if args.db is None:
@@ -285,10 +288,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.max_firings is not None and args.max_firings < 0:
             raise PetriflowError(f"--max-firings must be >= 0, got {args.max_firings}")
         outcome = run_files(args.net, world=args.world, config=args.config, seed=args.seed,
-                            until=args.until, trace=args.trace, xes=args.xes, db=args.db,
+                            until=args.until, trace=args.trace, xes=args.xes, db=args.db, poses=args.poses,
                             realtime=args.realtime, gui=args.gui, progress=_progress(args),
                             max_firings=args.max_firings, metrics=_metric_names(args.metrics),
                             picture=args.picture)
+    run_view_finish(args, outcome, made_up_trace)
     result = outcome.result
     summary = {
         "net": outcome.net.id,
@@ -480,6 +484,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--resume", action="store_true", help="continue the killed run journaled in --db")
     run.add_argument("--realtime", action="store_true", help="pace simulated time to the wall clock")
     run.add_argument("--gui", action="store_true", help="open pybullet's GUI (needs a display)")
+    from petriflow.view.command import add_parser as add_view, add_run_options
+
+    add_run_options(run)
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     run.add_argument("--metrics", metavar="NAMES",
                      help="report these registered metrics at the end (comma-separated; 'none': no metric)"
@@ -525,6 +532,7 @@ def build_parser() -> argparse.ArgumentParser:
     from petriflow.sweep.command import add_parser as add_sweep
 
     add_sweep(sub)
+    add_view(sub)
     return parser
 
 

@@ -51,6 +51,8 @@ class EventKind(Name):
     """A cancellation region withdraws tokens and cancels running actions."""
     CUSTOM = "custom"
     """Something an action reported (``ctx.emit``)."""
+    POSE = "pose"
+    """Where the world's bodies are (optional sampling, :mod:`petriflow.runtime.poses`)."""
     STOP = "stop"
     """The run ends: why, firings, marking, what was still running."""
 
@@ -246,6 +248,7 @@ _NEEDS = {
             "produced": _counts},
     "cancel": {"withdrawn": _counts},
     "message": {"place": lambda v: isinstance(v, str), "fate": lambda v: isinstance(v, str)},
+    "pose": {"poses": lambda v: isinstance(v, dict)},
 }
 
 
