@@ -43,9 +43,17 @@ nets with a large bounded part, a deadlock beyond the state limit) and on any PN
 files named after it; a file with an ``answer.json`` beside it (the oracle corpus) has
 its states, edges, bounds, safeness and deadlock checked against it.
 
+``--reductions`` runs ``check --method`` (``auto``, ``stubborn``) beside
+``--method explicit`` and PM4Py's Woflan on the team nets of seed 004
+(``petriflow.agents.bidding.nets.build``, 5, 20 and 100 robots) and the textbook
+philosophers (one fork at a time, 100 of them: a deadlock), each in a fresh process
+(CPU seconds of ``check_net``, peak RSS, the markings each search stored).
+
 Usage::
 
     python bench/statespace.py                  # the full table (a few minutes)
+    python bench/statespace.py --reductions     # check's reductions (about 20 minutes)
+    python bench/statespace.py --reductions --quick   # 5 robots and the philosophers, no Woflan
     python bench/statespace.py --check          # check's steps on the stress nets
     python bench/statespace.py --check tests/data/oracle/mcc/*/model.pnml
     python bench/statespace.py --quick          # small sizes only (a smoke run)
@@ -381,8 +389,113 @@ def check_main(paths: list[str], quick: bool, out: str | None) -> int:
     return 1 if any("mismatch" in row for row in rows) else 0
 
 
+def reduction_cases(quick: bool) -> list[tuple[str, str, Callable[[], Net]]]:
+    """(name, method, factory) for ``--reductions``: the team nets, the philosophers."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from tests.analysis import nets
+
+    def bidding(robots: int, deployment: str) -> Callable[[], Net]:
+        def make() -> Net:
+            from petriflow.agents.bidding.nets import build
+
+            return build(robots, deployment)
+        return make
+
+    found = [
+        ("bidding-autonomous-5", "explicit", bidding(5, "autonomous")),
+        ("bidding-autonomous-5", "auto", bidding(5, "autonomous")),
+        ("philosophers (one fork at a time) 100", "stubborn", lambda: nets.philosophers_one_fork(100)),
+        ("bidding-autonomous-20", "explicit", bidding(20, "autonomous")),
+        ("bidding-autonomous-20", "auto", bidding(20, "autonomous")),
+        ("bidding-random-20", "auto", bidding(20, "random")),
+    ]
+    if not quick:
+        found += [("bidding-autonomous-100", "auto", bidding(100, "autonomous"))]
+    return found if not quick else found[:3]
+
+
+def _reduction_child(make: Callable[[], Net], method: str, max_states: int, pipe) -> None:
+    from petriflow.analysis.reachability import warm_up
+    from petriflow.analysis.report import check_net, exit_code
+
+    warm_up()
+    net = make()
+    start = time.process_time()
+    result = check_net(net, method=method, max_states=max_states)
+    seconds = time.process_time() - start
+    pipe.send({"places": len(net.places), "transitions": len(net.transitions),
+               "cpu_s": round(seconds, 2),
+               "verdict": {0: "OK", 1: "PROBLEM", 2: "UNDECIDED"}[exit_code(result)],
+               "sound": result.get("sound"), "deadlock_free": result.get("deadlock_free"),
+               "states": result.get("states"), "visited": result.get("states_visited"),
+               "methods": result.get("methods"),
+               "peak_rss_mib": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)})
+
+
+def _woflan_child(make: Callable[[], Net], pipe) -> None:
+    """PM4Py's Woflan on the same net (soundness), CPU seconds."""
+    from pm4py.algo.analysis.woflan import algorithm as woflan
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from tests.analysis.strategies import to_pm4py
+
+    net = make()
+    pm_net, initial, places = to_pm4py(net)
+    from pm4py.objects.petri_net.obj import Marking as PMMarking
+
+    final = PMMarking({places["o"]: 1})
+    start = time.process_time()
+    sound = woflan.apply(pm_net, initial, final, parameters={"print_diagnostics": False})
+    pipe.send({"cpu_s": round(time.process_time() - start, 2), "sound": bool(sound),
+               "peak_rss_mib": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)})
+
+
+def _in_child(target, args, limit: float) -> dict[str, Any]:
+    context = multiprocessing.get_context("fork")
+    receive, send = context.Pipe(duplex=False)
+    child = context.Process(target=target, args=args + (send,))
+    child.start()
+    if receive.poll(limit):
+        row = receive.recv()
+    else:
+        row = {"error": f"over {limit:.0f} s"}
+    child.kill()
+    child.join()
+    return row
+
+
+def reductions_main(quick: bool, out: str | None, limit: float = 600.0) -> int:
+    """``--reductions``: ``check --method`` side by side with the explicit explorer and
+    PM4Py's Woflan on the team nets and the philosophers."""
+    rows = []
+    print(f"{'net':42} {'method':9} {'verdict':9} {'CPU s':>8} {'RSS MiB':>8}  markings stored")
+    for name, method, make in reduction_cases(quick):
+        row = _in_child(_reduction_child, (make, method, 2_000_000), limit)
+        row.update(net=name, method=method)
+        rows.append(row)
+        print(f"{name:42} {method:9} {row.get('verdict', row.get('error', '?')):9}"
+              f" {row.get('cpu_s', float('nan')):8.2f} {row.get('peak_rss_mib', 0):8}  {row.get('visited')}",
+              flush=True)
+        if method == "explicit" and name.startswith("bidding") and not quick:
+            import importlib.util
+
+            if importlib.util.find_spec("pm4py") is None:
+                continue
+            row = _in_child(_woflan_child, (make,), min(limit, 120.0))
+            row.update(net=name, method="Woflan")
+            rows.append(row)
+            print(f"{name:42} {'Woflan':9} {str(row.get('sound', row.get('error'))):9}"
+                  f" {row.get('cpu_s', float('nan')):8.2f} {row.get('peak_rss_mib', 0):8}", flush=True)
+    if out:
+        Path(out).write_text(json.dumps(rows, indent=2, default=str))
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--reductions", action="store_true",
+                        help="check --method auto/symmetry/stubborn beside the explicit explorer"
+                             " and PM4Py's Woflan on the team nets and the philosophers")
     parser.add_argument("--check", action="store_true",
                         help="time petriflow check's steps on the stress nets and the files given")
     parser.add_argument("files", nargs="*", metavar="PNML", help="nets for --check")
@@ -394,6 +507,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--tools", default="petriflow,PM4Py,SNAKES",
                         help="comma-separated subset of petriflow,PM4Py,SNAKES")
     args = parser.parse_args(argv)
+    if args.reductions:
+        return reductions_main(args.quick, args.json)
     if args.check:
         return check_main(args.files, args.quick, args.json)
     if args.files:

@@ -401,7 +401,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     result = check_net(
         net, max_states=args.max_states or DEFAULT_MAX_STATES,
         max_coverability=DEFAULT_MAX_COVERABILITY if args.max_coverability is None else args.max_coverability,
-        invariant_budget=args.invariant_budget)
+        invariant_budget=args.invariant_budget, method=args.method)
     if args.json:
         _print_json(plain(result))
     else:
@@ -524,6 +524,11 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--max-coverability", type=int, default=None, metavar="N",
                        help="most nodes of the Karp-Miller search that decides boundedness before"
                        " the state space (default 100,000; 0: none)")
+    check.add_argument("--method", choices=("auto", "explicit", "symmetry", "stubborn", "structural"),
+                       default="auto", help="how to answer (docs/analysis.md): the full state space"
+                       " (explicit), up to permutations of interchangeable agents (symmetry),"
+                       " deadlocks by stubborn sets (stubborn), soundness of free-choice WF-nets"
+                       " by the Rank Theorem (structural); auto (default) picks and reports which")
     check.add_argument("--invariant-budget", type=int, default=None, metavar="N",
                        help="work budget of each of the P- and T-semiflow computations (0: skip"
                        " them); default 100,000,000 steps (about 0.2 s) for P-semiflows and, for"

@@ -11,6 +11,11 @@ One concept per module:
   reversibility, read off a state space;
 * :mod:`~petriflow.analysis.soundness` — WF-net structure and classical soundness;
 * :mod:`~petriflow.analysis.invariants` — P- and T-semiflows (Farkas);
+* :mod:`~petriflow.analysis.symmetry` — the state space up to permutations of
+  interchangeable agents;
+* :mod:`~petriflow.analysis.stubborn` — stubborn sets: deadlocks, reaching a marking;
+* :mod:`~petriflow.analysis.structural` — soundness of free-choice WF-nets by the Rank Theorem;
+* :mod:`~petriflow.analysis.methods` — ``check --method``: which of them answers what;
 * :mod:`~petriflow.analysis.report` — :func:`check_net`, the ``petriflow check`` command.
 
 Examples:

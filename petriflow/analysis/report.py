@@ -152,8 +152,15 @@ T_BUDGET_FLOOR = 10_000_000
 
 def check_net(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
               max_coverability: int = DEFAULT_MAX_COVERABILITY,
-              invariant_budget: int | None = None) -> dict[str, Any]:
+              invariant_budget: int | None = None, method: str | None = "auto") -> dict[str, Any]:
     """Analyse ``net`` and return the JSON-ready result ``petriflow check`` prints.
+
+    ``method`` (:data:`~petriflow.analysis.methods.METHODS`) picks how: ``explicit``
+    explores the full state space as described below; ``auto``, ``symmetry``,
+    ``stubborn`` and ``structural`` use the reductions of
+    :mod:`~petriflow.analysis.methods` (docs/analysis.md), falling back to the explicit
+    exploration where a reduction does not apply. The result's ``methods`` says which
+    method answered each property, ``states_visited`` how many markings were stored.
 
     In order, each within its own budget: the structure (WF-net, free-choice);
     P-semiflows (``invariant_budget``), which may prove every place bounded; unless they
@@ -189,39 +196,18 @@ def check_net(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
         (True, True, 3, [])
     """
     _check_range(net)
+    if method is not None:     # None: the explicit exploration itself, for the methods module
+        from petriflow.analysis.methods import check_with_method
+
+        return check_with_method(net, method, max_states=max_states,
+                                 max_coverability=max_coverability,
+                                 invariant_budget=invariant_budget)
     compiled = CompiledNet(net)
     structure = workflow_structure(net)
     start = net.initial_marking
     if not start and structure.is_wf_net:
         start = Marking({structure.source: 1})
-    result: dict[str, Any] = {
-        "net": net.id,
-        "places": len(net.places),
-        "transitions": len(net.transitions),
-        "initial_marking": start.to_dict(),
-        "complete": True,
-        "workflow_net": structure.is_wf_net,
-        "source_place": structure.source if structure.is_wf_net else None,
-        "sink_place": structure.sink if structure.is_wf_net else None,
-        "free_choice": is_free_choice(net),
-        "sound": False,
-        "bounded": None,
-        "safe": None,
-        "deadlock_free": None,
-        "dead_transitions": None,
-        "live": None,
-        "reversible": None,
-        "states": None,
-        "edges": None,
-        "max_tokens_place": None,
-        "max_tokens_marking": None,
-        "unbounded_places": [],
-        "unbounded_places_complete": None,
-        "k_bound": None,
-        "coverability": None,
-        "violations": [],
-        "algorithm": [],
-    }
+    result = _skeleton(net, structure, start)
     p_budget = DEFAULT_BUDGET if invariant_budget is None else invariant_budget
     result["invariants"], covered = _invariants(compiled, start, p_budget)
     structurally_bounded = bool(result["invariants"].get("covered_by_p_semiflows"))
@@ -304,6 +290,38 @@ def check_net(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
     result["violations"] = [v.to_dict() for v in violations]
     result["algorithm"] = "; ".join(result["algorithm"])
     return result
+
+
+def _skeleton(net: Net, structure, start: Marking) -> dict[str, Any]:
+    """The result with every key present and nothing decided yet."""
+    return {
+        "net": net.id,
+        "places": len(net.places),
+        "transitions": len(net.transitions),
+        "initial_marking": start.to_dict(),
+        "complete": True,
+        "workflow_net": structure.is_wf_net,
+        "source_place": structure.source if structure.is_wf_net else None,
+        "sink_place": structure.sink if structure.is_wf_net else None,
+        "free_choice": is_free_choice(net),
+        "sound": False,
+        "bounded": None,
+        "safe": None,
+        "deadlock_free": None,
+        "dead_transitions": None,
+        "live": None,
+        "reversible": None,
+        "states": None,
+        "edges": None,
+        "max_tokens_place": None,
+        "max_tokens_marking": None,
+        "unbounded_places": [],
+        "unbounded_places_complete": None,
+        "k_bound": None,
+        "coverability": None,
+        "violations": [],
+        "algorithm": [],
+    }
 
 
 def soundness_final(net: Net, structure) -> Marking | None:
@@ -517,11 +535,18 @@ def exit_code(result: dict[str, Any]) -> int:
         1
     """
     if not result.get("complete", True):
-        # Stopped at the limit: a definite failure found on the way still fails.
+        # Stopped at the limit: a definite failure found on the way still fails; a
+        # verdict another method reached (the Rank Theorem, stubborn sets) still holds.
+        decided = result.get("methods") or {}
         if result.get("workflow_net"):
-            return EXIT_PROBLEM if result.get("sound") is False else EXIT_UNDECIDED
+            if result.get("sound") is False:
+                return EXIT_PROBLEM
+            return EXIT_OK if result.get("sound") and decided.get("sound") else EXIT_UNDECIDED
         found = any(v.get("kind") == "deadlock" for v in result.get("violations", ()))
-        return EXIT_PROBLEM if found or result.get("bounded") is False else EXIT_UNDECIDED
+        if found or result.get("bounded") is False:
+            return EXIT_PROBLEM
+        return EXIT_OK if result.get("bounded") and result.get("stuck_markings") == 0 \
+            and decided.get("stuck_markings") else EXIT_UNDECIDED
     if result.get("workflow_net"):
         return EXIT_OK if result.get("sound") else EXIT_PROBLEM
     stuck = result.get("stuck_markings")
@@ -553,6 +578,18 @@ def format_report(result: dict[str, Any]) -> str:
     else:
         problem = next((v["message"] for v in result["violations"] if v["kind"] == "not_wf_net"), "")
         lines.append(f"  {problem or 'not a WF-net'}")
+    methods = result.get("methods")
+    if methods:
+        answered = {}
+        for key, how in methods.items():
+            if how is not None:
+                answered.setdefault(how, []).append(key)
+        visited = ", ".join(f"{how} {count:,}" for how, count in
+                            (result.get("states_visited") or {}).items() if count is not None)
+        lines.append(f"  method ({result.get('method', 'auto')}): "
+                     + "; ".join(f"{how}: {', '.join(keys)}" for how, keys in answered.items())
+                     + (f" (markings stored: {visited})" if visited else ""))
+        lines.extend(f"    {note}" for note in result.get("method_notes") or ())
     if not result["complete"]:
         lines.append(f"  state space: {result['error']}")
         found = result.get("partial")

@@ -27,7 +27,7 @@ from __future__ import annotations
 from petriflow.net import Net
 
 __all__ = ["complete_state_machine", "deadlock_beyond_limit", "lamport_fast_mutex", "long_cycle",
-           "pumped_after_bounded", "shared_cycles"]
+           "philosophers_one_fork", "pumped_after_bounded", "shared_cycles"]
 
 
 def _move(net: Net, name: str, before: list[str], after: list[str], read: tuple[str, ...] = ()) -> None:
@@ -175,4 +175,28 @@ def long_cycle(n: int) -> Net:
         net.add_place(f"p{k}", tokens=1 if k == 0 else 0)
     for k in range(n):
         _move(net, f"t{k}", [f"p{k}"], [f"p{(k + 1) % n}"])
+    return net
+
+
+def philosophers_one_fork(n: int) -> Net:
+    """The textbook dining philosophers: each takes the left fork, then the right one,
+    eats, and puts both back. Deadlocks when every philosopher holds a left fork (the
+    classic of ``petriflow.classic`` takes both forks at once and never deadlocks).
+
+    Examples:
+        >>> philosophers_one_fork(3)
+        <Net 'philosophers-one-fork-3': 12 places, 9 transitions, 30 arcs>
+    """
+    net = Net(f"philosophers-one-fork-{n}")
+    for k in range(n):
+        for place in (f"think_{k}", f"left_{k}", f"eat_{k}", f"fork_{k}"):
+            net.add_place(place)
+    for k in range(n):
+        right = f"fork_{(k + 1) % n}"
+        _move(net, f"take_left_{k}", [f"think_{k}", f"fork_{k}"], [f"left_{k}"])
+        _move(net, f"take_right_{k}", [f"left_{k}", right], [f"eat_{k}"])
+        _move(net, f"release_{k}", [f"eat_{k}"], [f"think_{k}", f"fork_{k}", right])
+    from petriflow.marking import Marking
+
+    net.set_initial_marking(Marking({p: 1 for k in range(n) for p in (f"think_{k}", f"fork_{k}")}))
     return net

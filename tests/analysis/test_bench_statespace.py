@@ -60,3 +60,18 @@ def test_check_mode_times_each_step_and_checks_oracle_answers(tmp_path, capsys):
     rows = json.loads(out.read_text())["rows"]
     unbounded = next(r for r in rows if r["net"].startswith("unbounded"))
     assert unbounded["verdict"] == "PROBLEM" and unbounded["result"]["unbounded_places"] == ["heap"]
+
+
+def test_reductions_mode_compares_methods(tmp_path, capsys):
+    """--reductions --quick: the 5-robot team net explicitly and by symmetry (same
+    verdict and full state count, fewer markings stored), the philosophers' deadlock by
+    stubborn sets."""
+    out = tmp_path / "reductions.json"
+    assert load_bench().main(["--reductions", "--quick", "--json", str(out)]) == 0
+    rows = {(r["net"], r["method"]): r for r in json.loads(out.read_text())}
+    full = rows[("bidding-autonomous-5", "explicit")]
+    auto = rows[("bidding-autonomous-5", "auto")]
+    assert full["verdict"] == auto["verdict"] == "OK" and full["states"] == auto["states"]
+    assert auto["visited"]["symmetry"] < full["visited"]["explicit"] == full["states"]
+    philosophers = rows[("philosophers (one fork at a time) 100", "stubborn")]
+    assert philosophers["verdict"] == "PROBLEM" and philosophers["deadlock_free"] is False

@@ -99,11 +99,15 @@ transitions: [{id: go, in: [a], out: [b]}, {id: back, in: [b], out: [a]}, {id: s
 
 def test_state_limit_gives_an_incomplete_result_and_exit_2():
     """Beyond max_states: complete false, an error message, exit 2; structure still there."""
-    result = check_net(dining_philosophers(12), max_states=50)
+    result = check_net(dining_philosophers(12), max_states=50, method="explicit")
     assert result["complete"] is False and "max_states=50" in result["error"]
     assert result["states"] is None and result["invariants"]["p_semiflows"]
     assert exit_code(result) == EXIT_UNDECIDED
     assert "UNDECIDED" in format_report(result)
+    # --method auto goes on with stubborn sets: no dead marking, bounded: a verdict
+    auto = check_net(dining_philosophers(12), max_states=200)     # 322 markings in all
+    assert auto["complete"] is False and auto["stuck_markings"] == 0
+    assert auto["methods"]["stuck_markings"] == "stubborn" and exit_code(auto) == 0
 
 
 def test_format_report_is_short_and_readable():
@@ -140,7 +144,7 @@ def test_check_command_state_limit_message(tmp_path, capsys):
     from petriflow.io.yaml import dumps_net
 
     path.write_text(dumps_net(dining_philosophers(10)))
-    code = main(["check", str(path), "--json", "--max-states", "20"])
+    code = main(["check", str(path), "--json", "--max-states", "20", "--method", "explicit"])
     captured = capsys.readouterr()
     assert code == EXIT_UNDECIDED
     assert json.loads(captured.out)["complete"] is False

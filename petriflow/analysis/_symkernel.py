@@ -1,0 +1,235 @@
+"""The compiled loop of the symmetry-reduced exploration (private).
+
+One breadth-first search over canonical markings: a marking is a row of ``uint8``
+counts; its canonical form sorts, for each group of interchangeable agents, the agents'
+blocks of places lexicographically (insertion sort: a successor differs from its sorted
+parent in one or two blocks, so the sort is close to linear). States live in an
+open-addressing hash table keyed by a 64-bit FNV-1a hash of the whole row, confirmed
+on the row. The loop returns to Python when a buffer is full (status 1, Python grows
+it and calls again), when the table is half full (3, Python rehashes), when the state
+limit is reached (2), or when a count would exceed 255 (4: the caller falls back).
+
+Compiled by numba (cached on disk); the same code runs as plain Python without it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+try:
+    import numba
+
+    _cache = __name__ == "petriflow.analysis._symkernel"
+    _jit = numba.njit(cache=_cache, nogil=True)
+except ImportError:  # pragma: no cover - exercised only where numba is missing
+    def _jit(function):
+        return function
+
+__all__ = ["canonicalise", "explore", "rehash", "row_hash"]
+
+OK, GROW, LIMIT, REHASH, OVERFLOW = 0, 1, 2, 3, 4
+
+_FNV_OFFSET = np.uint64(14695981039346656037)
+_FNV_PRIME = np.uint64(1099511628211)
+
+
+@_jit
+def row_hash(row):
+    h = np.uint64(14695981039346656037)
+    for x in row:
+        h = (h ^ np.uint64(x)) * np.uint64(1099511628211)
+    h ^= h >> np.uint64(29)
+    return h
+
+
+@_jit
+def _less(row, a, b, width):
+    """Whether block ``a`` (its first place indices ``a``) sorts before block ``b``."""
+    for j in range(width):
+        x = row[a[j]]
+        y = row[b[j]]
+        if x != y:
+            return x < y
+    return False
+
+
+@_jit
+def canonicalise(row, group_k, group_b, group_off, blocks, scratch):
+    """Sort each group's blocks of ``row`` in place (lexicographic, ascending).
+
+    ``blocks[group_off[g] + a * group_b[g] + j]`` is the place index of local place
+    ``j`` of agent ``a`` of group ``g``; ``scratch`` holds at least one group's places.
+    """
+    for g in range(group_k.shape[0]):
+        k = group_k[g]
+        b = group_b[g]
+        off = group_off[g]
+        # copy out the block values, insertion-sort them as rows, write them back
+        for a in range(k):
+            for j in range(b):
+                scratch[a * b + j] = row[blocks[off + a * b + j]]
+        for a in range(1, k):
+            i = a
+            while i > 0:
+                smaller = False
+                for j in range(b):
+                    x = scratch[i * b + j]
+                    y = scratch[(i - 1) * b + j]
+                    if x != y:
+                        smaller = x < y
+                        break
+                if not smaller:
+                    break
+                for j in range(b):
+                    t = scratch[i * b + j]
+                    scratch[i * b + j] = scratch[(i - 1) * b + j]
+                    scratch[(i - 1) * b + j] = t
+                i -= 1
+        for a in range(k):
+            for j in range(b):
+                row[blocks[off + a * b + j]] = scratch[a * b + j]
+
+
+@_jit
+def _find(rows, hashes, table, row, h, n_cols):
+    mask = np.uint64(table.shape[0] - 1)
+    slot = h & mask
+    while True:
+        s = table[slot]
+        if s == 0:
+            return -1, slot
+        s -= 1
+        if hashes[s] == h:
+            same = True
+            for c in range(n_cols):
+                if rows[s, c] != row[c]:
+                    same = False
+                    break
+            if same:
+                return s, slot
+        slot = (slot + np.uint64(1)) & mask
+
+
+@_jit
+def rehash(hashes, n, table):
+    """Insert states ``0..n-1`` into the empty ``table`` by their hashes."""
+    mask = np.uint64(table.shape[0] - 1)
+    for s in range(n):
+        slot = hashes[s] & mask
+        while table[slot] != 0:
+            slot = (slot + np.uint64(1)) & mask
+        table[slot] = s + 1
+
+
+@_jit
+def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, parent, parent_row,
+            enabled_count, seen_by, fired,
+            pre_p, pre_w, pre_n, post_p, post_w, post_n, reset_p, reset_n,
+            group_k, group_b, group_off, blocks, named_g, named_a, named_n, max_states):
+    """Expand states ``counters[1]`` .. while any are left; ``counters`` = ``[states,
+    next state to expand, edges]`` is updated in place. Returns a status code.
+
+    Per state, every enabled row is counted (``enabled_count``: the out-degree of each
+    marking of the orbit), but only one row per orbit of the marking's stabiliser is
+    fired: agents with equal blocks are interchangeable there, so a row naming agents
+    ``a_1, a_2, ...`` (``named_g``/``named_a``, in the order they appear in its id) is
+    fired only when each ``a_k`` is the lowest agent of its run of equal blocks not named
+    before it. Each distinct successor is one edge (``seen_by`` deduplicates); ``fired``
+    marks the rows fired."""
+    n_cols = rows.shape[1]
+    n_rows = pre_n.shape[0]
+    row = np.empty(n_cols, dtype=np.uint8)
+    scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
+    n_groups = group_k.shape[0]
+    max_k = 1
+    for g in range(n_groups):
+        max_k = max(max_k, group_k[g])
+    run = np.zeros((max(1, n_groups), max_k), dtype=np.int64)
+    n = counters[0]
+    head = counters[1]
+    ne = counters[2]
+    while head < n:
+        if n + n_rows > rows.shape[0] or ne + n_rows > edge_target.shape[0]:
+            counters[0], counters[1], counters[2] = n, head, ne
+            return GROW
+        if 2 * (n + n_rows) > table.shape[0]:
+            counters[0], counters[1], counters[2] = n, head, ne
+            return REHASH
+        if n > max_states:
+            counters[0], counters[1], counters[2] = n, head, ne
+            return LIMIT
+        offsets[head] = ne
+        # runs of equal blocks: run[g, a] = the first agent of a's run
+        for g in range(n_groups):
+            b = group_b[g]
+            off = group_off[g]
+            run[g, 0] = 0
+            for a in range(1, group_k[g]):
+                same = True
+                for j in range(b):
+                    if rows[head, blocks[off + a * b + j]] != rows[head, blocks[off + (a - 1) * b + j]]:
+                        same = False
+                        break
+                run[g, a] = run[g, a - 1] if same else a
+        count = 0
+        for t in range(n_rows):
+            enabled = True
+            for k in range(pre_n[t]):
+                if rows[head, pre_p[t, k]] < pre_w[t, k]:
+                    enabled = False
+                    break
+            if not enabled:
+                continue
+            count += 1
+            representative = True
+            for k in range(named_n[t]):
+                g = named_g[t, k]
+                a = named_a[t, k]
+                start = run[g, a]
+                expected = start
+                for q in range(k):
+                    if named_g[t, q] == g and run[g, named_a[t, q]] == start:
+                        expected += 1
+                if a != expected:
+                    representative = False
+                    break
+            if not representative:
+                continue
+            fired[t] = True
+            for c in range(n_cols):
+                row[c] = rows[head, c]
+            for k in range(pre_n[t]):
+                row[pre_p[t, k]] -= pre_w[t, k]
+            for k in range(reset_n[t]):
+                row[reset_p[t, k]] = 0
+            for k in range(post_n[t]):
+                value = np.int64(row[post_p[t, k]]) + post_w[t, k]
+                if value > 255:
+                    counters[0], counters[1], counters[2] = n, head, ne
+                    return OVERFLOW
+                row[post_p[t, k]] = value
+            canonicalise(row, group_k, group_b, group_off, blocks, scratch)
+            h = row_hash(row)
+            found, slot = _find(rows, hashes, table, row, h, n_cols)
+            if found < 0:
+                found = n
+                for c in range(n_cols):
+                    rows[n, c] = row[c]
+                hashes[n] = h
+                table[slot] = n + 1
+                parent[n] = head
+                parent_row[n] = t
+                seen_by[n] = -1
+                n += 1
+            if seen_by[found] != head:
+                seen_by[found] = head
+                edge_target[ne] = found
+                edge_row[ne] = t
+                ne += 1
+        enabled_count[head] = count
+        head += 1
+        offsets[head] = ne
+    counters[0], counters[1], counters[2] = n, head, ne
+    if n > max_states:
+        return LIMIT
+    return OK
