@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from petriflow.agents.comm.agent import CommAgent, Peer
+from petriflow.agents.comm.agent import CommAgent, Peer, vertex_id
 from petriflow.agents.comm.framework import History, addresses, dhcp_pools, dpp, grid_position, grid_size
 from petriflow.agents.comm.radio import RadioChannel, pick_threshold, threshold_sweep
 
@@ -155,13 +155,16 @@ class Initialise(InstantAction):
 
 
 class MakeHistory(InstantAction):
-    """Process 4: the empty data and history arrays."""
+    """Process 4: the empty data and history arrays. The central unit keeps its
+    history per recipient by vertex: a vertex a robot holds, whoever mapped it, is not
+    forwarded to it (``History(identity=vertex_id)``); a robot's history is the
+    paper's, per source."""
 
     agent_state = CommAgent
 
     def run(self, ctx: ActionContext) -> None:
         state = ctx.state
-        state.history = History(state.address)
+        state.history = History(state.address, identity=vertex_id if state.kind == "central" else None)
         state.last_news = state.since = ctx.now  # a late joiner waits for news from when it joined
 
 
@@ -193,9 +196,13 @@ def _plan(ctx: ActionContext, state: CommAgent, links: dict[str, Any]) -> None:
 class Explore(Action):
     """A robot goes to its next cell, senses its walls, maps a vertex, plans what to send.
 
-    After its own exploration it heads for the place it last heard from a robot whose
-    data it lacks (a rendezvous), and waits there; a decentralised robot that has waited
-    ``give_up`` s re-explores what the silent robots had claimed.
+    After its own exploration a decentralised robot (``meet``) heads for a robot whose
+    data it lacks or that it has still to tell: back to the cell where it last talked
+    with it, else to the border of its region (a rendezvous), and waits there, choosing
+    again when whom it waits for changes; a robot whose header says it cannot move is
+    not visited. One that has waited ``give_up`` s re-explores what the silent robots
+    had claimed. A centralised robot waits for the central unit's relay. At ``stop_at``
+    the robot breaks down: it stops for good, its data is final, its radio goes on.
     """
 
     params = {
@@ -208,7 +215,9 @@ class Explore(Action):
         "jitter": Param(float, 0.1, "each move's speed is the cruise speed times U(1 - j, 1 + j) (seeded)",
                          low=0, high=1),
         "stop_at": Param((float, int, type(None)), None, "a mechanical failure at this time: the robot stops"
-                         " moving for good, its radio goes on"),
+                         " moving for good, its data is final as it stands, its radio goes on"),
+        "meet": Param(bool, True, "after exploring, drive to meet robots whose data is missing (decentralised;"
+                      " a centralised robot waits for the central unit's relay)"),
     }
     needs_world = True
     agent_state = CommAgent
@@ -242,6 +251,9 @@ class Explore(Action):
             if not state.broken:
                 state.broken = True
                 ctx.emit("comm.broken", distance_m=round(state.robot.travelled, 3))
+                if not state.explored:
+                    self._explored(ctx)  # it will explore no more: what it has is all of its data
+            self._give_up(ctx, state.missing())
             self.waiting = self.params["wait"]
             return
         if not state.explored:
@@ -299,25 +311,42 @@ class Explore(Action):
                 self.goal = state.explorer.next_cell()
                 ctx.emit("comm.reexplore", silent=sorted(missing), cells=len(cells))
                 return
-            if not state.gave_up >= set(missing):
-                state.gave_up |= set(missing)
-                ctx.emit("comm.gave_up", silent=sorted(missing))
+            self._give_up(ctx, missing)
         waiting_for = [s for s in missing if s not in state.gave_up]
-        owed = state.untold() + [name for name, box in state.outbox.items() if box]
+        if not self.params["meet"]:
+            self.goal = None
+            self.waiting = self.params["wait"]
+            return
+        stopped = {state.peers[name].address for name in state.stopped if name in state.peers}
+        waiting_for = [s for s in waiting_for if s not in stopped]
+        owed = state.untold() + [name for name, box in state.outbox.items() if box and name not in state.stopped]
         waiting_for += [state.peers[name].address for name in owed if state.peers[name].address not in waiting_for]
+        if state.parked and tuple(waiting_for) != state.parked_for:
+            state.parked = False  # someone else to meet now (or no longer): choose the place again
         if waiting_for and not state.route and not state.parked:
             state.route = self._meeting_route(waiting_for)
             state.parked = not state.route
+            state.parked_for = tuple(waiting_for)
         if state.route:
             self.goal = state.route.pop(0)
         else:
             self.goal = None
             self.waiting = self.params["wait"]
 
+    def _give_up(self, ctx: ActionContext, missing: list[int]) -> None:
+        """Give up on the robots whose data is missing, after ``give_up`` s without news."""
+        state = self.state
+        if missing and ctx.now - max(state.explored_at or 0.0, state.last_news) > self.params["give_up"] \
+                and not state.gave_up >= set(missing):
+            state.gave_up |= set(missing)
+            ctx.emit("comm.gave_up", silent=sorted(missing))
+
     def _meeting_route(self, sources: list[int]) -> list[tuple[int, int]]:
-        """Cells to a place to meet a robot whose data is missing: the nearest visited
-        cell with an open side into a cell that robot mapped (the border between the two
-        explored regions), else the visited cell nearest where it was last heard of."""
+        """Cells to a place to meet a robot whose data is missing (or that is still to be
+        told): the cell where this robot last heard it (they were in range there; both
+        go back to it), else the nearest visited cell with an open side into a cell that
+        robot mapped (the border between the two explored regions), else the visited
+        cell nearest where it was last heard of."""
         import networkx as nx
 
         state = self.state
@@ -326,6 +355,11 @@ class Explore(Action):
         here = explorer.cell
         if here not in graph:
             return []
+        for source in sources:
+            peer = state.by_address(source)
+            met = state.met_at.get(peer.name) if peer is not None else None
+            if met is not None and met in graph and nx.has_path(graph, here, met):
+                return nx.shortest_path(graph, here, met)[1:]  # empty when here: it waits here
         lengths = nx.single_source_shortest_path_length(graph, here)
         offsets = {"north": (1, 0), "south": (-1, 0), "east": (0, 1), "west": (0, -1)}
         for source in sources:
@@ -384,6 +418,7 @@ class Explore(Action):
             if ctx.now < self.wake_at - 1e-9:
                 return Status.RUNNING
             self.at = ctx.now
+            state.robot.drive(0.0, 0.0, 0.0)  # a robot at rest holds its place (braked: not pushed away)
             _plan(ctx, state, self.links)
             return Status.OK
         robot = state.robot
@@ -395,6 +430,7 @@ class Explore(Action):
             self.waiting -= dt
             if self.waiting > 0:
                 return Status.RUNNING
+            state.robot.drive(0.0, 0.0, 0.0)  # a robot at rest holds its place (braked: not pushed away)
             _plan(ctx, state, self.links)
             return Status.OK
         cell = self.goal
@@ -473,6 +509,7 @@ class Send(InstantAction):
         message = state.take(self.params["peer"])
         if message is None:
             raise ActionFailure(f"comm.send: nothing waiting for {self.params['peer']!r}")
+        state.met(self.params["peer"])  # it hears the peer here
         ctx.put(self.params["box"], {"size": message.size, "payload": message.payload, "code": message.code,
                                      "message": message})
         ctx.emit("comm.sent", to=self.params["peer"], code=message.code, bytes=message.size,
@@ -493,6 +530,9 @@ class Receive(InstantAction):
             raise ActionFailure(f"comm.receive: the token of {self.params['box']!r} carries no message")
         state.now = ctx.now
         new = state.receive(message)
+        sender = state.by_address(message.sender)
+        if sender is not None:
+            state.met(sender.name)  # within range here: a place to meet again
         if new or message.final:
             state.last_news = ctx.now
         if new:

@@ -30,7 +30,14 @@ from typing import Any
 from petriflow.agents.comm.framework import History, Message, plan
 from petriflow.runtime.agents import AgentState
 
-__all__ = ["CommAgent", "Peer"]
+__all__ = ["CommAgent", "Peer", "vertex_id"]
+
+
+def vertex_id(item: Any) -> int:
+    """What a map item stands for: its vertex (the maze cell's id), whoever mapped it.
+    The history's per-recipient record uses it (``History(identity=vertex_id)``): a
+    vertex a peer holds is not sent to it again, under any source."""
+    return item[0]
 
 
 @dataclass
@@ -66,10 +73,13 @@ class CommAgent(AgentState):
     in_range: set = field(default_factory=set)
     last_seen: dict[int, tuple[float, float]] = field(default_factory=dict)  # source -> last vertex position
     route: list = field(default_factory=list)
+    met_at: dict = field(default_factory=dict)   # peer -> this robot's cell when it last heard that peer
     finished: bool = False
     reexplored: bool = False
     broken: bool = False                         # a mechanical failure: it cannot move
+    stopped: set = field(default_factory=set)    # peers whose header says they cannot move
     parked: bool = False                         # waiting at its meeting place
+    parked_for: tuple = ()                       # the robots it parked there to meet
     gave_up: set = field(default_factory=set)   # robots given up on (silent too long)
     last_news: float = 0.0                       # simulated time new map data last arrived
     heard: dict = field(default_factory=dict)    # peer -> simulated time of its last message
@@ -132,8 +142,8 @@ class CommAgent(AgentState):
         talks (a robot broken down, its radio on) is."""
         out = []
         for name, peer in self.peers.items():
-            if self.now - self.heard.get(name, self.since) > self.patience:
-                continue
+            if self.now - self.heard.get(name, self.since) > self.patience or name in self.stopped:
+                continue  # gone, or cannot come: it hears what passes by, nobody goes to tell it
             for source, total in self.final.items():
                 if source == peer.address or self.history.count(source) < total:
                     continue
@@ -141,6 +151,16 @@ class CommAgent(AgentState):
                     out.append(name)
                     break
         return out
+
+    def met(self, peer: str) -> None:
+        """Remember where this robot stands while it talks with ``peer`` (the cell its
+        pose is in, when it has been there; else the last cell it sensed): a place to
+        meet that peer again."""
+        if self.explorer is None or self.robot is None:
+            return
+        x, y, _ = self.robot.pose
+        cell = (int((y - self.origin[1]) // self.cell), int((x - self.origin[0]) // self.cell))
+        self.met_at[peer] = cell if cell in self.explorer.visited else self.explorer.cell
 
     # Messages --------------------------------------------------------------------------
     @property
@@ -150,6 +170,7 @@ class CommAgent(AgentState):
 
     def queue(self, message: Message) -> None:
         message.id_bytes = self.id_bytes
+        message.stopped = self.broken
         peer = self.by_address(message.receiver)
         if peer is not None:
             self.outbox.setdefault(peer.name, deque()).append(message)
@@ -185,15 +206,17 @@ class CommAgent(AgentState):
                 continue
             if self.history.count(source) >= total:
                 self.asked.add(key)
-                note = Message(0, source, total, self.address, peer.address)
-                note.final = True
-                self.queue(note)
                 # the final push: what the peer may still lack goes with the note, so no
                 # request has to be answered after this agent has finished
                 unsent = self.history.unsent(peer.address, source)
                 if unsent:
                     self.history.sent(peer.address, source, unsent)
-                    self.queue(Message(2, source, total, self.address, peer.address, unsent, final=True))
+                count = self.history.count_for(peer.address, source)
+                note = Message(0, source, count, self.address, peer.address)
+                note.final = True
+                self.queue(note)
+                if unsent:
+                    self.queue(Message(2, source, count, self.address, peer.address, unsent, final=True))
 
     def take(self, peer: str) -> Message | None:
         box = self.outbox.get(peer)
@@ -213,6 +236,8 @@ class CommAgent(AgentState):
         sender = self.by_address(message.sender)
         if sender is not None:
             self.heard[sender.name] = self.now
+            if message.stopped:
+                self.stopped.add(sender.name)
         new: list[int] = []
         final = message.final
         if message.code == 0:
@@ -229,8 +254,8 @@ class CommAgent(AgentState):
                 chosen = self.history.unsent(message.sender, message.source)[:message.count]
                 self.history.sent(message.sender, message.source, chosen)
                 if chosen:
-                    reply = Message(2, message.source, self.history.count(message.source), self.address,
-                                    message.sender, list(chosen))
+                    reply = Message(2, message.source, self.history.count_for(message.sender, message.source),
+                                    self.address, message.sender, list(chosen))
                     reply.final = message.source in self.final
                     self.queue(reply)
         else:

@@ -38,6 +38,7 @@ from __future__ import annotations
 import math
 import struct
 from dataclasses import dataclass, field
+from collections.abc import Callable
 from typing import Any
 
 __all__ = [
@@ -113,10 +114,14 @@ class History:
     ``data`` holds ``(source, item, via)``: ``via`` is the agent it came from (the
     agent itself for its own data), so nothing goes back where it came from.
     ``rows`` holds ``[from, to, sent, pending]`` in the order they were made. Both are
-    indexed (by source, by row key) so a large team's history stays fast.
+    indexed (by source, by row key) so a large team's history stays fast. ``held``
+    holds, per peer, what it has as far as this agent knows (see the module):
+    ``identity(item)`` with ``identity``, else ``(source, item)``.
     """
 
     me: int
+    identity: Callable[[Any], Any] | None = None
+    held: dict[int, set] = field(default_factory=dict)
     data: list[tuple[int, Any, int]] = field(default_factory=list)
     rows: list[list[int]] = field(default_factory=list)
     given: dict[tuple[int, int], list[Any]] = field(default_factory=dict)  # (peer, source) -> items sent
@@ -131,6 +136,20 @@ class History:
     def _add_row(self, row: list[int]) -> None:
         self.rows.append(row)
         self._rows[(row[0], row[1])] = row
+
+    def _id(self, source: int, item: Any) -> Any:
+        return self.identity(item) if self.identity is not None else (source, _key(item))
+
+    def _note(self, peer: int, source: int, items: list[Any]) -> None:
+        self.held.setdefault(peer, set()).update(self._id(source, item) for item in items)
+
+    def lacks(self, peer: int, source: int, items: list[Any]) -> list[Any]:
+        """Those of ``items`` (of ``source``) that ``peer`` does not hold, as far as this
+        agent knows."""
+        held = self.held.get(peer)
+        if not held:
+            return list(items)
+        return [item for item in items if self._id(source, item) not in held]
 
     def _keep(self, source: int, item: Any, via: int) -> None:
         self.data.append((source, item, via))
@@ -170,6 +189,7 @@ class History:
             if not self.has(source, item):
                 self._keep(source, item, sender)
                 new.append(item)
+        self._note(sender, source, items)
         row = self._row(source, self.me)
         if row is None:
             self._add_row([source, self.me, len(items), 0])
@@ -182,8 +202,10 @@ class History:
     def outgoing(self, peer: int) -> list[tuple[int, list[Any], str]]:
         """What the rules send ``peer``: ``(source, items, rule)`` per source, rule
         ``"new"`` (rules 1 and 2: never sent that source to this peer: all of it) or
-        ``"pending"`` (rule 3: the items made or received since)."""
+        ``"pending"`` (rule 3: the items made or received since); in either case only
+        the items the peer does not hold (:meth:`lacks`)."""
         out = []
+        chosen: set = set()  # what goes to the peer in this plan already, under an earlier source
         for source in self.sources():
             if source == peer:
                 continue
@@ -191,12 +213,15 @@ class History:
             if row is not None and row[3] <= 0:
                 continue
             items = self.items(source, excluding_via=peer)
+            if row is not None:
+                items = items[-row[3]:]
+            items = [item for item in self.lacks(peer, source, items) if self._id(source, item) not in chosen]
+            chosen.update(self._id(source, item) for item in items)
             if not items:
+                if row is not None:
+                    row[3] = 0  # the peer holds all of it already: nothing is pending
                 continue
-            if row is None:
-                out.append((source, items, "new"))
-            else:
-                out.append((source, items[-row[3]:], "pending"))
+            out.append((source, items, "new" if row is None else "pending"))
         return out
 
     def sent(self, peer: int, source: int, items: list[Any]) -> None:
@@ -209,11 +234,28 @@ class History:
             row[3] = 0
         self.given.setdefault((peer, source), []).extend(items)
         self._given_sets.setdefault((peer, source), set()).update(_key(i) for i in items)
+        self._note(peer, source, items)
 
     def unsent(self, peer: int, source: int) -> list[Any]:
-        """Items of ``source`` this agent holds, did not get from ``peer`` and never sent it."""
+        """Items of ``source`` this agent holds, did not get from ``peer``, never sent it,
+        and that the peer does not hold as far as this agent knows."""
         given = self._given_sets.get((peer, source), set())
-        return [item for item in self.items(source, excluding_via=peer) if _key(item) not in given]
+        return self.lacks(peer, source, [item for item in self.items(source, excluding_via=peer)
+                                         if _key(item) not in given])
+
+    def count_for(self, peer: int, source: int) -> int:
+        """How many items of ``source`` ``peer`` must hold, as that source's, to hold it all:
+        the items of ``source`` held here, less those whose identity the peer holds from
+        another source (with ``identity``: the vertex it mapped itself, or got under
+        another robot's name). A header's count towards that peer."""
+        items = self._by_source.get(source, ())
+        held = self.held.get(peer)
+        if self.identity is None or not held:
+            return len(items)
+        given = self._given_sets.get((peer, source), set())
+        covered = sum(1 for item, via in items
+                      if via != peer and _key(item) not in given and self.identity(item) in held)
+        return len(items) - covered
 
     def sent_count(self, peer: int, source: int) -> int:
         """Items of ``source`` sent to ``peer`` so far (the row's ``sent``)."""
@@ -235,7 +277,8 @@ def _key(item: Any) -> Any:
 class Message:
     """One packet: header ``code``, ``source`` id, ``count`` (codes 0, 2, 3: the items of
     that source the sender holds; code 1: the items requested); vertices for codes 2
-    and 3; ``final``: the source's data is complete (the code byte's top bit)."""
+    and 3; ``final``: the source's data is complete (the code byte's top bit);
+    ``stopped``: the sender cannot move any more (a mechanical failure; the next bit)."""
 
     code: int
     source: int
@@ -245,6 +288,7 @@ class Message:
     vertices: list[tuple[int, float, float]] = field(default_factory=list)
     final: bool = False
     id_bytes: int = 1
+    stopped: bool = False
 
     @property
     def size(self) -> int:
@@ -258,7 +302,8 @@ class Message:
         return (VERTEX_BYTES - 1 + self.id_bytes) * len(self.vertices)
 
     def encode(self) -> bytes:
-        head = bytes([self.code | (0x80 if self.final else 0), self.source & 0xFF, min(self.count, 255)])
+        head = bytes([self.code | (0x80 if self.final else 0) | (0x40 if self.stopped else 0), self.source & 0xFF,
+                      min(self.count, 255)])
         return head + b"".join(encode_vertex(*v, id_bytes=self.id_bytes) for v in self.vertices)
 
 
@@ -288,7 +333,7 @@ def plan(history: History, peer: int) -> list[Message]:
     in a row towards the peer, code 3 (immediate) for a source never sent to it."""
     messages = []
     for source, items, rule in history.outgoing(peer):
-        total = len(history.items(source))
+        total = history.count_for(peer, source)
         if rule == "pending":
             messages.append(Message(0, source, total, history.me, peer))
         else:

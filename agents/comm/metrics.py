@@ -4,10 +4,13 @@ its world's maze (``meta.maze``): the ground truth is the maze's topological map
 * ``comm.bytes_total``: map data sent by all agents, in bytes as the paper counts them
   (5 per vertex); ``count: air`` adds the 3-byte headers of every message.
 * ``comm.bytes_per_agent``: the same per agent (``{robot1: 60, ...}``).
-* ``comm.time_s``: when every surviving agent first held every vertex of the maze's
-  map (the run's end if that never happened).
+* ``comm.time_s``: when every working agent (neither killed nor broken down) first
+  held every vertex of the maze's map (the run's end if that never happened).
 * ``comm.distance_m``: distance driven, mean over the robots.
-* ``comm.maps_complete``: share of the surviving agents holding every vertex at the end.
+* ``comm.maps_complete``: share of the working agents (neither killed nor broken down)
+  holding every vertex at the end.
+* ``comm.complete_per_agent``: per agent, 1 if it holds every vertex at the end, else 0
+  (a robot broken down included: ``{robot3: 0, ...}``).
 * ``comm.vertices``: vertices of the maze's map (the ground truth's size).
 """
 
@@ -31,11 +34,15 @@ def truth(record: Any) -> set[int]:
 
 
 def _agents(record: Any) -> tuple[list[str], set[str]]:
+    """The agents that started, and those out of the mission: killed, or broken down
+    (``comm.broken``: a robot that cannot move any more)."""
     started, killed = [], set()
     for event in record.events:
         if event.kind == "custom" and event.data.get("name") == "comm.characterised" and event.agent not in started:
             started.append(event.agent)
         elif event.kind == "fault" and event.data.get("fault") == "kill":
+            killed.add(event.agent)
+        elif event.kind == "custom" and event.data.get("name") == "comm.broken":
             killed.add(event.agent)
     return started, killed
 
@@ -86,6 +93,15 @@ def maps_complete(record: Any) -> float | None:
     return sum(1 for a in survivors if wanted <= held.get(a, set())) / len(survivors)
 
 
+def complete_per_agent(record: Any) -> dict[str, int]:
+    wanted = truth(record)
+    started, _ = _agents(record)
+    held: dict[str, set[int]] = {a: set() for a in started}
+    for _, agent, ids in holdings(record):
+        held.setdefault(agent, set()).update(ids)
+    return {agent: int(wanted <= ids) for agent, ids in held.items()}
+
+
 def distance_m(record: Any) -> float | None:
     last: dict[str, float] = {}
     for e in record.events:
@@ -104,5 +120,6 @@ def register(registry: Any) -> None:
     """Register the metrics (the ``petriflow.actions`` plugin calls this)."""
     for name, function in (("comm.bytes_total", bytes_total), ("comm.bytes_per_agent", bytes_per_agent),
                            ("comm.time_s", time_s), ("comm.distance_m", distance_m),
-                           ("comm.maps_complete", maps_complete), ("comm.vertices", vertices)):
+                           ("comm.maps_complete", maps_complete), ("comm.complete_per_agent", complete_per_agent),
+                           ("comm.vertices", vertices)):
         registry.register_metric(name, function, events=name != "comm.vertices")

@@ -46,6 +46,13 @@ MONITOR = (1.75, 3.25)
 CENTRAL = (2.5, 2.5)
 #: The central unit's address (Table 6).
 CENTRAL_ADDRESS = 129
+#: The robots' cruise speed (m/s): the paper's own distance over time, 0.052-0.069 m/s
+#: over the 14 robot rows of Tables 6-8 that give both (median 0.060; robot1 of Table 6:
+#: 30.5 m in 472.46 s).
+SPEED = 0.06
+#: Seconds a robot waits without news before it gives silent robots up: the time to
+#: drive 36 m at :data:`SPEED` (ours; the paper says nothing of waiting).
+GIVE_UP = 600.0
 
 
 def _agents(robots: int, monitor: bool, mode: str) -> list[dict[str, Any]]:
@@ -67,8 +74,9 @@ def _peers(agent: dict[str, Any], agents: list[dict[str, Any]], mode: str) -> li
 
 
 def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *, cell: float = 5 / 6,
-          cols: int = 6, area: float = 5.0, speed: float = 0.15, give_up: float = 240.0,
-          listen_give_up: float = 900.0, **ignored: Any) -> Net:
+          cols: int = 6, area: float = 5.0, speed: float = SPEED, give_up: float = GIVE_UP,
+          listen_give_up: float = 3.75 * GIVE_UP, breakdown: str | None = None, fail_at: float = 110.0,
+          **ignored: Any) -> Net:
     """The mission's net (see the module).
 
     Args:
@@ -77,10 +85,13 @@ def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *
             ``centralised`` (robots talk only to the central unit, which relays).
         monitor: add the monitor agent (it joins when the run configuration says).
         cell, cols, area: the maze's cell size (m), cells per row, side (m).
-        speed: the robots' cruise speed (m/s).
+        speed: the robots' cruise speed (m/s; :data:`SPEED`, from the paper's distances and times).
         give_up: seconds a robot waits for silent robots (see ``comm.explore``).
         listen_give_up: the same for a monitor or the central unit, which are there to
             relay and so wait longer.
+        breakdown: a robot that has a mechanical failure at ``fail_at`` s (it stops
+            moving, its radio goes on: ``comm.explore``'s ``stop_at``); ``None``: none.
+        fail_at: the time of that failure (s; the paper's 110 s).
         ignored: other sweep parameters (they go elsewhere).
     """
     if mode not in ("decentralised", "centralised"):
@@ -88,6 +99,10 @@ def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *
     if not 1 <= robots <= 126:
         raise ValueError(f"robots must be from 1 to 126, got {robots}")
     agents = _agents(robots, monitor, mode)
+    robot_names = [a["name"] for a in agents if a["kind"] == "robot"]
+    if breakdown is not None and breakdown not in robot_names:
+        raise ValueError(f"breakdown names no robot of the team ({', '.join(robot_names)}): {breakdown!r}")
+    breakdown = {} if breakdown is None else {breakdown: float(fail_at)}
     peers = {a["name"]: [p["name"] for p in _peers(a, agents, mode)] for a in agents}
     b = NetBuilder(f"comm-{mode}-{robots}{'-monitor' if monitor else ''}",
                    label=f"seed 000 mapping mission: {robots} robots, {mode}{', a monitor' if monitor else ''}")
@@ -126,7 +141,9 @@ def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *
                      outputs=["idle", "listen"])
         a.transition("step", label="explore a cell" if kind == "robot" else "listen",
                      action="comm.explore" if kind == "robot" else "comm.listen",
-                     params=({"speed": speed, "give_up": give_up, "reexplore": mode == "decentralised"}
+                     params=({"speed": speed, "give_up": give_up, "reexplore": mode == "decentralised",
+                              "meet": mode == "decentralised",
+                              **({"stop_at": float(breakdown[name])} if name in breakdown else {})}
                              if kind == "robot" else {"give_up": listen_give_up}),
                      inputs=["idle"], outputs=["out"])
         a.transition("loop", label="go on", guard="comm.going_on", priority=1, inputs=["out"], outputs=["idle"])
@@ -179,10 +196,12 @@ def world(maze_seed: int = MAZE_SEED, robots: int = 3, cols: int = 6, area: floa
     for i, (x, y) in enumerate(starts(robots, cols, area)):
         bodies.append({"id": f"robot{i + 1}", "agent": f"robot{i + 1}", "urdf": "petriflow.agents:robots/diffdrive.urdf",
                        "position": [x, y], "z": 0.05, "colour": colours[i % len(colours)]})
+    # the static agents are kinematic bodies (no mass): a robot driving past does not push them away
     bodies.append({"id": "monitor1", "agent": "monitor1", "urdf": "petriflow.agents:robots/diffdrive.urdf",
-                   "position": [MONITOR[0] * area / 5.0, MONITOR[1] * area / 5.0], "z": 0.05, "colour": "yellow"})
+                   "position": [MONITOR[0] * area / 5.0, MONITOR[1] * area / 5.0], "z": 0.05, "colour": "yellow",
+                   "motion": "kinematic"})
     bodies.append({"id": "central", "agent": "central", "urdf": "petriflow.agents:robots/diffdrive.urdf",
-                   "position": [area / 2, area / 2], "z": 0.6, "colour": "white"})
+                   "position": [area / 2, area / 2], "z": 0.6, "colour": "white", "motion": "kinematic"})
     description = maze.world(bodies, dt=0.05)
     description["gravity"] = 0.0
     return description

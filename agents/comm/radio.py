@@ -61,7 +61,11 @@ class RadioChannel(ChannelModel):
     latency: float = field(default=0.002, metadata={"range": (0.0, 60.0)})
     bitrate: float = field(default=150e6, metadata={"range": (1.0, 1e12)})
     antenna_z: float = field(default=0.15, metadata={"range": (0.0, 10.0)})
-    gains_db: dict = field(default_factory=dict)  # agent -> antenna gain (dB), e.g. a central unit's access point
+    gains_db: dict = field(default_factory=dict)  # agent -> antenna gain (dB), where a maker documents one
+    #: agents whose links are used wherever the adapter delivers every frame (Fig. 5:
+    #: ``lossless_dbm``) instead of above the framework's threshold: a central unit,
+    #: which every robot must reach and which has no peers to choose between
+    adapter_limit: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.world: Any = None
@@ -72,6 +76,19 @@ class RadioChannel(ChannelModel):
     def sensitivity_dbm(self) -> float:
         """Where frames stop arriving: the RSSI at 8 m behind one concrete wall (Fig. 5)."""
         return self.rssi(8.0) - self.concrete_db
+
+    @property
+    def lossless_dbm(self) -> float:
+        """The weakest RSSI at which no frame is lost: the sensitivity plus the fading
+        margin (7 m behind the concrete wall of Fig. 5)."""
+        return self.sensitivity_dbm + self.fade_db
+
+    def limit_dbm(self, a: str, b: str) -> float:
+        """The RSSI a link between ``a`` and ``b`` must exceed to be used: the framework's
+        threshold, or the adapter's lossless limit for a link of an ``adapter_limit`` agent."""
+        if self.adapter_limit and (a in self.adapter_limit or b in self.adapter_limit):
+            return self.lossless_dbm
+        return self.threshold_dbm
 
     def bind(self, world: Any) -> None:
         """The run's world: positions and walls between agents come from it (walls do
@@ -100,7 +117,8 @@ class RadioChannel(ChannelModel):
         return self.rssi(*found) + float(self.gains_db.get(a, 0.0)) + float(self.gains_db.get(b, 0.0))
 
     def usable(self, a: str, b: str, positions: dict[str, Any] | None = None) -> bool:
-        """Whether the framework would use the link (RSSI above the threshold).
+        """Whether the framework would use the link (RSSI above the threshold, or above
+        the adapter's lossless limit for an ``adapter_limit`` agent's link).
 
         Walls only take power away, so a pair whose RSSI in free space (antenna gains
         included) is already at or below the threshold is out of range without
@@ -118,10 +136,10 @@ class RadioChannel(ChannelModel):
             if pa is not None and pb is not None:
                 free = self.path.rssi(math.dist(pa, pb)) + float(self.gains_db.get(a, 0.0)) \
                     + float(self.gains_db.get(b, 0.0))
-                if free <= self.threshold_dbm:
+                if free <= self.limit_dbm(a, b):
                     return False
         level = self.link_rssi(a, b)
-        return level is None or level > self.threshold_dbm
+        return level is None or level > self.limit_dbm(a, b)
 
     def loss_probability(self, level: float) -> float:
         """Chance a frame at RSSI ``level`` is lost."""

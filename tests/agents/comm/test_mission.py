@@ -119,24 +119,25 @@ def trial_metrics(table: str, row: int) -> tuple[dict, dict]:
     return result["metrics"], trial.params
 
 
-def test_a_failed_robot_leaves_the_decentralised_survivors_with_the_whole_map():
-    metrics, params = trial_metrics("table8", 1)
-    assert params["failed"] == "robot3"
-    assert metrics["maps_complete"] == 1.0            # survivors only: they re-explored robot3's cells
+def test_a_broken_down_robot_leaves_the_decentralised_survivors_with_the_whole_map():
+    metrics, params = trial_metrics("table8-breakdown", 0)
+    assert params["breakdown"] == "robot3" and params["fail_at"] == 110
+    assert metrics["maps_complete"] == 1.0                  # robot1 and robot2, the working agents
+    assert metrics["complete_per_agent.robot3"] == 0        # nobody drives to it: its map lacks vertices (Fig. 11)
 
 
-def test_a_failed_central_unit_leaves_partial_maps():
+def test_a_failed_central_unit_leaves_every_robot_with_a_partial_map():
     metrics, params = trial_metrics("table8", 0)
-    assert params["failed"] == "central"
-    assert metrics["maps_complete"] < 1.0
+    assert params["fail_at"] == 110
+    assert metrics["maps_complete"] == 0.0
 
 
 @pytest.mark.slow
 def test_a_late_monitor_relays_to_the_broken_down_robot():
     metrics, params = trial_metrics("table9", 0)
     assert params["monitor"] is True
-    assert metrics["bytes_per_agent.monitor1"] > 0     # it joined, got data and passed it on
-    assert metrics["maps_complete"] == 1.0             # robot3, which cannot move, holds the whole map
+    assert metrics["bytes_per_agent.monitor1"] > 0          # it joined, got data and passed it on
+    assert metrics["complete_per_agent.robot3"] == 1        # robot3, which cannot move, holds the whole map
 
 
 def test_each_agents_map_is_drawn_with_its_missing_vertices(tmp_path):
