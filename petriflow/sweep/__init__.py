@@ -38,9 +38,10 @@ from pathlib import Path
 from typing import Any, Callable
 
 from petriflow.errors import PetriflowError
-from petriflow.sweep.backends import BACKENDS, BackendError, default_workers, run_local, run_ray
+from petriflow.sweep.backends import BACKENDS, RETRIES, BackendError, RayBackend, default_workers, run_local
 from petriflow.sweep.report import metric_names, summary, trial_status
-from petriflow.sweep.spec import Sweep, Trial, load_sweep
+from petriflow.sweep.ship import collect
+from petriflow.sweep.spec import Sweep, Trial, canonical, load_sweep
 from petriflow.sweep.store import Store, StoreError
 
 __all__ = ["Sweep", "SweepResult", "load_sweep", "run_sweep", "BACKENDS", "BackendError", "StoreError"]
@@ -135,39 +136,54 @@ def _progress(name: str, total: int, progress: Any) -> Any:
 
 def run_sweep(sweep: Sweep, *, backend: str = "local", workers: int | None = None, db: str | Path | None = None,
               resume: bool = False, progress: Any = False, ray_address: str | None = None,
-              on_result: Callable[[Trial, dict[str, Any]], None] | None = None) -> SweepResult:
+              on_result: Callable[[Trial, dict[str, Any]], None] | None = None, retries: int = RETRIES,
+              ray_pip: list[str] | None = None) -> SweepResult:
     """Run every trial of ``sweep`` not yet in ``db``; record and summarise them.
 
     Args:
         backend: ``local`` (worker processes) or ``ray``.
-        workers: processes (local; default: every CPU) or tasks in flight (ray;
-            default: the cluster's CPUs).
-        db: the results database (default: in memory).
-        resume: ``db`` exists: run only the trials it lacks.
+        workers: processes (local; default: every CPU) or trials in flight at most
+            (ray; default: the cluster's CPUs, as nodes come and go).
+        db: the results database (default: in memory). It is created only once the
+            backend has started (a cluster that cannot be reached leaves no file).
+        resume: ``db`` exists: run only the trials it lacks, and again those recorded
+            ``crashed`` (their process or node died).
         progress: ``"bar"`` (a terminal's progress bar), a number of seconds (a line
             on standard error that often: a log, CI), or nothing.
         ray_address: the Ray cluster (default ``RAY_ADDRESS``, else a local instance).
         on_result: called with each trial's result as it arrives.
+        retries: ray: times a trial is tried again after its node or worker died.
+        ray_pip: ray: more packages for nodes that get petriflow's dependencies by pip.
 
     Raises:
-        StoreError: ``db`` exists without ``resume``, or holds another sweep.
+        StoreError: ``db`` exists without ``resume``, or holds another sweep (or the
+            files the sweep reads changed since).
         BackendError: the backend cannot start.
     """
     if backend not in BACKENDS:
         raise PetriflowError(f"unknown backend {backend!r} (one of {', '.join(BACKENDS)})")
     if workers is not None and workers < 1:
         raise PetriflowError(f"workers must be at least 1, not {workers}")
+    if retries < 0:
+        raise PetriflowError(f"retries must be 0 or more, not {retries}")
+    bundle = collect(sweep)
+    meta = {"file": sweep.path, "digest": bundle.digest(), "files": canonical(bundle.hashes)}
     store = Store(db)
-    store.begin({"file": sweep.path, "digest": sweep.digest}, resume=resume)
+    store.check(meta, resume)
+    cluster = None
+    if backend == "ray":
+        cluster = RayBackend(workers, sweep.timeout, ray_address, retries=retries, pip=ray_pip)
+        cluster.connect(bundle)
     started = wallclock.perf_counter()
     try:
+        store.begin(meta, resume=resume)
         done = store.done()
         todo = [t for t in sweep.trials() if (t.key, t.seed) not in done]
         payloads = [sweep.payload(t) for t in todo]
-        if backend == "local":
+        if cluster is None:
             results = run_local(payloads, workers or default_workers(), sweep.timeout)
         else:
-            results = run_ray(payloads, workers, sweep.timeout, ray_address)
+            results = cluster.run(payloads)
         bar = _progress(sweep.name, len(todo), progress)
         try:
             for index, result in results:
@@ -183,6 +199,8 @@ def run_sweep(sweep: Sweep, *, backend: str = "local", workers: int | None = Non
         trials = store.results()
     finally:
         store.close()
+        if cluster is not None:
+            cluster.close()
     names = metric_names([m.name for m in sweep.metrics], trials)
     rows = summary(sweep.rows, trials, names)
     failures = [t for t in trials if trial_status(t) != "ok"]

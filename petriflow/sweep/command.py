@@ -4,13 +4,17 @@ Exit codes: 0 every trial ran and no run ended ``failed``, 1 some trial failed (
 run ended failed, or it could not run, crashed or timed out; they are in the report,
 with their status, and in the results database), 2 bad input. Progress goes to standard
 error: a bar on a terminal, a line every ``--progress-every`` seconds otherwise (a log,
-CI), nothing with ``--quiet``.
+CI), nothing with ``--quiet``; so does anything else written to standard output while
+trials run (a trial's prints), and on Ray whatever Ray itself writes goes to a log file
+(named on standard error), so ``--json`` prints one JSON document and nothing else.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -21,7 +25,7 @@ __all__ = ["add_parser", "cmd_sweep"]
 
 def add_parser(sub) -> argparse.ArgumentParser:
     """Add the ``sweep`` command to the ``petriflow`` subcommands ``sub``."""
-    from petriflow.sweep.backends import BACKENDS
+    from petriflow.sweep.backends import BACKENDS, RETRIES
 
     sweep = sub.add_parser(
         "sweep", help="Run an experiment: a net over a grid of parameters and seeds, measured.",
@@ -31,12 +35,19 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sweep.add_argument("spec", help="sweep file (YAML)")
     sweep.add_argument("--backend", choices=BACKENDS, default="local",
                        help="local worker processes (default) or a Ray cluster")
-    sweep.add_argument("--workers", type=int, help="processes (local; default: every CPU) or tasks in"
-                       " flight (ray; default: the cluster's CPUs)")
+    sweep.add_argument("--workers", type=int, help="processes (local; default: every CPU) or trials in"
+                       " flight at most (ray; default: the cluster's CPUs, as nodes come and go)")
     sweep.add_argument("--trials", type=int, help="run seeds 1..K (overrides the file's trials or seeds)")
     sweep.add_argument("--db", help="SQLite results database (new file; or the one to --resume)")
-    sweep.add_argument("--resume", action="store_true", help="run only the trials --db lacks")
-    sweep.add_argument("--ray-address", help="Ray cluster address (default: RAY_ADDRESS, else a local instance)")
+    sweep.add_argument("--resume", action="store_true", help="run only the trials --db lacks, and again those"
+                       " recorded crashed (their process or node died)")
+    sweep.add_argument("--ray-address", help="Ray cluster address: HOST:6379 on a node of the cluster, or"
+                       " ray://HOST:10001 with ray[client] (default: RAY_ADDRESS, else a local instance)")
+    sweep.add_argument("--retries", type=int, default=RETRIES, metavar="N",
+                       help=f"ray: times a trial is tried again after its node or worker died (default {RETRIES})")
+    sweep.add_argument("--ray-pip", action="append", metavar="REQUIREMENT",
+                       help="ray: a package more for nodes that get petriflow's dependencies by pip (your action"
+                       " modules' imports); repeat for more")
     sweep.add_argument("--json", action="store_true", help="print the report as JSON")
     sweep.add_argument("--csv", metavar="OUT", help="write the report as CSV")
     sweep.add_argument("--plot", metavar="OUT.png", help="plot each metric against the first parameter")
@@ -70,8 +81,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     if not args.progress_every > 0:
         raise PetriflowError(f"--progress-every must be a number of seconds > 0, got {args.progress_every}")
     progress = None if args.quiet else ("bar" if sys.stderr.isatty() else args.progress_every)
-    result = run_sweep(sweep, backend=args.backend, workers=args.workers, db=args.db, resume=args.resume,
-                       progress=progress, ray_address=args.ray_address)
+    if args.retries < 0:
+        raise PetriflowError(f"--retries must be 0 or more, got {args.retries}")
+    # while trials run, whatever else writes to standard output (a trial's prints) goes
+    # to standard error, and on Ray, whatever Ray writes to either to a log file: the
+    # report alone is on standard output, petriflow's own lines on standard error
+    with (_ray_output() if args.backend == "ray" else _stdout_to_stderr()):
+        result = run_sweep(sweep, backend=args.backend, workers=args.workers, db=args.db, resume=args.resume,
+                           progress=progress, ray_address=args.ray_address, retries=args.retries,
+                           ray_pip=args.ray_pip)
     if args.metrics:
         wanted = [m.strip() for m in args.metrics.split(",") if m.strip()]
         unknown = [m for m in wanted if m not in result.names]
@@ -110,6 +128,71 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             if path:
                 print(f"  wrote {path}")
     return 1 if result.failures else 0
+
+
+@contextlib.contextmanager
+def _stdout_to_stderr():
+    """Point file descriptor 1 at standard error for the block (threads and child
+    processes included), then back."""
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # no standard output at all
+        yield
+        return
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        try:
+            sys.stdout.flush()
+        except (OSError, ValueError):
+            pass
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+@contextlib.contextmanager
+def _ray_output():
+    """Point file descriptors 1 and 2 at a log file for the block (Ray's threads and
+    its C++ core write there), with ``sys.stderr`` still the real standard error;
+    name the log on standard error when Ray wrote anything."""
+    import tempfile
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    try:
+        saved_out, saved_err = os.dup(1), os.dup(2)
+    except OSError:
+        yield
+        return
+    log_fd, log_path = tempfile.mkstemp(prefix="petriflow-sweep-ray-", suffix=".log")
+    real_stderr = sys.stderr
+    sys.stderr = os.fdopen(os.dup(saved_err), "w", buffering=1, encoding=real_stderr.encoding or "utf-8",
+                           errors="backslashreplace")
+    finished = False
+    try:
+        os.dup2(log_fd, 1)
+        os.dup2(log_fd, 2)
+        yield
+        finished = True
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        ours, sys.stderr = sys.stderr, real_stderr
+        ours.close()
+        os.dup2(saved_out, 1)
+        os.dup2(saved_err, 2)
+        os.close(saved_out)
+        os.close(saved_err)
+        os.close(log_fd)
+        if finished and os.path.getsize(log_path):
+            print(f"ray: its own messages are in {log_path}", file=sys.stderr)
+        else:  # nothing, or a failure whose error line says what matters
+            os.unlink(log_path)
 
 
 def _count(n: int, noun: str) -> str:

@@ -25,7 +25,8 @@ The format is documented in ``docs/sweep-format.md``; in short::
         - {params: {mode: centralised}, values: {time_s: 55.2}}
 
 A trial is one row's parameters and one seed; :meth:`Sweep.payload` is all a worker
-needs to run it (plain data, absolute paths), so a trial's result depends only on
+needs to run it (plain data; absolute paths, made relative to the shipped files on a
+cluster), so a trial's result depends only on
 (sweep, parameters, seed), on any backend.
 
 Examples:
@@ -45,7 +46,6 @@ Examples:
 
 from __future__ import annotations
 
-import hashlib
 import itertools
 import json
 import math
@@ -331,11 +331,13 @@ class Sweep:
 
     @property
     def digest(self) -> str:
-        """A digest of what decides a trial's result (net, run, set, metrics; not the
-        seeds, the timeout or the paper's values): a results database answers for one."""
-        data = self.to_data()
-        del data["timeout"], data["name"], data["path"]
-        return hashlib.sha256(canonical(data).encode()).hexdigest()[:16]
+        """The sweep's fingerprint: what decides a trial's result (net, run, set,
+        metrics; not the seeds, the timeout or the paper's values) and the *content* of
+        every file its trials read (:func:`petriflow.sweep.ship.collect`): a results
+        database answers for one."""
+        from petriflow.sweep.ship import collect
+
+        return collect(self).digest()
 
     @property
     def parameters(self) -> list[str]:

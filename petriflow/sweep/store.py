@@ -52,8 +52,28 @@ class Store:
         self.path = None if path is None else Path(path)
         self.db: sqlite3.Connection | None = None
 
+    def check(self, meta: dict[str, str], resume: bool) -> None:
+        """Refuse early, creating nothing: ``path`` exists without ``resume``, is
+        missing with it, or holds another sweep (see :meth:`begin`)."""
+        if self.path is None:
+            return
+        where = str(self.path)
+        exists = self.path.exists()
+        if exists and not resume:
+            raise StoreError(f"{where}: already exists; use --resume to finish that sweep, or another --db")
+        if not exists and resume:
+            raise StoreError(f"{where}: no such results database to resume")
+        if self.path.is_dir():
+            raise NetFormatError("--db names a folder, not a file", path=where)
+        if exists:
+            self.begin(meta, resume=True)
+            self.close()
+
     def begin(self, meta: dict[str, str], resume: bool) -> None:
         """Open (``resume``: an existing database of the same sweep) or create the database.
+
+        ``meta`` holds ``file``, ``digest`` (the sweep's fingerprint) and, optionally,
+        ``files`` (JSON ``{file: content digest}``, so a refusal names the file that changed).
 
         Raises:
             StoreError: it exists and ``resume`` is false; it holds another sweep; it is
@@ -80,8 +100,7 @@ class Store:
                 if known.get("format") != FORMAT:
                     raise StoreError(f"{where}: not a petriflow sweep results database")
                 if known.get("digest") != meta["digest"]:
-                    raise StoreError(f"{where}: holds the results of another sweep ({known.get('file')}, or this"
-                                     " file before it changed); use another --db")
+                    raise StoreError(f"{where}: {_changed(known, meta)}")
                 self.db.execute("SELECT row, params, seed, status, outcome, metrics, wall, error FROM trials LIMIT 1")
             else:
                 self.db.execute("PRAGMA journal_mode=WAL")
@@ -103,16 +122,17 @@ class Store:
             self.db.executemany("INSERT OR REPLACE INTO sweep VALUES (?, ?)", sorted(meta.items()))
 
     def done(self) -> set[tuple[str, int]]:
-        """``{(params, seed)}`` of the trials already recorded."""
+        """``{(params, seed)}`` of the trials recorded, less the ``crashed`` ones (their
+        process or node died: a resumed sweep runs them again)."""
         assert self.db is not None
-        return set(self.db.execute("SELECT params, seed FROM trials").fetchall())
+        return set(self.db.execute("SELECT params, seed FROM trials WHERE status != 'crashed'").fetchall())
 
     def add(self, row: int, params: dict[str, Any], seed: int, result: dict[str, Any]) -> None:
-        """Record one trial's result (committed at once)."""
+        """Record one trial's result (committed at once; it replaces a ``crashed`` one)."""
         assert self.db is not None
         with self.db:
             self.db.execute(
-                "INSERT OR IGNORE INTO trials VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
+                "INSERT OR REPLACE INTO trials VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
                 (row, canonical(params), seed, result["status"], result.get("outcome"),
                  json.dumps(result.get("metrics", {}), sort_keys=True), result.get("wall"), result.get("error")),
             )
@@ -134,3 +154,19 @@ class Store:
         if self.db is not None:
             self.db.close()
             self.db = None
+
+
+def _changed(known: dict[str, str], meta: dict[str, str]) -> str:
+    """Why a database's sweep differs from this one, in a few words."""
+    try:
+        before, now = json.loads(known.get("files") or "null"), json.loads(meta.get("files") or "null")
+    except ValueError:
+        before = now = None
+    if isinstance(before, dict) and isinstance(now, dict):
+        edited = sorted(f for f in now if f in before and before[f] != now[f])
+        if edited:
+            return (f"{', '.join(edited[:3])}{' and more' if len(edited) > 3 else ''} changed since these results"
+                    f" were recorded; restore {'it' if len(edited) == 1 else 'them'}, or use another --db")
+        if before != now:
+            return "the sweep reads other files than when these results were recorded; use another --db"
+    return f"holds the results of another sweep ({known.get('file')}, or this file before it changed); use another --db"

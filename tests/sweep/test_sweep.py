@@ -224,12 +224,71 @@ def test_resume_after_a_kill_runs_every_trial_exactly_once(folder, tmp_path):
     assert rows == [(seed, 1) for seed in range(1, 13)]
 
 
-@pytest.mark.slow
-def test_ray_backend_gives_the_local_pools_rows_seed_for_seed(folder, tmp_path):
-    pytest.importorskip("ray")
-    sweep = load_sweep(random_sweep(folder, tmp_path, trials=3))
-    local = run_sweep(sweep, workers=2)
-    remote = run_sweep(sweep, backend="ray", workers=2)
-    strip = lambda trials: [(t["row"], t["seed"], t["status"], t["metrics"]) for t in trials]  # noqa: E731
-    assert strip(remote.trials) == strip(local.trials)
-    assert remote.rows == local.rows
+def test_resume_refuses_with_one_line_when_a_file_the_trials_read_changed(folder, tmp_path, capsys):
+    """The fingerprint is the files' content: an edited net refuses, a moved project resumes."""
+    import shutil
+
+    project = tmp_path / "project"
+    project.mkdir()
+    (project / "net.yaml").write_text("petriflow: 1\nrun: run.yaml\nplaces: [{id: i, tokens: 1}, o]\ntransitions:"
+                                      " [{id: rest, action: core.wait, params: {seconds: 1}, in: [i], out: [o]}]\n")
+    (project / "run.yaml").write_text("seed: 0\nuntil: 100\n")
+    path = write(project, "edit.yaml", """\
+        petriflow-sweep: 1
+        net: net.yaml
+        trials: 2
+        metrics: [core.end_time]
+        """)
+    db = tmp_path / "results.sqlite"
+    assert main(["sweep", str(path), "--db", str(db), "--workers", "1", "--trials", "1"]) == 0
+    capsys.readouterr()
+    moved = tmp_path / "moved"
+    shutil.copytree(project, moved)
+    assert main(["sweep", str(moved / "edit.yaml"), "--db", str(db), "--resume", "--workers", "1"]) == 0
+    assert "1 run now" in capsys.readouterr().out
+    net = moved / "net.yaml"
+    net.write_text(net.read_text().replace("seconds: 1", "seconds: 2"))
+    assert main(["sweep", str(moved / "edit.yaml"), "--db", str(db), "--resume", "--trials", "3"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip().splitlines() == [
+        f"petriflow: {db}: net.yaml changed since these results were recorded; restore it, or use another --db"]
+    (moved / "run.yaml").write_text((moved / "run.yaml").read_text() + "\n")  # the run configuration too
+    net.write_text(net.read_text().replace("seconds: 2", "seconds: 1"))
+    assert main(["sweep", str(moved / "edit.yaml"), "--db", str(db), "--resume"]) == 2
+    assert "run.yaml changed since" in capsys.readouterr().err
+
+
+def test_resume_runs_crashed_trials_again_and_keeps_the_others(folder, tmp_path, capsys):
+    path = random_sweep(folder, tmp_path, trials=2)
+    db = tmp_path / "results.sqlite"
+    assert main(["sweep", str(path), "--db", str(db), "--workers", "2"]) == 0
+    with sqlite3.connect(db) as connection:
+        clean = connection.execute("SELECT row, seed, status, metrics FROM trials ORDER BY row, seed").fetchall()
+        connection.execute("UPDATE trials SET status = 'crashed', metrics = '{}' WHERE seed = 2")
+        connection.execute("UPDATE trials SET wall = -1 WHERE seed = 1")
+    capsys.readouterr()
+    assert main(["sweep", str(path), "--db", str(db), "--resume", "--workers", "2"]) == 0
+    assert "2 run now" in capsys.readouterr().out
+    with sqlite3.connect(db) as connection:
+        assert connection.execute("SELECT row, seed, status, metrics FROM trials ORDER BY row, seed").fetchall() == clean
+        assert connection.execute("SELECT COUNT(*) FROM trials WHERE wall = -1").fetchone() == (2,)  # kept
+
+
+def test_json_is_the_only_thing_on_standard_output_even_when_a_trial_prints(folder, tmp_path):
+    (tmp_path / "chatty_actions.py").write_text(
+        "from petriflow import action\n\n@action('chatty.say')\ndef say(ctx):\n"
+        "    print('hello from a trial', flush=True)\n    yield 1.0\n")
+    (tmp_path / "chatty.yaml").write_text(
+        "petriflow: 1\nrun: {actions: [chatty_actions.py]}\nplaces: [{id: i, tokens: 1}, o]\n"
+        "transitions: [{id: t, action: chatty.say, in: [i], out: [o]}]\n")
+    path = write(tmp_path, "s.yaml", """\
+        petriflow-sweep: 1
+        net: chatty.yaml
+        trials: 2
+        metrics: [core.end_time]
+        """)
+    done = subprocess.run([sys.executable, "-m", "petriflow.cli", "sweep", str(path), "--json", "--workers", "2"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["rows"][0]["trials"] == 2
+    assert "hello from a trial" in done.stderr
