@@ -20,6 +20,7 @@ JSON and in the exit code (1 when any trial failed).
 from __future__ import annotations
 
 import csv
+import json
 import math
 from collections import Counter
 from pathlib import Path
@@ -90,6 +91,8 @@ def _number(value: Any) -> str:
         return "-"
     if isinstance(value, str):
         return value
+    if isinstance(value, (list, tuple, dict)):  # a row parameter such as a list of faults
+        return json.dumps(value, sort_keys=True, separators=(",", ":"))
     if value == 0 or 0.01 <= abs(value) < 1e6:
         return f"{value:.4g}" if abs(value) < 1000 else f"{value:,.0f}"
     return f"{value:.3g}"

@@ -55,6 +55,7 @@ from pathlib import Path
 from typing import Any
 
 from petriflow.errors import NetFormatError
+from petriflow.runtime.metrics import MetricRef, parse_refs
 
 __all__ = ["Sweep", "Row", "Trial", "MetricRef", "load_sweep", "substitute", "FORMAT_VERSION", "SET_ROOTS"]
 
@@ -95,15 +96,6 @@ class Row:
     index: int
     params: dict[str, Any]
     paper: dict[str, Any] = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
-class MetricRef:
-    """A metric the sweep reports: under ``name``, the registered ``metric`` with ``params``."""
-
-    name: str
-    metric: str
-    params: dict[str, Any] = field(default_factory=dict)
 
 
 def canonical(value: Any) -> str:
@@ -427,38 +419,7 @@ def _rows(data: dict, fail) -> list[Row]:
 
 
 def _metrics(data: dict, fail) -> list[MetricRef]:
-    given = data.get("metrics", ["core.end_time", "core.firings", "core.outcome"])
-    entries: list[tuple[str, Any]] = []
-    if isinstance(given, dict):
-        entries = list(given.items())
-    elif isinstance(given, list) and given:
-        for entry in given:
-            if isinstance(entry, str):
-                entries.append((entry, entry))
-            elif isinstance(entry, dict) and len(entry) == 1:
-                entries.append(next(iter(entry.items())))
-            else:
-                fail("metrics: each entry is a registered metric name, or {name: metric} or"
-                     " {name: {metric: NAME, PARAM: VALUE}}", item=entry, key="metrics")
-    else:
-        fail("metrics must be a non-empty list or mapping of registered metrics", key="metrics")
-    metrics: list[MetricRef] = []
-    for name, spec in entries:
-        if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z_][\w.\-]*", name):
-            fail(f"metrics: {name!r} is not a metric name", key="metrics")
-        if isinstance(spec, str):
-            metric, params = spec, {}
-        elif isinstance(spec, dict) and isinstance(spec.get("metric"), str):
-            metric, params = spec["metric"], {k: v for k, v in spec.items() if k != "metric"}
-            if not _plain_value(params):
-                fail(f"metrics: {name}: parameters must be plain data", item=spec, key="metrics")
-        else:
-            fail(f"metrics: {name}: give a registered metric name or {{metric: NAME, ...}}", item=spec,
-                 key="metrics")
-        if any(m.name == name for m in metrics):
-            fail(f"metrics: {name!r} is listed twice", key="metrics")
-        metrics.append(MetricRef(name, metric, params))
-    return metrics
+    return parse_refs(data.get("metrics", ["core.end_time", "core.firings", "core.outcome"]), fail)
 
 
 def _paper(data: dict, rows: list[Row], metric_names: set[str], fail) -> str | None:

@@ -28,13 +28,13 @@ Examples:
 from __future__ import annotations
 
 import importlib
-import math
 import time as wallclock
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from petriflow.errors import NetFormatError, PetriflowError
+from petriflow.runtime.metrics import plain_value
 from petriflow.sweep.spec import substitute
 
 __all__ = ["run_trial", "build", "Built", "set_path", "TrialError"]
@@ -154,20 +154,11 @@ def _apply_net(net, sets: dict[str, Any]) -> None:
 
 
 def _value(name: str, value: Any, into: dict[str, Any]) -> None:
-    """Store a metric's value as plain data: numbers, text, None; a mapping flattened."""
-    if isinstance(value, dict):
-        for key, item in value.items():
-            _value(f"{name}.{key}", item, into)
-        return
-    if hasattr(value, "item") and not isinstance(value, (str, bytes)):  # numpy scalars
-        value = value.item()
-    if isinstance(value, bool):
-        value = int(value)
-    if isinstance(value, float) and not math.isfinite(value):
-        value = None
-    if value is not None and not isinstance(value, (int, float, str)):
-        raise TrialError(f"metric {name}: returned {type(value).__name__}, not a number, text or mapping")
-    into[name] = value
+    """Store a metric's value as plain data (:func:`petriflow.runtime.metrics.plain_value`)."""
+    try:
+        plain_value(name, value, into)
+    except PetriflowError as exc:
+        raise TrialError(str(exc)) from None
 
 
 @dataclass

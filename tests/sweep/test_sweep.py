@@ -292,3 +292,11 @@ def test_json_is_the_only_thing_on_standard_output_even_when_a_trial_prints(fold
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["rows"][0]["trials"] == 2
     assert "hello from a trial" in done.stderr
+
+
+def test_a_row_parameter_that_is_a_list_is_shown_as_data(tmp_path):
+    """A row may set a list (faults of a run configuration); the report prints it as JSON."""
+    from petriflow.sweep.report import _number
+
+    assert _number([{"kill": "central", "at": 110}]) == '[{"at":110,"kill":"central"}]'
+    assert _number({"a": 1}) == '{"a":1}' and _number(2.5) == "2.5"
