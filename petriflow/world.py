@@ -21,6 +21,19 @@ The description is plain data (a ``world.yaml`` beside a net)::
     cameras:
       - {id: top, position: [0, 0, 6], target: [0, 0, 0], up: [0, 1, 0], fov: 60,
          width: 640, height: 480}
+    mode: dynamic            # or kinematic (below)
+
+**Kinematic mode** (``mode: kinematic``): robots are bodies without mass whose poses
+the world holds in numpy arrays and integrates together at each step from the
+velocities actions command (:meth:`World.command`; a robot's ``drive`` is ``diff``,
+``unicycle`` or ``holonomic``). A pose is written back to pybullet only when
+something reads pybullet (a ray test that may hit robots, a camera, :meth:`World.sync`
+for code that calls pybullet itself) or for drawing in the GUI, and
+``stepSimulation`` runs only when a body still has dynamics (a robot with
+``motion: dynamic``, a box with mass): legged and chain robots keep full dynamics in
+a kinematic world. **Sensors on demand**: :meth:`World.request_rays` records rays an
+action asks for; the world casts every request of a tick in one ``rayTestBatch`` at
+its next step (or at :meth:`World.flush_sensors`), and the request then holds the hits.
 
 A ``urdf`` is a path relative to the description file, or ``"package:path"`` naming a
 file shipped inside an installed Python package (``pybullet_data:r2d2.urdf``). It is
@@ -42,9 +55,15 @@ from pathlib import Path
 from typing import Any
 
 from petriflow.errors import DependencyNotInstalled, NetFormatError, PetriflowError, did_you_mean
-from petriflow.worldfile import COLOURS, check_box, check_world
+from petriflow.worldfile import COLOURS, DRIVES, check_box, check_world
 
-__all__ = ["World", "Camera", "load_world", "COLOURS"]
+__all__ = ["World", "Camera", "RayRequest", "load_world", "COLOURS", "DRIVES", "ROBOT_GROUP"]
+
+#: The collision filter group of kinematic robots: ray tests that should see only the
+#: scene (walls, boxes) leave it out of their mask.
+ROBOT_GROUP = 1 << 5
+#: Rays per ``rayTestBatch`` call (pybullet's own limit is 16,384).
+_RAY_BATCH = 16384
 
 
 @contextlib.contextmanager
@@ -113,6 +132,7 @@ class Camera:
         """Render the current scene with pybullet's CPU renderer."""
         import numpy as np
 
+        self.world.sync()
         p = self.world.p
         _, _, rgba, _, _ = p.getCameraImage(
             self.width, self.height, self.view, self.projection,
@@ -130,6 +150,25 @@ class Camera:
         clip = projection @ view @ np.array([x, y, z, 1.0])
         ndc = clip[:3] / clip[3]
         return ((ndc[0] + 1) / 2 * self.width, (1 - ndc[1]) / 2 * self.height)
+
+
+class RayRequest:
+    """Rays an action asked for (:meth:`World.request_rays`): ``hits`` is ``None`` until
+    the world casts them, then one ``(body, fraction, (x, y, z))`` per ray (body ``-1``
+    and fraction ``1.0`` for a ray that hits nothing)."""
+
+    __slots__ = ("starts", "ends", "robots", "hits")
+
+    def __init__(self, starts: list, ends: list, robots: bool) -> None:
+        self.starts = starts
+        self.ends = ends
+        self.robots = robots
+        self.hits: list[tuple[int, float, tuple[float, float, float]]] | None = None
+
+    @property
+    def ready(self) -> bool:
+        """Whether the rays were cast."""
+        return self.hits is not None
 
 
 class World:
@@ -167,6 +206,14 @@ class World:
         self.agents: dict[str, str] = {}
         self.cameras: dict[str, Camera] = {}
         self.steps = 0
+        #: ``dynamic`` or ``kinematic`` (see the module).
+        self.mode: str = description["mode"]
+        self._kin: dict[str, int] = {}          # kinematic robot's body id -> row of the arrays
+        self._kin_rows: list[dict[str, Any]] = []
+        self._dynamic = 0                       # bodies pybullet must step (mass > 0)
+        self._commanded: dict[int, tuple[float, float, float]] = {}  # dynamic bodies driven by velocity
+        self._requests: list[RayRequest] = []
+        self._gui = gui
         if description["plane"]:
             self.bodies["plane"] = self._load_urdf("pybullet_data:plane.urdf", (0, 0, 0), 0.0, fixed=True)
         for box in description["boxes"]:
@@ -177,6 +224,7 @@ class World:
             self._add_robot(robot)
         for camera in description["cameras"]:
             self._add_camera(camera)
+        self._arrays()
 
     # Building -----------------------------------------------------------------------
     def _fail(self, message: str, element: str | None = None):
@@ -224,6 +272,7 @@ class World:
         body = p.createMultiBody(box["mass"], shape, visual, box["position"],
                                  p.getQuaternionFromEuler((0, 0, box["yaw"])), physicsClientId=self.client)
         self.bodies[id] = body
+        self._dynamic += box["mass"] > 0
         return body
 
     def _add_grid(self, grid: dict[str, Any]) -> None:
@@ -251,16 +300,205 @@ class World:
         self.agents[robot["agent"]] = robot["id"]
         if "colour" in robot:
             self.p.changeVisualShape(body, -1, rgbaColor=robot["colour"], physicsClientId=self.client)
+        if robot.get("motion", "dynamic") == "kinematic":
+            p, client = self.p, self.client
+            for link in range(-1, p.getNumJoints(body, physicsClientId=client)):
+                # no mass: pybullet never integrates it; its own group: scene-only rays skip it
+                p.changeDynamics(body, link, mass=0.0, physicsClientId=client)
+                p.setCollisionFilterGroupMask(body, link, ROBOT_GROUP, 0xFFFF, physicsClientId=client)
+            self._kin[body] = len(self._kin_rows)
+            self._kin_rows.append({"body": body, "x": x, "y": y, "yaw": robot["yaw"], "z": robot["z"],
+                                   "roll": robot["roll"], "pitch": robot["pitch"],
+                                   "drive": DRIVES.index(robot.get("drive", "diff"))})
+        else:
+            self._dynamic += 1
 
+    def _arrays(self) -> None:
+        """The kinematic robots' poses and commands as arrays (one row per robot)."""
+        import numpy as np
+
+        rows = self._kin_rows
+        #: ``(N, 3)`` x, y, yaw of the kinematic robots (row order: :attr:`kinematic_bodies`).
+        self.poses = np.array([[r["x"], r["y"], r["yaw"]] for r in rows], dtype=float).reshape(-1, 3)
+        #: ``(N, 3)`` commanded forward speed (m/s), sideways speed (m/s), turn rate (rad/s).
+        self.velocities = np.zeros((len(rows), 3))
+        self._z = np.array([r["z"] for r in rows], dtype=float)
+        self._tilt = [(r["roll"], r["pitch"]) for r in rows]
+        self._drive = np.array([r["drive"] for r in rows], dtype=np.int8)
+        self._live = np.ones(len(rows), dtype=bool)
+        self._moving = np.zeros(len(rows), dtype=bool)
+        self._stale = np.zeros(len(rows), dtype=bool)      # pose changed since written to pybullet
+        #: pybullet body ids of the kinematic robots, in row order.
+        self.kinematic_bodies = [r["body"] for r in rows]
+        del self._kin_rows
     def _add_camera(self, camera: dict[str, Any]) -> None:
         self.cameras[camera["id"]] = Camera(self, camera["id"], camera["position"], camera["target"], camera["up"],
                                             camera["fov"], camera["width"], camera["height"])
 
     # Running ------------------------------------------------------------------------
     def step(self) -> None:
-        """Advance physics by one ``dt``."""
-        self.p.stepSimulation(physicsClientId=self.client)
+        """Advance the world by one ``dt``: cast the rays asked for since the last step
+        (at the poses they were asked at), move the kinematic robots, and step pybullet
+        when a body has dynamics (always in the dynamic mode)."""
+        if self._requests:
+            self.flush_sensors()
+        if self._moving.any():
+            self._integrate(self.dt)
+        if self._commanded:
+            self._apply_commands()
+        if self.mode == "dynamic" or self._dynamic:
+            self.p.stepSimulation(physicsClientId=self.client)
+        if self._gui:
+            self.sync()
         self.steps += 1
+
+    # Kinematic robots ---------------------------------------------------------------
+    @property
+    def active(self):
+        """``(N,)`` booleans: which kinematic robots are in the scene (not removed)."""
+        return self._live
+
+    def is_kinematic(self, name: str) -> bool:
+        """Whether a body (or an agent's robot) moves kinematically."""
+        return self.body(name) in self._kin
+
+    def row(self, name: str) -> int:
+        """A kinematic robot's row in :attr:`poses` and :attr:`velocities`.
+
+        Raises:
+            PetriflowError: the body is not a kinematic robot.
+        """
+        row = self._kin.get(self.body(name))
+        if row is None:
+            raise PetriflowError(f"{name!r} is not a kinematic robot (its world's mode is {self.mode})")
+        return row
+
+    def command(self, name: str, v: float = 0.0, w: float = 0.0, vy: float = 0.0) -> None:
+        """Drive a robot at forward speed ``v`` (m/s), turn rate ``w`` (rad/s) and, for a
+        ``holonomic`` drive, sideways speed ``vy`` (m/s), until the next command. A
+        kinematic robot is moved by the world's integration; a dynamic body gets the
+        velocity before each physics step (it still collides and, on a floor, rubs)."""
+        body = self.body(name)
+        row = self._kin.get(body)
+        if row is None:
+            if not (v or w or vy):
+                self._commanded.pop(body, None)
+                self.p.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)
+                return
+            if body not in self._commanded:
+                self.p.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0, physicsClientId=self.client)
+            self._commanded[body] = (float(v), float(vy), float(w))
+            return
+        if vy and self._drive[row] != DRIVES.index("holonomic"):
+            raise PetriflowError(f"{name!r} has a {DRIVES[self._drive[row]]} drive: it cannot move sideways")
+        self.velocities[row] = (v, vy, w)
+        self._moving[row] = bool(v or w or vy) and self._live[row]
+
+    def set_pose(self, name: str, x: float, y: float, yaw: float) -> None:
+        """Put a kinematic robot at ``(x, y, yaw)`` (written to pybullet when read)."""
+        row = self.row(name)
+        self.poses[row] = (x, y, yaw)
+        self._stale[row] = True
+
+    def _integrate(self, dt: float) -> None:
+        """Every moving kinematic robot's pose after ``dt`` at its commanded velocity: the
+        exact arc for constant speeds (one formula for all drives: a holonomic robot's
+        body-frame velocity turns with it)."""
+        import numpy as np
+
+        rows = np.flatnonzero(self._moving)
+        x, y, th = self.poses[rows, 0], self.poses[rows, 1], self.poses[rows, 2]
+        v, vy, w = self.velocities[rows, 0], self.velocities[rows, 1], self.velocities[rows, 2]
+        th1 = th + w * dt
+        turning = np.abs(w) > 1e-12
+        safe = np.where(turning, w, 1.0)
+        # integrals of cos and sin of the heading over the step
+        ic = np.where(turning, (np.sin(th1) - np.sin(th)) / safe, np.cos(th) * dt)
+        is_ = np.where(turning, (np.cos(th) - np.cos(th1)) / safe, np.sin(th) * dt)
+        self.poses[rows, 0] = x + v * ic - vy * is_
+        self.poses[rows, 1] = y + v * is_ + vy * ic
+        self.poses[rows, 2] = np.arctan2(np.sin(th1), np.cos(th1))
+        self._stale[rows] = True
+
+    def _apply_commands(self) -> None:
+        """Dynamic bodies driven by :meth:`command`: the world-frame velocity along the
+        step's mean heading (the chord of the arc the kinematic mode follows)."""
+        p, client = self.p, self.client
+        for body, (v, vy, w) in self._commanded.items():
+            _, orientation = p.getBasePositionAndOrientation(body, physicsClientId=client)
+            yaw = p.getEulerFromQuaternion(orientation)[2]
+            half = w * self.dt / 2
+            scale = math.sin(half) / half if abs(half) > 1e-12 else 1.0  # chord over arc
+            mid = yaw + half
+            c, s = math.cos(mid), math.sin(mid)
+            p.resetBaseVelocity(body, ((v * c - vy * s) * scale, (v * s + vy * c) * scale, 0.0), (0.0, 0.0, w),
+                                physicsClientId=client)
+
+    def sync(self) -> None:
+        """Write the kinematic robots' poses that changed to pybullet (what reads
+        pybullet directly needs first; ray tests that see robots, cameras and the GUI
+        call it themselves)."""
+        import numpy as np
+
+        rows = np.flatnonzero(self._stale & self._live)
+        if not len(rows):
+            return
+        p, client = self.p, self.client
+        for row in rows.tolist():
+            x, y, yaw = self.poses[row]
+            roll, pitch = self._tilt[row]
+            p.resetBasePositionAndOrientation(self.kinematic_bodies[row], (x, y, self._z[row]),
+                                              p.getQuaternionFromEuler((roll, pitch, yaw)), physicsClientId=client)
+        self._stale[rows] = False
+
+    # Sensors ------------------------------------------------------------------------
+    def rays(self, starts, ends, *, robots: bool = True) -> list[tuple[int, float, tuple[float, float, float]]]:
+        """Cast rays now, in batches of pybullet's ``rayTestBatch``: one ``(body,
+        fraction, (x, y, z))`` per ray. ``robots=False`` leaves kinematic robots out (the
+        rays see the scene only, and no pose needs writing back)."""
+        if robots:
+            self.sync()
+        p = self.p
+        mask = 0xFFFF & ~ROBOT_GROUP if not robots else 0xFFFF
+        out: list[tuple[int, float, tuple[float, float, float]]] = []
+        starts, ends = list(starts), list(ends)
+        if len(starts) != len(ends):
+            raise PetriflowError(f"{len(starts)} ray starts but {len(ends)} ray ends")
+        for first in range(0, len(starts), _RAY_BATCH):
+            batch = p.rayTestBatch(starts[first:first + _RAY_BATCH], ends[first:first + _RAY_BATCH],
+                                   collisionFilterMask=mask, physicsClientId=self.client)
+            out.extend((hit[0], hit[2], hit[3]) for hit in batch)
+        return out
+
+    def request_rays(self, starts, ends, *, robots: bool = False) -> RayRequest:
+        """Ask for rays (a sensor event): they are cast with every other request of this
+        tick in one batch at the world's next step (or :meth:`flush_sensors`), at the
+        poses of now; the returned request then holds the hits."""
+        request = RayRequest([tuple(map(float, s)) for s in starts], [tuple(map(float, e)) for e in ends],
+                             robots)
+        if len(request.starts) != len(request.ends):
+            raise PetriflowError(f"{len(request.starts)} ray starts but {len(request.ends)} ray ends")
+        self._requests.append(request)
+        return request
+
+    def flush_sensors(self) -> int:
+        """Cast every pending ray request now, one batch for those that see robots and
+        one for those that see the scene only; returns the number of rays cast."""
+        pending, self._requests = self._requests, []
+        cast = 0
+        for robots in (False, True):
+            group = [r for r in pending if r.robots == robots]
+            if not group:
+                continue
+            starts = [s for r in group for s in r.starts]
+            ends = [e for r in group for e in r.ends]
+            hits = self.rays(starts, ends, robots=robots)
+            cast += len(hits)
+            at = 0
+            for request in group:
+                request.hits = hits[at:at + len(request.starts)]
+                at += len(request.starts)
+        return cast
 
     @property
     def time(self) -> float:
@@ -277,7 +515,12 @@ class World:
 
     def pose(self, name: str) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of a body or agent's robot."""
-        position, orientation = self.p.getBasePositionAndOrientation(self.body(name), physicsClientId=self.client)
+        body = self.body(name)
+        row = self._kin.get(body)
+        if row is not None:
+            x, y, yaw = self.poses[row].tolist()
+            return (x, y, yaw)
+        position, orientation = self.p.getBasePositionAndOrientation(body, physicsClientId=self.client)
         yaw = self.p.getEulerFromQuaternion(orientation)[2]
         return (position[0], position[1], yaw)
 
@@ -301,6 +544,10 @@ class World:
         does not deploy; the agent then has no body (:meth:`position` is ``None``)."""
         body = self.body(name)
         name = self.agents.get(name, name)
+        row = self._kin.pop(body, None)
+        if row is not None:
+            self._live[row] = self._moving[row] = self._stale[row] = False
+        self._commanded.pop(body, None)
         self.p.removeBody(body, physicsClientId=self.client)
         del self.bodies[name]
         for agent in [a for a, b in self.agents.items() if b == name]:

@@ -29,7 +29,7 @@ from typing import Any, Mapping
 from petriflow import limits
 from petriflow.errors import NetFormatError, did_you_mean
 
-__all__ = ["check_world", "check_box", "COLOURS", "MIN_DT", "MAX_DT"]
+__all__ = ["check_world", "check_box", "COLOURS", "MIN_DT", "MAX_DT", "MODES", "DRIVES"]
 
 #: Named colours (RGBA) a description may use.
 COLOURS = {
@@ -48,10 +48,18 @@ MIN_DT, MAX_DT = 1e-4, 1.0
 _FAR = 1e4          # metres: coordinates beyond this are a typo, not a scene
 _BIG = 1e3          # metres: the largest box extent
 
-_KEYS = {"dt", "gravity", "plane", "boxes", "grid", "robots", "cameras", "meta"}
+_KEYS = {"dt", "gravity", "plane", "boxes", "grid", "robots", "cameras", "meta", "mode"}
 _BOX_KEYS = {"id", "size", "position", "yaw", "colour", "mass"}
 _GRID_KEYS = {"cell", "height", "origin", "rows", "colour"}
-_ROBOT_KEYS = {"id", "urdf", "position", "yaw", "roll", "pitch", "colour", "agent", "z"}
+_ROBOT_KEYS = {"id", "urdf", "position", "yaw", "roll", "pitch", "colour", "agent", "z", "motion", "drive"}
+
+#: World modes: ``dynamic`` (every robot a physics body, stepped by pybullet: the default)
+#: and ``kinematic`` (robots without mass whose poses the world integrates, see
+#: :mod:`petriflow.world`).
+MODES = ("dynamic", "kinematic")
+#: Motion models of a kinematic robot: ``diff`` and ``unicycle`` follow a forward speed
+#: and a turn rate, ``holonomic`` also a sideways speed.
+DRIVES = ("diff", "unicycle", "holonomic")
 _CAMERA_KEYS = {"id", "position", "target", "up", "fov", "width", "height"}
 
 
@@ -163,8 +171,12 @@ def check_world(data: Any, path: str | None = None) -> dict[str, Any]:
     world = check.mapping(data, _KEYS, "world description")
     out: dict[str, Any] = {
         "dt": 1.0 / 240.0, "gravity": -9.81, "plane": True, "boxes": [], "grid": None, "robots": [],
-        "cameras": [], "meta": {},
+        "cameras": [], "meta": {}, "mode": "dynamic",
     }
+    if "mode" in world:
+        if world["mode"] not in MODES:
+            check.fail(f"mode is one of {', '.join(MODES)}, got {world['mode']!r}", world)
+        out["mode"] = world["mode"]
     if "dt" in world:
         dt = world["dt"]
         if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not MIN_DT <= float(dt) <= MAX_DT:
@@ -220,6 +232,13 @@ def check_world(data: Any, path: str | None = None) -> dict[str, Any]:
             entry[key] = check.number(robot.get(key, default), key, robot, body)
         if "colour" in robot:
             entry["colour"] = check.colour(robot["colour"], robot, body)
+        entry["motion"] = robot.get("motion", "kinematic" if out["mode"] == "kinematic" else "dynamic")
+        if entry["motion"] not in MODES:
+            check.fail(f"motion is one of {', '.join(MODES)}, got {entry['motion']!r}", robot, body)
+        entry["drive"] = robot.get("drive", "diff")
+        if entry["drive"] not in DRIVES:
+            hint = did_you_mean(str(entry["drive"]), DRIVES)
+            check.fail(f"drive is one of {', '.join(DRIVES)}, got {entry['drive']!r}{hint}", robot, body)
         out["robots"].append(entry)
     seen_cameras: set[str] = set()
     for camera in _list(check, world.get("cameras"), "cameras", world):

@@ -1,0 +1,168 @@
+"""The swarm mission as a workflow net, for any number of robots (:func:`build`), and
+its worlds (:func:`world`).
+
+One subnet per robot ``robotK`` (state ``swarm.scout``), the same for every robot:
+
+* ``wake`` (``swarm.wake``): ``start`` to ``idle``;
+* ``step`` (``swarm.explore``): ``idle`` to ``moved``, one cell of exploration;
+* ``share`` (``swarm.share``, guard ``swarm.has_frame``, priority 2): ``moved`` to
+  ``sending`` and a frame into the robot's radio place ``air`` (channel ``swarm``);
+* ``sent`` (``swarm.sent``): the frame back from the medium and ``sending`` to ``idle``;
+* ``go_on`` (guard ``swarm.going_on``): ``moved`` to ``idle``;
+* ``finish`` (guard ``swarm.explored``): ``moved`` to ``back``;
+* ``home`` (``swarm.home``): ``back`` to ``done``.
+
+The net grows linearly with the team: 7 transitions and 7 places a robot, no place
+shared between robots. Who hears a frame is the medium's business (a broadcast to the
+robots in range, :mod:`petriflow.agents.swarm.radio`), not the net's: a frame goes out
+of the radio place and its end of transmission comes back, so ``petriflow check``
+proves each robot's loop sound and bounded whatever the team.
+
+The world (:func:`world`): a maze generated from a seed, about ``cells_per_robot``
+cells a robot (``cols`` = ``rows`` = ceil(sqrt(robots x cells_per_robot))), cells of
+``cell`` metres, the robots spread over a lattice of cells, in the kinematic world mode
+(masses none, poses integrated in arrays).
+
+``python -m petriflow.agents.swarm.nets`` writes ``nets/swarm/`` (the 3-robot net and
+world, the sweep's worlds).
+
+Examples:
+    >>> net = build(robots=3)
+    >>> len(net.subnets), len(net.transitions), net.subnets["robot2"].state
+    (3, 23, 'swarm.scout')
+    >>> from petriflow.analysis.report import check_net
+    >>> check_net(net)["sound"]
+    True
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import Any
+
+from petriflow.net import Net
+from petriflow.netbuild import NetBuilder
+
+__all__ = ["build", "world", "size", "starts", "main"]
+
+#: The robots' body (a differential-drive disc; its masses are dropped in the kinematic mode).
+URDF = "petriflow.agents:robots/diffdrive.urdf"
+MAZE_SEED = 7
+LOOPS = 0.1
+
+
+def size(robots: int, cells_per_robot: float = 8.0) -> int:
+    """Cells a side of the maze for a team (at least 4)."""
+    return max(4, math.ceil(math.sqrt(robots * cells_per_robot)))
+
+
+def starts(robots: int, cols: int) -> list[tuple[int, int]]:
+    """Start cells ``(row, col)``: a lattice of k x k (k = ceil(sqrt(robots))) spread over the maze."""
+    k = math.ceil(math.sqrt(robots))
+    spots = [(min(cols - 1, int((a + 0.5) * cols / k)), min(cols - 1, int((b + 0.5) * cols / k)))
+             for a in range(k) for b in range(k)]
+    return spots[:robots]
+
+
+def build(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, reach: int = 4,
+          speed: float = 0.5, turn_rate: float = 2.0, **ignored: Any) -> Net:
+    """The mission's net (see the module).
+
+    Args:
+        robots: robots in the swarm (1..100,000).
+        cells_per_robot, cell: the maze's size per robot and cell side (m): they give
+            the maze's side (:func:`size`), which every robot's map needs.
+        reach: cells a robot looks ahead for unmapped cells; with none that near, it
+            goes home.
+        speed, turn_rate: the robots' cruise speed (m/s) and turn rate (rad/s).
+        ignored: other sweep parameters (they go elsewhere).
+    """
+    if not 1 <= robots <= 100_000:
+        raise ValueError(f"robots must be from 1 to 100,000, got {robots}")
+    side = size(robots, cells_per_robot)
+    b = NetBuilder(f"swarm-{robots}", label=f"a swarm of {robots} robots maps a {side} x {side} maze")
+    for k in range(1, robots + 1):
+        name = f"robot{k}"
+        a = b.agent(name, label=f"robot {k}", state="swarm.scout")
+        for local in ("start", "idle", "moved", "sending", "back", "done"):
+            a.place(local)
+        air = a.place("air", channel="swarm", label=f"{name}'s radio")
+        move = {"speed": speed, "turn_rate": turn_rate, "air": air}
+        wake = {"air": air, "cols": side, "rows": side, "cell": cell, "origin": [0.0, 0.0], "horizon": 2 * reach}
+        a.transition("wake", action="swarm.wake", params=wake, inputs=["start"], outputs=["idle"])
+        a.transition("step", label="one cell of exploration", action="swarm.explore", params=dict(move, reach=reach),
+                     inputs=["idle"], outputs=["moved"])
+        a.transition("share", label="a frame on the air", action="swarm.share", params={"air": air},
+                     guard="swarm.has_frame", priority=2, inputs=["moved"], outputs=["sending", "air"])
+        a.transition("sent", label="end of transmission", action="swarm.sent", params={"air": air},
+                     inputs=["sending", "air"], outputs=["idle"])
+        a.transition("go_on", guard="swarm.going_on", priority=1, inputs=["moved"], outputs=["idle"])
+        a.transition("finish", label="nothing unmapped within reach", guard="swarm.explored", priority=1,
+                     inputs=["moved"], outputs=["back"])
+        a.transition("home", label="back to the start", action="swarm.home", params=move, inputs=["back"],
+                     outputs=["done"])
+        a.start("start")
+        a.done("done")
+    b.envelope(begin_label="deploy", end_label="every robot home")
+    return b.build()
+
+
+def world(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, maze_seed: int = MAZE_SEED,
+          dt: float = 0.1) -> dict[str, Any]:
+    """The mission's world (see the module)."""
+    from petriflow.agents.mobile.maze import generate
+
+    side = size(robots, cells_per_robot)
+    maze = generate(side, side, seed=maze_seed, cell=cell, loops=LOOPS)
+    bodies = [{"id": f"robot{k + 1}", "urdf": URDF, "position": [round((c + 0.5) * cell, 6), round((r + 0.5) * cell, 6)],
+               "z": 0.0, "colour": ("red", "blue", "green", "orange")[k % 4]}
+              for k, (r, c) in enumerate(starts(robots, side))]
+    description = maze.world(bodies, dt=dt)
+    description["gravity"] = 0.0
+    description["mode"] = "kinematic"
+    return description
+
+
+def _dump(description: dict[str, Any]) -> str:
+    """A world as YAML with one line per box and robot (flow style inside the lists)."""
+    import yaml
+
+    head = {k: v for k, v in description.items() if k not in ("boxes", "robots", "meta")}
+    lines = [yaml.safe_dump(head, sort_keys=False).rstrip()]
+    for key in ("boxes", "robots"):
+        lines.append(f"{key}:")
+        lines += [f"  - {yaml.safe_dump(item, default_flow_style=True, width=1 << 20).strip()}"
+                  for item in description[key]]
+    lines.append(yaml.safe_dump({"meta": description["meta"]}, sort_keys=False, width=1 << 20).rstrip())
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Write the shipped world and nets (``nets/swarm/``)."""
+    from petriflow.io.yaml import dumps_net
+
+    parser = argparse.ArgumentParser(description="write the swarm scenario's worlds and nets")
+    parser.add_argument("--out", default="nets/swarm")
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    (out / "experiments").mkdir(parents=True, exist_ok=True)
+    note = ("# Generated by python -m petriflow.agents.swarm.nets: a maze of about 8 cells a robot\n"
+            f"# (generate(side, side, seed={MAZE_SEED}, cell=1, loops={LOOPS})), the robots on a lattice of cells,\n"
+            "# the kinematic world mode. meta.maze is the maze: the metrics take the cell count from it.\n")
+    (out / "world.yaml").write_text(note + _dump(world(3)))
+    print(f"wrote {out / 'world.yaml'}")
+    for robots in (10, 100, 1000):
+        path = out / "experiments" / f"swarm-world-{robots}.yaml"
+        path.write_text(note + _dump(world(robots)))
+        print(f"wrote {path}")
+    net = build(3)
+    net.run = "run.yaml"
+    (out / "swarm-3.yaml").write_text("# Generated by python -m petriflow.agents.swarm.nets; the run configuration"
+                                      f" is run.yaml.\n{dumps_net(net)}")
+    print(f"wrote {out / 'swarm-3.yaml'}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,238 @@
+"""The swarm at 10, 100 and 1,000 robots: petriflow beside pybullet's floor and numpy.
+
+For each team size, in one run:
+
+* **petriflow**: the swarm mission (``nets/swarm``: each robot its own subnet, the
+  kinematic world mode, sensors and radio on demand) run to its end (or ``--until``):
+  CPU seconds of the scheduler's run per simulated second. While it runs, the world's
+  poses and commanded velocities after every step, every ray batch it cast and every
+  radio neighbour query are recorded (a few copies of small arrays a step).
+* **pybullet floor**: the same world in pybullet with no nets: every tick the robots'
+  poses reset to those petriflow's robots had (``resetBasePositionAndOrientation``,
+  what a world that keeps poses in pybullet pays), then the same rays in the same
+  batches (``rayTestBatch``, the wall counts' rounds included). No ``stepSimulation``:
+  the bodies are static.
+* **numpy**: a plain loop over the same ticks integrating the same velocities with the
+  same formula on arrays, and the same neighbour queries answered by one distance row
+  and the log-distance threshold (free space: no walls, which need the ray tests).
+
+The table (``--markdown``) is the one in ``nets/swarm/README.md``. CPU time
+(``time.process_time``), not wall time, so other work on the machine does not count.
+
+    python bench/swarm.py                    # 10, 100, 1000 robots (several minutes)
+    python bench/swarm.py --robots 10 100 --until 60
+    python bench/swarm.py --cores            # does a second core pay? (rays in a thread, a second process)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+NETS = Path(__file__).resolve().parents[1] / "nets" / "swarm"
+
+
+def run_petriflow(robots: int, until: float | None, seed: int = 1) -> dict:
+    from petriflow.agents.swarm.nets import build, world
+    from petriflow.runtime.config import load_config
+    from petriflow.runtime.scheduler import Scheduler
+    from petriflow.world import World
+
+    description = world(robots)
+    net = build(robots)
+    config = load_config(NETS / "run.yaml")
+    w = World(description, base=NETS)
+    record = {"poses": [], "velocities": [], "rays": {}, "queries": {}}
+    step, rays = w.step, w.rays
+
+    def recorded_step():
+        step()
+        record["poses"].append(w.poses.copy())
+        record["velocities"].append(w.velocities.copy())
+
+    def recorded_rays(starts, ends, *, robots=True):
+        starts, ends = list(starts), list(ends)
+        record["rays"].setdefault(w.steps, []).append((starts, ends, robots))
+        return rays(starts, ends, robots=robots)
+
+    w.step, w.rays = recorded_step, recorded_rays
+    scheduler = Scheduler(net, world=w, config=config, seed=seed)
+    radio = scheduler.channels.models["swarm"]
+    neighbours = radio.neighbours
+
+    def recorded_neighbours(agent):
+        record["queries"].setdefault(w.steps, []).append(radio.rows.get(agent, -1))
+        return neighbours(agent)
+
+    radio.neighbours = recorded_neighbours
+    with scheduler:
+        cpu = time.process_time()
+        result = scheduler.run(until=until)
+        cpu = time.process_time() - cpu
+    out = {"robots": robots, "sim_s": result.time, "reason": result.reason.value, "cpu_s": cpu,
+           "cpu_per_sim_s": cpu / result.time, "ticks": len(record["poses"]), "firings": result.firings,
+           "rays": sum(len(s) for batches in record["rays"].values() for s, _, _ in batches),
+           "queries": sum(len(q) for q in record["queries"].values())}
+    w.close()
+    return out | {"record": record, "description": description, "dt": description["dt"],
+                  "model": radio.index(None)}
+
+
+def run_floor(description: dict, record: dict) -> float:
+    """pybullet alone: poses reset every tick, the same ray batches."""
+    from petriflow.world import World
+
+    w = World(description, base=NETS)
+    p, client = w.p, w.client
+    bodies = list(w.kinematic_bodies)
+    z = [0.0] * len(bodies)
+    mask_scene = 0xFFFF & ~__import__("petriflow.world", fromlist=["ROBOT_GROUP"]).ROBOT_GROUP
+    cpu = time.process_time()
+    for tick, poses in enumerate(record["poses"], start=1):
+        for body, (x, y, yaw), height in zip(bodies, poses.tolist(), z):
+            p.resetBasePositionAndOrientation(body, (x, y, height), p.getQuaternionFromEuler((0, 0, yaw)),
+                                              physicsClientId=client)
+        for starts, ends, robots in record["rays"].get(tick, ()):
+            for first in range(0, len(starts), 16384):
+                p.rayTestBatch(starts[first:first + 16384], ends[first:first + 16384],
+                               collisionFilterMask=0xFFFF if robots else mask_scene, physicsClientId=client)
+    cpu = time.process_time() - cpu
+    w.close()
+    return cpu
+
+
+def run_numpy(record: dict, dt: float, model) -> float:
+    """A plain numpy loop: the same kinematics and the same neighbour queries (free space)."""
+    poses = record["poses"][0].copy() if record["poses"] else np.zeros((0, 3))
+    m = model.model
+    cpu = time.process_time()
+    for tick, velocity in enumerate(record["velocities"], start=1):
+        v, vy, w = velocity[:, 0], velocity[:, 1], velocity[:, 2]
+        th = poses[:, 2]
+        th1 = th + w * dt
+        turning = np.abs(w) > 1e-12
+        safe = np.where(turning, w, 1.0)
+        ic = np.where(turning, (np.sin(th1) - np.sin(th)) / safe, np.cos(th) * dt)
+        is_ = np.where(turning, (np.cos(th) - np.cos(th1)) / safe, np.sin(th) * dt)
+        poses[:, 0] += v * ic - vy * is_
+        poses[:, 1] += v * is_ + vy * ic
+        poses[:, 2] = np.arctan2(np.sin(th1), np.cos(th1))
+        for asker in record["queries"].get(tick, ()):
+            d = np.hypot(*(poses[:, :2] - poses[asker, :2]).T)
+            rssi = m.tx_power_dbm - 10.0 * m.exponent * np.log10(np.maximum(d, m.min_distance))
+            np.flatnonzero(rssi >= model.threshold_dbm)
+    return time.process_time() - cpu
+
+
+def measure_cores(robots: int = 1000) -> None:
+    """What using the second core would give the world's work: rays cast with pybullet's
+    own threads, rays in a Python thread beside the firing (does pybullet release the
+    GIL?), and one tick's world work handed to another process and back."""
+    import multiprocessing
+    import threading
+
+    from petriflow.agents.swarm.nets import world
+    from petriflow.world import ROBOT_GROUP, World
+
+    w = World(world(robots), base=NETS)
+    p = w.p
+    points = w.poses[:, :2].tolist()
+    starts = [(x, y, 0.1) for x, y in points for _ in range(4)]
+    ends = [(x + dx, y + dy, 0.1) for x, y in points for dx, dy in ((1, 0), (0, 1), (-1, 0), (0, -1))]
+    mask = 0xFFFF & ~ROBOT_GROUP
+    for threads in (1, 2):
+        cpu = time.process_time()
+        for _ in range(20):
+            p.rayTestBatch(starts, ends, collisionFilterMask=mask, numThreads=threads, physicsClientId=w.client)
+        print(f"{len(starts)} rays, rayTestBatch(numThreads={threads}): {(time.process_time() - cpu) / 20 * 1000:.1f} ms CPU")
+
+    def spin(seconds: float) -> int:
+        end, count = time.perf_counter() + seconds, 0
+        while time.perf_counter() < end:
+            count += 1
+        return count
+
+    alone = spin(1.0)
+    stop = threading.Event()
+
+    def cast() -> None:
+        while not stop.is_set():
+            p.rayTestBatch(starts, ends, collisionFilterMask=mask, physicsClientId=w.client)
+
+    thread = threading.Thread(target=cast)
+    thread.start()
+    beside = spin(1.0)
+    stop.set()
+    thread.join()
+    print(f"a Python loop with rays cast in another thread runs at {beside / alone:.0%} of its speed alone")
+    here, there = multiprocessing.Pipe()
+    child = multiprocessing.Process(target=_echo, args=(there,))
+    child.start()
+    payload = (w.poses.copy(), starts[:400], ends[:400])
+    cpu, wall = time.process_time(), time.perf_counter()
+    for _ in range(200):
+        here.send(payload)
+        here.recv()
+    print(f"one tick's world work to another process and back (poses, 400 rays): "
+          f"{(time.process_time() - cpu) / 200 * 1000:.2f} ms CPU here, {(time.perf_counter() - wall) / 200 * 1000:.2f} ms wall")
+    here.send(None)
+    child.join()
+    w.close()
+
+
+def _echo(connection) -> None:
+    while True:
+        message = connection.recv()
+        if message is None:
+            return
+        connection.send(message)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--robots", type=int, nargs="+", default=[10, 100, 1000])
+    parser.add_argument("--until", type=float, default=None, help="simulated seconds (default: the mission's end)")
+    parser.add_argument("--markdown", action="store_true", help="print the README table")
+    parser.add_argument("--json", action="store_true")
+    parser.add_argument("--cores", action="store_true", help="measure what a second core would give, and stop")
+    args = parser.parse_args(argv)
+    if args.cores:
+        measure_cores()
+        return
+    rows = []
+    for robots in args.robots:
+        run = run_petriflow(robots, args.until)
+        sim = run["sim_s"]
+        floor = run_floor(run["description"], run["record"]) / sim
+        plain = run_numpy(run["record"], run["dt"], run["model"]) / sim
+        row = {k: v for k, v in run.items() if k not in ("record", "description", "model", "dt")}
+        row |= {"floor_cpu_per_sim_s": floor, "numpy_cpu_per_sim_s": plain,
+                "petriflow_over_floor": run["cpu_per_sim_s"] / floor if floor else math.inf,
+                "petriflow_over_numpy": run["cpu_per_sim_s"] / plain if plain else math.inf}
+        rows.append(row)
+        if not args.json:
+            print(f"N={robots}: {sim:.1f} simulated s ({row['reason']}, {row['ticks']} ticks, {row['rays']} rays,"
+                  f" {row['queries']} radio queries, {row['firings']} firings): petriflow {row['cpu_per_sim_s']:.4f}, pybullet floor"
+                  f" {floor:.4f}, numpy {plain:.5f} CPU s per simulated s", flush=True)
+    if args.json:
+        print(json.dumps(rows, indent=1))
+    if args.markdown:
+        print("| robots | simulated s | petriflow CPU s / sim s | real-time factor | pybullet floor | numpy |"
+              " petriflow ÷ floor | petriflow ÷ numpy |")
+        print("|---:|---:|---:|---:|---:|---:|---:|---:|")
+        for r in rows:
+            print(f"| {r['robots']:,} | {r['sim_s']:.1f} | {r['cpu_per_sim_s']:.4f} | {1 / r['cpu_per_sim_s']:.1f}× |"
+                  f" {r['floor_cpu_per_sim_s']:.4f} | {r['numpy_cpu_per_sim_s']:.5f} |"
+                  f" {r['petriflow_over_floor']:.2f} | {r['petriflow_over_numpy']:.0f} |")
+        by = {r["robots"]: r["cpu_per_sim_s"] for r in rows}
+        if 100 in by and 1000 in by:
+            print(f"\ncost 100 → 1,000 robots: {by[1000] / by[100]:.1f}×")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,171 @@
+"""The swarm scenario: its nets are sound and linear in the team, its history is seed
+000's, its radio broadcasts to the robots in range, and a mission runs to the end."""
+
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+import pytest
+
+from petriflow.agents.comm.framework import History
+from petriflow.agents.swarm.agent import OPEN, Scout, SwarmHistory
+from petriflow.agents.swarm.nets import build, world
+from petriflow.analysis.report import check_net
+from petriflow.io import load_net
+from petriflow.runtime.scheduler import Scheduler
+from petriflow.world import World
+
+NETS = Path(__file__).resolve().parents[3] / "nets" / "swarm"
+
+
+def test_the_three_robot_net_is_sound_and_the_shipped_one_is_what_build_writes():
+    net = build(3)
+    result = check_net(net)
+    assert result["workflow_net"] and result["sound"]
+    shipped = load_net(NETS / "swarm-3.yaml")
+    assert sorted(shipped.transitions) == sorted(net.transitions)
+    assert sorted(shipped.places) == sorted(net.places)
+
+
+def test_the_net_grows_linearly_with_the_team():
+    small, large = build(10), build(100)
+    assert len(large.transitions) - 2 == 10 * (len(small.transitions) - 2)
+    assert len(large.places) - 2 == 10 * (len(small.places) - 2)
+
+
+def test_the_swarm_history_follows_seed_000s_rules_exactly():
+    rng = random.Random(3)
+    plain, indexed = History(1), SwarmHistory(1)
+    for step in range(400):
+        kind = rng.random()
+        peer, source = rng.randint(2, 6), rng.randint(1, 6)
+        if kind < 0.3:
+            item = (rng.randint(0, 50), 0.5, 0.5, 1)
+            assert plain.add_own(item) == indexed.add_own(item)
+        elif kind < 0.6:
+            items = [(rng.randint(0, 50), 0.5, 0.5, 2) for _ in range(rng.randint(1, 3))]
+            assert plain.receive(peer, source, items) == indexed.receive(peer, source, items)
+        else:
+            assert plain.unsent(peer, source) == indexed.unsent(peer, source)
+            items = plain.unsent(peer, source)[:2]
+            plain.sent(peer, source, items)
+            indexed.sent(peer, source, items)
+        assert plain.rows == indexed.rows
+        assert plain.outgoing(peer) == indexed.outgoing(peer)
+
+
+def _exchange(a: Scout, b: Scout, rounds: int = 4) -> None:
+    """Frames between two scouts in range, both ways, a few rounds."""
+    for _ in range(rounds):
+        a.plan_for(b.name, b.address)
+        b.plan_for(a.name, a.address)
+        for sender, receiver in ((a, b), (b, a)):
+            frame = sender.frame()
+            for packet in frame["to"].get(receiver.name, []):
+                receiver.receive(sender.name, sender.address, packet)
+
+
+def test_two_scouts_end_with_each_others_maps_and_nothing_more_to_say():
+    a, b = Scout("robot1", 1, cols=4, rows=4), Scout("robot2", 2, cols=4, rows=4)
+    a.sense(0, OPEN["north"])
+    a.sense(4, OPEN["south"] | OPEN["east"])
+    b.sense(15, OPEN["west"])
+    _exchange(a, b)
+    assert set(a.sides) == set(b.sides) == {0, 4, 15}
+    assert a.sides[15] == OPEN["west"] and b.sides[4] == OPEN["south"] | OPEN["east"]
+    sent = a.sent_bytes + b.sent_bytes
+    b.sense(14, OPEN["east"])                       # new data: it goes by query, request, transfer
+    _exchange(a, b)
+    assert 14 in a.sides and a.sent_bytes + b.sent_bytes > sent
+    a.plan_for(b.name, b.address)
+    assert not any(a.outbox.values())               # nothing pending: nothing sent again
+
+
+def _mission(robots: int, until: float = 900.0):
+    from petriflow.runtime.config import load_config
+
+    config = load_config(NETS / "run.yaml")
+    description = world(robots)
+    w = World(description, base=NETS)
+    scheduler = Scheduler(build(robots), world=w, config=config, seed=1)
+    events = []
+    scheduler.on_event(events.append)
+    with scheduler:
+        result = scheduler.run(until=until)
+    return result, events, description, w, scheduler
+
+
+def test_a_small_swarm_maps_its_maze_shares_it_and_goes_home():
+    result, events, description, w, scheduler = _mission(6)
+    try:
+        assert result.reason.value == "final"
+        cells = description["meta"]["maze"]["rows"] * description["meta"]["maze"]["cols"]
+        sensed = {e.data["data"]["cell"] for e in events if e.kind == "custom" and e.data["name"] == "swarm.sensed"}
+        assert len(sensed) >= 0.9 * cells
+        homes = {e.agent for e in events if e.kind == "custom" and e.data["name"] == "swarm.home"}
+        assert homes == {f"robot{k}" for k in range(1, 7)}
+        sent = [e for e in events if e.kind == "message" and e.data["fate"] == "sent"]
+        assert sent and sum(e.data["size"] for e in sent) > 0
+        # every robot stands on its start cell again, exactly on the centre
+        for body in description["robots"]:
+            x, y, _ = w.pose(body["id"])
+            assert (x, y) == pytest.approx(tuple(body["position"]), abs=1e-6)
+        # the maps were shared: robots know cells they never sensed, and hold others' data
+        states = scheduler.firer.agents.states
+        learnt = [len(set(s.sides) - s.sensed) for s in states.values()]
+        assert sum(n > 0 for n in learnt) >= 4
+        assert all(s.history.count(s.address) == len(s.sensed) for s in states.values())
+        assert sum(len(s.history.sources()) > 1 for s in states.values()) >= 4
+    finally:
+        w.close()
+
+
+def test_the_radio_reaches_only_the_robots_in_range():
+    from petriflow.agents.swarm.radio import SwarmRadio
+    from petriflow.runtime.channels import Message
+    from petriflow.runtime.kernel import Kernel
+    from petriflow.runtime.media import MediumPort, ProcessClock
+
+    robots = [{"id": f"robot{k}", "urdf": "petriflow.agents:robots/diffdrive.urdf", "position": [x, 0.5]}
+              for k, x in ((1, 0.5), (2, 3.5), (3, 9.5))]
+    w = World({"dt": 0.1, "gravity": 0.0, "mode": "kinematic", "robots": robots})
+    try:
+        delivered = []
+        port = MediumPort(ProcessClock(Kernel(dt=0.1)), delivered.append, lambda m, why: None, None, w)
+        radio = SwarmRadio()
+        radio.attach(port)
+        assert radio.view("robot1").neighbours() == [("robot2", 2)]     # 3 m: heard; 9 m: beyond 5 m
+        assert radio.view("robot3").neighbours() == []
+        frame = {"to": {"robot2": [(3, 1, 1, False, [])], "robot3": [(3, 1, 1, False, [])]}, "size": 10, "from": 1}
+        radio.send(Message("robot1_air", "robot1", "robot1", frame, 0.0, 10))
+        port.clock.run(until=0.1)
+        assert [m.data["heard"] for m in delivered] == [1]
+        assert radio.view("robot2").take() == [("robot1", 1, (3, 1, 1, False, []))]
+        assert radio.view("robot3").take() == [] and radio.view("robot2").take() == []
+    finally:
+        w.close()
+
+
+def test_the_scale_sweep_builds_every_row_and_runs_its_small_one():
+    from petriflow.io.files import read_yaml_file
+    from petriflow.sweep import load_sweep
+    from petriflow.sweep.trial import build as build_trial, run_trial
+
+    sweep = load_sweep(NETS / "experiments" / "scale.yaml")
+    trials = sweep.trials()
+    assert [t.params["robots"] for t in trials] == [10, 100, 1000]
+    assert {ref.name for ref in sweep.metrics} == {"coverage", "bytes_total", "time_s", "completed",
+                                                   "cpu_s_per_sim_s"}
+    for trial in trials:
+        built = build_trial(sweep.payload(trial)["sweep"], trial.params, trial.seed)
+        description = read_yaml_file(built.config.world)
+        assert description["mode"] == "kinematic"
+        assert [r["id"] for r in description["robots"]] == [
+            f"robot{k}" for k in range(1, trial.params["robots"] + 1)]
+        assert description == world(trial.params["robots"])   # the shipped world is what world() writes
+    result = run_trial(sweep.payload(trials[0]))
+    assert result["status"] == "ok" and result["outcome"] == "final", result
+    metrics = result["metrics"]
+    assert metrics["completed"] == 1 and metrics["coverage"] > 0.9 and metrics["bytes_total"] > 0
+    assert 0 < metrics["time_s"] <= 1800 and metrics["cpu_s_per_sim_s"] > 0
