@@ -15,7 +15,9 @@ modules' firmware as actions of a net; the experiment is a sweep
   core's log-distance model).
 * :mod:`~petriflow.agents.bus.medium`: the buses (RS-485, CAN, ZigBee) at bit-level
   timing, receive buffers and transmit queues, on a
-  :class:`~petriflow.runtime.media.ProcessClock`; each bus is a petriflow medium, and
+  :class:`~petriflow.runtime.media.ProcessClock`; ZigBee as a network (broadcast
+  transaction tables, relaying with passive acknowledgement, end devices polling
+  their parent); a sniffer node on any bus; each bus is a petriflow medium, and
   :class:`~petriflow.agents.bus.medium.BusSimulator` runs one on its own.
 * :mod:`~petriflow.agents.bus.channel`: a run's messages as frames on a bus, their
   fates when they happen, and the view a module's firmware asks the bus through.
@@ -28,7 +30,8 @@ modules' firmware as actions of a net; the experiment is a sweep
 * :mod:`~petriflow.agents.bus.nets`: the chain as a workflow net, algorithm 1 or 2.
 * :mod:`~petriflow.agents.bus.chain`: the chain as a pybullet robot (hinges, front
   sensors).
-* :mod:`~petriflow.agents.bus.metrics`: lost messages per module, phase error, speed.
+* :mod:`~petriflow.agents.bus.metrics`: lost messages per module (at the addressees
+  and at the sniffer), phase error, speed.
 * :mod:`~petriflow.agents.bus.figures`: lost messages beside Tables 1-3, CPG phases.
 * :mod:`~petriflow.agents.bus.plugin`: registers the buses as channel models, the
   firmware's actions and guards, and the metrics.

@@ -227,7 +227,9 @@ class BusView:
     * :meth:`reads_every`: how often the module reads its receive buffer, and from when;
     * :meth:`quiet_for`: how long the bus has been quiet, now;
     * :attr:`sender_in_identifier`: whether the sender's address travels in the frame's
-      identifier (CAN), so a payload need not carry it.
+      identifier (CAN), so a payload need not carry it;
+    * :meth:`sniff`, :meth:`captured`: for a sniffer's agent, join the bus as a sniffer
+      and count what it captured.
 
     Args:
         carrier: the run's bus.
@@ -266,3 +268,17 @@ class BusView:
     def quiet_for(self) -> float:
         """Seconds the bus has carried nothing, now (0 while a frame is on it)."""
         return self._carrier.medium.quiet_for()
+
+    def sniff(self) -> None:
+        """This agent is a sniffer on the bus: a node that never sends and takes every
+        intact frame that reaches it, whoever it is for, on arrival
+        (:meth:`~petriflow.agents.bus.medium.BusMedium.sniff`)."""
+        carrier = self._carrier
+        carrier.medium.sniff(carrier.module(self.agent))
+
+    def captured(self) -> dict[str, int]:
+        """What this agent captured as a sniffer so far: ``{sender's agent: frames}``."""
+        carrier = self._carrier
+        counts = carrier.medium.captured.get(carrier.module(self.agent), {})
+        agents = {number: agent for agent, number in carrier.numbers.items()}
+        return {str(agents[number]): n for number, n in sorted(counts.items()) if number in agents}

@@ -26,14 +26,20 @@ def _float(value: Any) -> float:
         return math.nan
 
 
-def draw_losses(table: Path, out: Path) -> None:
-    """Bars: mean lost % per module and bus, algorithm 1 and 2, the paper's hollow."""
+def draw_losses(table: Path, out: Path, reception: str = "loop") -> None:
+    """Bars: mean lost % per module and bus, algorithm 1 and 2, the paper's hollow: the
+    sniffer's count (``sniff_mK``, where the paper counts) when the table has it, else
+    the addressees' (``lost_pct_mK``); rows of the given reception model when the
+    table has several."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     rows = list(csv.DictReader(table.open()))
+    if rows and "reception" in rows[0]:
+        rows = [r for r in rows if r["reception"] == reception]
+    key = "sniff_m" if rows and "sniff_m1_mean" in rows[0] else "lost_pct_m"
     buses = [b for b in ("serial", "can", "zigbee") if any(r["bus"] == b for r in rows)]
     figure, axes = plt.subplots(1, len(buses), figsize=(4.2 * len(buses), 3.8), sharey=True)
     axes = [axes] if len(buses) == 1 else list(axes)
@@ -45,10 +51,10 @@ def draw_losses(table: Path, out: Path) -> None:
                 continue
             for m in range(1, 4):
                 x = m - 1 + (a - 0.5) * 2 * width
-                axis.bar(x - width / 2, _float(row.get(f"lost_pct_m{m}_mean")), width,
-                         yerr=_float(row.get(f"lost_pct_m{m}_sd")), color=colour, capsize=2,
+                axis.bar(x - width / 2, _float(row.get(f"{key}{m}_mean")), width,
+                         yerr=_float(row.get(f"{key}{m}_sd")), color=colour, capsize=2,
                          label=f"algorithm {algorithm} (measured)" if m == 1 else None)
-                axis.bar(x + width / 2, _float(row.get(f"lost_pct_m{m}_paper")), width, fill=False,
+                axis.bar(x + width / 2, _float(row.get(f"{key}{m}_paper")), width, fill=False,
                          edgecolor=colour, hatch="//", label=f"algorithm {algorithm} (paper)" if m == 1 else None)
         axis.set_xticks(range(3))
         axis.set_xticklabels(["module 1", "module 2", "module 3"])
@@ -56,7 +62,9 @@ def draw_losses(table: Path, out: Path) -> None:
         axis.grid(axis="y", alpha=0.3)
     axes[0].set_ylabel("messages lost of 100 (%)")
     axes[-1].legend(fontsize=7)
-    figure.suptitle("seed 002, Tables 1-3: lost messages per module, measured (5 runs, mean ± sd) and published")
+    counted = "by the sniffer" if key == "sniff_m" else "at the addressees"
+    figure.suptitle(f"seed 002, Tables 1-3: lost messages per module ({counted}, reception: {reception}),"
+                    " measured (mean ± sd) and published", fontsize=9)
     figure.tight_layout()
     figure.savefig(out, dpi=110)
     plt.close(figure)

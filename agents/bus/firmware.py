@@ -19,6 +19,8 @@ heard from each neighbour) and its message count.
 ``bus.receive``           the reception routine: keep a message from a neighbour
                           addressed to this module (or learn that a frame was lost)
 ``bus.drain``             a frame for an address no module holds leaves the bus
+``bus.sniffer``           the sniffer joins the bus as a node that only listens
+``bus.sniffed``           the sniffer's record: frames captured per module
 ========================  ==============================================================
 
 Every send, read and loss is a custom event (``bus.sent``, ``bus.read``); the metrics
@@ -99,6 +101,8 @@ class Module:
         self.scheme = scheme
         self.oscillator = oscillator
         self.address = address
+        self.rate = 1.0              # the module's clock: its seconds per true second (crystal error)
+        self.next_overflow = 0.0     # when its overflow interrupt next fires (true time)
         self.sent = 0
         self.groups = 0
         self.send_now = False        # algorithm 2's overflow drew "send"
@@ -162,7 +166,13 @@ def _front_free(ctx: ActionContext, chain: list[str], name: str) -> bool:
 
 class Boot(_Timed):
     """Auto-addressing, the scheme, a random start phase; the module's start-up takes
-    ``U[0, spread]`` s, so the modules do not start in the same instant."""
+    ``U[0, spread]`` s (modules powered through the connector start nearly in step:
+    1 ms by default), and its clock runs ``1 + U[−crystal_ppm, crystal_ppm]·10⁻⁶`` times
+    the true rate (every timer of the module: control step, Delay, overflow period,
+    reads). ``reception`` is the reception model: ``loop`` (the reception routine runs
+    once per loop iteration: algorithm 1 reads its buffer every 20 ms + Delay, after
+    its wait; algorithm 2 every 20 ms) or ``interrupt`` (the pseudo-code's reception
+    interrupt: every frame is read on arrival)."""
 
     params = {
         "chain": Param(list, doc="the modules' agents, head first (who is behind whom)"),
@@ -170,10 +180,14 @@ class Boot(_Timed):
         "messages": Param(int, 100, "messages each module sends", low=1),
         "step_time": Param(float, 0.02, "one loop iteration: CPG and actuator (s)", low=1e-9),
         "max_delay": Param(float, 1.0, "algorithm 1: Delay ~ U[0, max_delay] s", low=0),
-        "idle_window": Param(float, 1.0, "algorithm 2: bus available comes U[0, idle_window] s into a quiet",
+        "idle_window": Param(float, 3.0, "algorithm 2: bus available comes U[0, idle_window] s into a quiet"
+                             " (3 s: 100 messages take about the paper's two minutes)",
                              low=0),
         "lag": Param(float, 2 * math.pi / 3, "the phase lag between neighbours (rad)"),
-        "spread": Param(float, 0.1, "start-up times are U[0, spread] s", low=0),
+        "spread": Param(float, 0.001, "start-up times are U[0, spread] s", low=0),
+        "crystal_ppm": Param(float, 50.0, "each module's clock error is U[-ppm, +ppm] parts per million", low=0),
+        "reception": Param(str, "loop", "the reception model: loop (once per loop iteration) or interrupt"
+                           " (on arrival)", choices=("loop", "interrupt")),
         "mailboxes": Param(list, [], "this module's channel places (to tell the bus its read period)", places="*"),
     }
 
@@ -194,17 +208,20 @@ class Boot(_Timed):
         addresses = auto_address(behind, {m: _front_free(ctx, chain, m) for m in chain})
         address = addresses[name]
         rng = ctx.rng
+        rate = 1.0 + rng.uniform(-p["crystal_ppm"], p["crystal_ppm"]) * 1e-6
         if p["algorithm"] == 1:
             scheme: Any = NativeScheme(address, len(chain), rng, step_time=p["step_time"], max_delay=p["max_delay"])
             read_every = p["step_time"] + scheme.delay  # its reception runs once per iteration, after the wait
         else:
             scheme = BusAwareScheme(address, len(chain), rng, step_time=p["step_time"], idle_window=p["idle_window"])
             read_every = p["step_time"]
+        read_every = 0.0 if p["reception"] == "interrupt" else read_every * rate
         parameters = CpgParameters(lag=p["lag"], dt=p["step_time"])
         oscillator = Oscillator(parameters, rng.uniform(0.0, 2 * math.pi), address > 0, address < len(chain) - 1)
         by_address = sorted(chain, key=lambda m: addresses[m])
         self.module = Module(name, by_address, p["algorithm"], p["messages"], scheme, oscillator, address)
-        self.module.updated = self.wake_at = ctx.now + max(0.0, self.duration(ctx))
+        self.module.rate = rate
+        self.module.updated = self.module.next_overflow = self.wake_at = ctx.now + max(0.0, self.duration(ctx))
         for place in p["mailboxes"]:  # the reception routine runs once per iteration, from the first
             ctx.medium(place).reads_every(read_every, start=self.wake_at)
         if ctx.world is not None:
@@ -212,7 +229,7 @@ class Boot(_Timed):
 
             self.module.joint = joint_of(ctx.world, name)
         ctx.emit("bus.addressed", address=address, delay=round(getattr(scheme, "delay", 0.0), 6),
-                 read_every=round(read_every, 6))
+                 read_every=round(read_every, 9), started=round(self.wake_at, 9), rate=rate)
         ctx.result = self.module
 
 
@@ -226,7 +243,7 @@ class Cpg(_Timed):
               "amplitude": Param(float, 0.5, "r, the joint's amplitude (rad)", low=0)}
 
     def duration(self, ctx: ActionContext) -> float:
-        return self.module.scheme.step_time
+        return self.module.scheme.step_time * self.module.rate
 
     def start(self, ctx: ActionContext) -> None:
         super().start(ctx)
@@ -263,7 +280,7 @@ class Wait(_Timed):
 
     def duration(self, ctx: ActionContext) -> float:
         scheme = self.module.scheme
-        return scheme.iteration() - scheme.step_time if isinstance(scheme, NativeScheme) else 0.0
+        return (scheme.iteration() - scheme.step_time) * self.module.rate if isinstance(scheme, NativeScheme) else 0.0
 
 
 class Send(InstantAction):
@@ -306,7 +323,10 @@ class Send(InstantAction):
 class Available(Action):
     """Algorithm 2's *bus available* interrupt: wait until the bus (``box``'s medium) has
     been quiet for this module's random ``U[0, idle_window]`` s and is free; a busy
-    spell in between draws a new time for the next quiet one."""
+    spell in between draws a new time for the next quiet one. The quiet is counted from
+    when the interrupt is re-armed (after the module's previous send) at the earliest:
+    a frame that never reached the medium (dropped by its interface) does not make the
+    next one due at once."""
 
     params = {"box": Param(str, doc="a channel place on the bus (to watch it)", places="")}
 
@@ -316,9 +336,10 @@ class Available(Action):
         self.bus = ctx.medium(self.params["box"])
         self.wanted = self.module.scheme.idle_delay()
         self.quiet = None
+        self.armed = ctx.now
 
     def poll(self, ctx: ActionContext) -> Status:
-        quiet_for = self.bus.quiet_for()
+        quiet_for = min(self.bus.quiet_for(), ctx.now - self.armed)
         if self.quiet is not None and quiet_for < self.quiet - 1e-12:  # the bus was busy meanwhile
             self.wanted = self.module.scheme.idle_delay()
         self.quiet = quiet_for
@@ -328,13 +349,20 @@ class Available(Action):
 
 
 class Overflow(_Timed):
-    """Algorithm 2's overflow interrupt: after ``period`` s, ``Indicator ~ U[0, 1]``;
-    the module sends if it is below the probability (0.5)."""
+    """Algorithm 2's overflow interrupt: every ``period`` s of the module's clock from
+    the end of its start-up (a free-running timer: its times do not slip with the
+    run's ticks), ``Indicator ~ U[0, 1]``; the module sends if it is below the
+    probability (0.5)."""
 
     params = {"period": Param(float, 1.0, "seconds between overflow interrupts", low=1e-9)}
 
-    def duration(self, ctx: ActionContext) -> float:
-        return self.params["period"]
+    def start(self, ctx: ActionContext) -> None:
+        self.module = module = _module(ctx)
+        ctx.result = module
+        period = self.params["period"] * module.rate
+        while module.next_overflow <= ctx.now + 1e-9:
+            module.next_overflow += period
+        self.wake_at = module.next_overflow
 
     def finish(self, ctx: ActionContext) -> None:
         self.module.send_now = self.module.scheme.overflow()
@@ -380,6 +408,28 @@ class Drain(InstantAction):
         ctx.emit("bus.read", sender=frame.get("sender") if isinstance(frame, dict) else None,
                  group=frame.get("group") if isinstance(frame, dict) else None, lost=lost, void=True,
                  why=data.get("why") if lost and isinstance(data, dict) else None)
+        return None
+
+
+class Sniffer(InstantAction):
+    """The paper's sniffer joins the bus (``box``'s medium) as a node of its own: it
+    never sends, and takes every intact frame that reaches it, whoever it is for."""
+
+    params = {"box": Param(str, doc="a channel place on the bus", places="")}
+
+    def run(self, ctx: ActionContext) -> None:
+        ctx.medium(self.params["box"]).sniff()
+        return None
+
+
+class Sniffed(InstantAction):
+    """The sniffer's record, when every module has sent its messages: the frames it
+    captured from each module (a ``bus.sniffed`` event, ``captured: {agent: frames}``)."""
+
+    params = {"box": Param(str, doc="a channel place on the bus", places="")}
+
+    def run(self, ctx: ActionContext) -> None:
+        ctx.emit("bus.sniffed", captured=ctx.medium(self.params["box"]).captured())
         return None
 
 

@@ -51,6 +51,21 @@ The three buses (their parameters are :class:`SerialBus`, :class:`CanBus`,
   waits the long or short interframe spacing. Received frames reach the module after
   the radio has written their payload out over the UART. A module cannot hear the
   air: for it the "bus" is free when its own radio has nothing to send.
+  That is the single-hop air (``network: false``). By default (``network: true``,
+  :class:`ZigbeeNetworkMedium`) the radios form a ZigBee network as Digi documents
+  it for its XBee ZigBee modules: a payload-addressed frame is a network broadcast;
+  the coordinator (the first module) and every router that transmits a broadcast
+  record it in a broadcast transaction table of ``btt_entries`` = 8 entries kept
+  ``btt_lifetime`` = 8 s each (a node whose table is full drops a new broadcast: its
+  module loses it, and it relays nothing, :attr:`Loss.BTT_FULL`); each router relays a
+  new broadcast after a random jitter of up to ``max_jitter`` = 63 ms and
+  retransmits it, at most ``broadcast_retries`` = 2 times, when ``passive_ack_timeout``
+  = 0.5 s after a transmission it has not heard every neighbouring router relay it
+  (passive acknowledgement). With ``roles: end_devices`` the modules other than the
+  coordinator are its end devices: they send to it (acknowledged, ``mac_retries``)
+  and get broadcasts only when they poll it (``poll_period`` = 100 ms); the parent
+  buffers one broadcast for all of them, a newer one replacing it
+  (:attr:`Loss.PARENT_BUFFER`).
 
 Losses common to all three (real modules' limits):
 
@@ -142,6 +157,7 @@ __all__ = [
     "Transmission",
     "ZigbeeBus",
     "ZigbeeMedium",
+    "ZigbeeNetworkMedium",
 ]
 
 #: Rank of the media's own events (frame ends, arrivals): at one instant they run first.
@@ -176,6 +192,11 @@ class Loss(Name):
     """CSMA/CA found the channel busy at every clear channel assessment and gave up."""
     RADIO = "radio"
     """Bit errors on the radio link to this module."""
+    BTT_FULL = "btt_full"
+    """A ZigBee node's broadcast transaction table was full: it dropped a new broadcast."""
+    PARENT_BUFFER = "parent_buffer"
+    """A ZigBee parent replaced the one broadcast it buffers for its end devices before
+    this end device polled for it."""
 
 
 @dataclass(frozen=True)
@@ -376,10 +397,21 @@ class ZigbeeBus(BusModel):
     noise_floor_dbm: float = field(default=-93.0, metadata={"range": (-200.0, 0.0)})
     interference_dbm: float = field(default=-200.0, metadata={"range": (-200.0, 40.0)})
     shadowing_db: float = field(default=0.0, metadata={"range": (0.0, 40.0)})
+    network: bool = True
+    roles: str = "routers"
+    btt_entries: int = field(default=8, metadata={"range": (1, 1000)})
+    btt_lifetime: float = field(default=8.0, metadata={"range": (0.0, 3600.0)})
+    broadcast_retries: int = field(default=2, metadata={"range": (0, 10)})
+    passive_ack_timeout: float = field(default=0.5, metadata={"range": (0.0, 60.0)})
+    max_jitter: float = field(default=0.063, metadata={"range": (0.0, 10.0)})
+    poll_period: float = field(default=0.1, metadata={"range": (1e-4, 60.0)})
+    mac_retries: int = field(default=3, metadata={"range": (0, 10)})
 
     def __post_init__(self) -> None:
         if self.min_be > self.max_be:
             raise FrameError(f"min_be {self.min_be} is above max_be {self.max_be}")
+        if self.roles not in ("routers", "end_devices"):
+            raise FrameError(f"roles is 'routers' or 'end_devices', not {self.roles!r}")
 
     def payload_limit(self) -> int:
         return IEEE802154_MAX_FRAME_BYTES - IEEE802154_MAC_HEADER_BYTES - self.network_bytes - 2
@@ -395,7 +427,8 @@ class ZigbeeBus(BusModel):
 
     def medium(self, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (), *,
                logs: bool = True, read_period: float | None = _BUS_DEFAULT) -> ZigbeeMedium:
-        return ZigbeeMedium(self, clock, rng, modules, logs=logs, read_period=read_period)
+        kind = ZigbeeNetworkMedium if self.network else ZigbeeMedium
+        return kind(self, clock, rng, modules, logs=logs, read_period=read_period)
 
 
 def _check_period(period: float | None) -> float | None:
@@ -452,6 +485,8 @@ class BusMedium:
         self._on_delivery: list[Callable[[Delivery], Any]] = []
         self._on_loss: list[Callable[[Lost], Any]] = []
         self._on_idle: list[Callable[[int], Any]] = []
+        self.sniffers: set[int] = set()
+        self.captured: dict[int, dict[int, int]] = {}
         for module in modules:
             self.add_module(module)
 
@@ -483,6 +518,15 @@ class BusMedium:
             self.modules.append(module)
             self._buffers[module] = deque()
             self._queues[module] = deque()
+
+    def sniff(self, module: int) -> None:
+        """Attach ``module`` as a sniffer: a node that never sends, takes every intact
+        frame it receives whoever it is for (no acceptance filter), reads on arrival,
+        and counts them per sender in :attr:`captured` (``{sniffer: {sender: frames}}``)."""
+        self.add_module(module)
+        self.sniffers.add(module)
+        self.captured.setdefault(module, {})
+        self._readers[module] = (0.0, 0.0)
 
     def request(self, frame: Frame) -> bool:
         """The sender's module asks to send ``frame`` now; ``False`` if its transmit queue
@@ -577,6 +621,10 @@ class BusMedium:
 
     def _arrive(self, frame: Frame, module: int) -> None:
         """An intact frame reaches ``module``'s receive buffer now."""
+        if module in self.sniffers:
+            counts = self.captured[module]
+            counts[frame.sender] = counts.get(frame.sender, 0) + 1
+            return
         if self.bus.acceptance_filter and module not in frame.receivers:
             return
         now = self.clock.now
@@ -897,6 +945,325 @@ class ZigbeeMedium(BusMedium):
             self._serve(module)
         else:
             self._notify_idle([module])
+
+
+class _Broadcast:
+    """One payload-addressed frame as a ZigBee network broadcast: which nodes have it,
+    why the others have not (yet), and how much of its relaying is still under way."""
+
+    __slots__ = ("frame", "origin", "key", "pending", "reached", "why", "heard", "tries", "intact", "done")
+
+    def __init__(self, frame: Frame, origin: int, key: Any) -> None:
+        self.frame = frame
+        self.origin = origin
+        self.key = key
+        self.pending = 0  # transmissions, jitter waits, passive-ack waits and polls to come
+        self.reached: set[int] = {origin}
+        self.why: dict[int | None, Loss] = {}
+        self.heard: dict[int, set[int]] = {}  # node -> the routers it heard transmit this broadcast
+        self.tries: dict[int, int] = {}
+        self.intact = False
+        self.done = False
+
+
+class ZigbeeNetworkMedium(ZigbeeMedium):
+    """XBee radios as a ZigBee network (``network: true``, the default): a module's
+    payload-addressed frame is a network broadcast. See :class:`ZigbeeBus` and the
+    module docstring: the coordinator and routers record each new broadcast in their
+    broadcast transaction table (``btt_entries`` entries, each kept ``btt_lifetime``
+    s; a node whose table is full drops a new broadcast: it neither delivers nor
+    relays it) and relay it after a jitter of up to ``max_jitter``, retransmitting it
+    (at most ``broadcast_retries`` times) when, ``passive_ack_timeout`` after a
+    transmission, it has not heard every neighbouring router relay it (passive
+    acknowledgement). With ``roles: end_devices`` every module but the coordinator
+    (the first attached) is an end device: it sends its frame to its parent (MAC
+    acknowledged, ``mac_retries`` retries), and receives broadcasts only when it polls
+    its parent (every ``poll_period`` s), which buffers ONE broadcast for all its end
+    devices, a new one replacing it. A sniffer (:meth:`~BusMedium.sniff`) is a router.
+    A broadcast's losses are decided when its last transmission, wait or poll is over.
+    """
+
+    def __init__(self, bus: ZigbeeBus, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (),
+                 positions: dict[int, float] | None = None, **options: Any) -> None:
+        self._btt: dict[int, deque[tuple[float, Any]]] = {}
+        self._radio: dict[int, deque[tuple[_Broadcast, str]]] = {}
+        self._uart_free: dict[int, float] = {}
+        self._buffered: dict[int, tuple[_Broadcast, set[int]]] = {}  # parent -> (broadcast, children to poll)
+        self._polls: dict[int, Timer] = {}
+        self._poll_phase: dict[int, float] = {}
+        self._on_air: dict[Transmission, tuple[int, _Broadcast, str]] = {}
+        self._sequence = 0
+        super().__init__(bus, clock, rng, modules, positions, **options)
+
+    def add_module(self, module: int) -> None:
+        super().add_module(module)
+        self._btt.setdefault(module, deque())
+        self._radio.setdefault(module, deque())
+
+    # Roles ----------------------------------------------------------------------------
+    def coordinator(self) -> int | None:
+        """The coordinator: the first attached module that is not a sniffer."""
+        return next((m for m in self.modules if m not in self.sniffers), None)
+
+    def role(self, node: int) -> str:
+        """``"coordinator"``, ``"router"`` or ``"end_device"``."""
+        if node == self.coordinator():
+            return "coordinator"
+        if node in self.sniffers or self.bus.roles == "routers":
+            return "router"
+        return "end_device"
+
+    def parent(self, node: int) -> int | None:
+        """An end device's parent (the coordinator); ``None`` for the others."""
+        return self.coordinator() if self.role(node) == "end_device" else None
+
+    def btt_size(self, node: int) -> int:
+        """Entries in ``node``'s broadcast transaction table now."""
+        self._purge(node)
+        return len(self._btt[node])
+
+    # The host's side ------------------------------------------------------------------
+    def is_free(self, module: int) -> bool:
+        return not self._serving[module] and not self._queues[module] and not self._radio[module]
+
+    def _request(self, frame: Frame) -> bool:
+        if not self._enqueue(frame, False):
+            return False
+        sender = frame.sender
+        now = self.clock.now
+        start = max(now, self._uart_free.get(sender, now))
+        ready = start + self._uart_time(len(frame.data) + self.bus.packetization_chars)
+        self._uart_free[sender] = ready
+        self.clock.at(ready, self._originate, sender, rank=MEDIUM)
+        return True
+
+    def _originate(self, node: int) -> None:
+        """The radio has the frame from its host's UART: a new broadcast."""
+        frame = self._queues[node].popleft()
+        self._sequence += 1
+        broadcast = _Broadcast(frame, node, (node, self._sequence))
+        if self.role(node) == "end_device":
+            self._push(node, broadcast, "up")
+            return
+        if not self._record(node, broadcast):
+            self._lost(Lost(frame, None, Loss.BTT_FULL, self.clock.now))
+            if not self._radio[node] and not self._serving[node]:
+                self._notify_idle([node])
+            return
+        self._push(node, broadcast, "broadcast")
+        self._buffer_for_children(node, broadcast)
+
+    # Broadcast transaction table --------------------------------------------------------
+    def _purge(self, node: int) -> None:
+        table, now = self._btt[node], self.clock.now
+        while table and table[0][0] <= now:
+            table.popleft()
+
+    def _record(self, node: int, broadcast: _Broadcast) -> bool:
+        """Make ``node``'s table entry for a new broadcast; ``False`` if the table is full."""
+        self._purge(node)
+        table = self._btt[node]
+        if len(table) >= self.bus.btt_entries:
+            return False
+        table.append((self.clock.now + self.bus.btt_lifetime, broadcast.key))
+        return True
+
+    def _take(self, node: int, broadcast: _Broadcast) -> None:
+        """A router or the coordinator received an intact copy now."""
+        if node in broadcast.reached:
+            return  # a duplicate: only a passive acknowledgement
+        now = self.clock.now
+        if not self._record(node, broadcast):
+            broadcast.why[node] = Loss.BTT_FULL
+            for child in self.modules:  # its end devices get nothing from it either
+                if self.parent(child) == node:
+                    broadcast.why.setdefault(child, Loss.BTT_FULL)
+            return
+        broadcast.reached.add(node)
+        broadcast.why.pop(node, None)
+        frame = broadcast.frame
+        self.clock.at(now + self._uart_time(len(frame.data)), self._arrive, frame, node, rank=MEDIUM)
+        broadcast.pending += 1
+        self.clock.at(now + self.rng.uniform(0.0, self.bus.max_jitter), self._relay, node, broadcast, rank=MEDIUM)
+        self._buffer_for_children(node, broadcast)
+
+    def _relay(self, node: int, broadcast: _Broadcast) -> None:
+        broadcast.pending -= 1
+        self._push(node, broadcast, "broadcast")
+
+    # End devices --------------------------------------------------------------------------
+    def _buffer_for_children(self, node: int, broadcast: _Broadcast) -> None:
+        children = {m for m in self.modules if m != broadcast.origin and self.parent(m) == node}
+        if not children:
+            return
+        old = self._buffered.pop(node, None)
+        self._buffered[node] = (broadcast, children)
+        broadcast.pending += len(children)
+        if old is not None:
+            dropped, waiting = old
+            for child in waiting:
+                dropped.why[child] = Loss.PARENT_BUFFER
+                dropped.pending -= 1
+            self._check_done(dropped)
+        for child in children:
+            self._schedule_poll(child)
+
+    def _schedule_poll(self, child: int) -> None:
+        if child in self._polls:
+            return
+        period = self.bus.poll_period
+        phase = self._poll_phase.setdefault(child, self.rng.uniform(0.0, period))
+        now = self.clock.now
+        when = phase + math.ceil((now - phase) / period - 1e-9) * period
+        self._polls[child] = self.clock.at(max(when, now), self._poll, child, rank=MEDIUM)
+
+    def _poll(self, child: int) -> None:
+        """An end device polls its parent: it gets the buffered broadcast it has not had."""
+        self._polls.pop(child, None)
+        parent = self.parent(child)
+        entry = self._buffered.get(parent) if parent is not None else None
+        if entry is None or child not in entry[1]:
+            return
+        broadcast, waiting = entry
+        waiting.discard(child)
+        if not waiting:
+            del self._buffered[parent]
+        broadcast.pending -= 1
+        broadcast.reached.add(child)
+        broadcast.why.pop(child, None)
+        frame = broadcast.frame
+        out = self.bus.frame_bits(frame) / self.bus.air_bitrate + self._uart_time(len(frame.data))
+        self.clock.at(self.clock.now + out, self._arrive, frame, child, rank=MEDIUM)
+        self._check_done(broadcast)
+
+    # The radio ------------------------------------------------------------------------------
+    def _push(self, node: int, broadcast: _Broadcast, kind: str) -> None:
+        broadcast.pending += 1
+        self._radio[node].append((broadcast, kind))
+        if not self._serving[node]:
+            self._serve(node)
+
+    def _serve(self, module: int) -> None:
+        self._serving[module] = True
+        self._attempt[module] = (0, self.bus.min_be)
+        self._backoff(module)
+
+    def _assess(self, module: int) -> None:
+        now = self.clock.now
+        self._forget(now)
+        if not (any(t.start < now for t in self._active) or bool(self._recent)):
+            self.clock.at(now + _TURNAROUND, self._transmit, module, rank=MEDIUM)
+            return
+        backoffs, exponent = self._attempt[module]
+        backoffs += 1
+        if backoffs > self.bus.max_backoffs:
+            broadcast, kind = self._radio[module][0]
+            broadcast.why.setdefault(None, Loss.ACCESS_FAILURE)
+            self._after(module, broadcast, kind, None)
+            self._next(module, now)
+            return
+        self._attempt[module] = (backoffs, min(exponent + 1, self.bus.max_be))
+        self._backoff(module)
+
+    def _garble(self, transmission: Transmission) -> None:
+        transmission.garbled = True  # other copies may still arrive: decided at the end
+
+    def _transmit(self, module: int) -> None:
+        now = self.clock.now
+        broadcast, kind = self._radio[module][0]
+        bits = self.bus.frame_bits(broadcast.frame)
+        transmission = Transmission(broadcast.frame, now, now + bits / self.bus.air_bitrate, bits)
+        self._on_air[transmission] = (module, broadcast, kind)
+        self._active.append(transmission)
+        self._started(transmission)
+        if len(self._active) > 1:
+            for other in self._active:
+                self._garble(other)
+        self.clock.at(transmission.end, self._end, transmission, rank=MEDIUM)
+
+    def _end(self, transmission: Transmission) -> None:
+        now = self.clock.now
+        self._active.remove(transmission)
+        self._forget(now)
+        self._recent.append(transmission)
+        node, broadcast, kind = self._on_air.pop(transmission)
+        if not transmission.garbled:
+            broadcast.intact = True
+        self._ended(transmission)
+        self._after(node, broadcast, kind, transmission)
+        mac_bytes = transmission.bits // 8 - 6
+        self._next(node, now + (_LIFS if mac_bytes > _MAX_SIFS_FRAME_BYTES else _SIFS))
+
+    def _after(self, node: int, broadcast: _Broadcast, kind: str, transmission: Transmission | None) -> None:
+        """``node``'s transmission of ``broadcast`` is over (``None``: CSMA/CA gave up)."""
+        broadcast.tries[node] = broadcast.tries.get(node, 0) + 1
+        if kind == "up":
+            parent = self.parent(node)
+            if transmission is not None and not transmission.garbled and parent is not None \
+                    and self._link.survives(self.distance(node, parent), transmission.bits, self.rng):
+                self._take(parent, broadcast)
+                if parent not in broadcast.reached:  # the parent's table was full: it went no further
+                    broadcast.why[None] = Loss.BTT_FULL
+            else:
+                if transmission is not None:
+                    broadcast.why[None] = Loss.COLLISION if transmission.garbled else Loss.RADIO
+                if broadcast.tries[node] <= self.bus.mac_retries:
+                    self._push(node, broadcast, "up")
+        elif transmission is not None:
+            for other in self.modules:
+                if other == node or self.role(other) == "end_device":
+                    continue
+                if transmission.garbled:
+                    broadcast.why.setdefault(other, Loss.COLLISION)
+                    continue
+                if not self._link.survives(self.distance(node, other), transmission.bits, self.rng):
+                    broadcast.why.setdefault(other, Loss.RADIO)
+                    continue
+                broadcast.heard.setdefault(other, set()).add(node)
+                self._take(other, broadcast)
+        if kind == "broadcast":
+            broadcast.pending += 1
+            self.clock.at(self.clock.now + self.bus.passive_ack_timeout, self._passive_ack, node, broadcast,
+                          rank=MEDIUM)
+        broadcast.pending -= 1
+        self._check_done(broadcast)
+
+    def _passive_ack(self, node: int, broadcast: _Broadcast) -> None:
+        """The passive acknowledgement timeout: retransmit unless every neighbouring
+        router (and the coordinator) was heard transmitting the broadcast."""
+        broadcast.pending -= 1
+        neighbours = [m for m in self.modules if m != node and self.role(m) != "end_device"]
+        heard = broadcast.heard.get(node, set())
+        if any(m not in heard for m in neighbours) and broadcast.tries.get(node, 0) <= self.bus.broadcast_retries:
+            self._push(node, broadcast, "broadcast")
+        self._check_done(broadcast)
+
+    def _next(self, module: int, when: float) -> None:
+        self._radio[module].popleft()
+        self._serving[module] = False
+        self.clock.at(when, self._resume, module, rank=MEDIUM)
+
+    def _resume(self, module: int) -> None:
+        if self._serving[module]:
+            return
+        if self._radio[module]:
+            self._serve(module)
+        elif not self._queues[module]:
+            self._notify_idle([module])
+
+    def _check_done(self, broadcast: _Broadcast) -> None:
+        """Nothing of the broadcast is under way: the nodes it did not reach lost it now."""
+        if broadcast.pending > 0 or broadcast.done:
+            return
+        broadcast.done = True
+        now = self.clock.now
+        if not broadcast.intact:
+            self._lost(Lost(broadcast.frame, None, broadcast.why.get(None, Loss.COLLISION), now))
+            return
+        default = broadcast.why.get(None, Loss.COLLISION)
+        for node in self.modules:
+            if node not in broadcast.reached:
+                self._lost(Lost(broadcast.frame, node, broadcast.why.get(node, default), now))
 
 
 class BusSimulator:

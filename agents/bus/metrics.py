@@ -10,6 +10,10 @@
 * ``bus.speed_mps``: forward speed of the chain (its modules' mean position, first to
   last sample), when the modules drive a chain in the world.
 * ``bus.lost_by_reason``: lost frames by reason (collision, overwritten, ...).
+* ``bus.sniffer_lost_pct_module``: where the paper counts: the messages of one module
+  that the sniffer on the bus did not capture, % of those the module sent (each CPG
+  message is one frame on every bus), whoever they were for;
+  ``bus.sniffer_lost_pct``: the mean over the modules.
 """
 
 from __future__ import annotations
@@ -59,6 +63,30 @@ def lost_pct_module(record: Any, module: int = 1) -> float | None:
 def lost_pct(record: Any) -> float | None:
     counts = _per_sender(record)
     values = [100.0 * (s - r) / s for s, r in counts.values() if s]
+    return statistics.fmean(values) if values else None
+
+
+def _sniffer_counts(record: Any) -> dict[str, tuple[int, int]]:
+    """``{agent: (sent, captured by the sniffer)}`` (empty without a sniffer's record)."""
+    records = _custom(record, "bus.sniffed")
+    if not records:
+        return {}
+    captured = records[-1].data["data"].get("captured") or {}
+    sent: dict[str, int] = {}
+    for e in _custom(record, "bus.sent"):
+        sent[e.agent] = sent.get(e.agent, 0) + 1
+    return {agent: (n, min(n, int(captured.get(agent, 0)))) for agent, n in sent.items()}
+
+
+def sniffer_lost_pct_module(record: Any, module: int = 1) -> float | None:
+    counts = _sniffer_counts(record).get(f"m{module}")
+    if not counts or not counts[0]:
+        return None
+    return 100.0 * (counts[0] - counts[1]) / counts[0]
+
+
+def sniffer_lost_pct(record: Any) -> float | None:
+    values = [100.0 * (s - c) / s for s, c in _sniffer_counts(record).values() if s]
     return statistics.fmean(values) if values else None
 
 
@@ -124,5 +152,6 @@ def register(registry: Any) -> None:
     """Register the metrics (the ``petriflow.actions`` plugin calls this)."""
     for name, function in (("bus.lost_pct", lost_pct), ("bus.lost_pct_module", lost_pct_module),
                            ("bus.phase_error_rad", phase_error_rad), ("bus.speed_mps", speed_mps),
-                           ("bus.lost_by_reason", lost_by_reason)):
+                           ("bus.lost_by_reason", lost_by_reason), ("bus.sniffer_lost_pct", sniffer_lost_pct),
+                           ("bus.sniffer_lost_pct_module", sniffer_lost_pct_module)):
         registry.register_metric(name, function, events=True)

@@ -17,11 +17,15 @@ lost frame arrive as a loss notice, so the net stays bounded and live however ma
 frames the bus loses. Algorithm 2's tail sends to an address no module holds: its
 frames go into a channel place nobody reads but ``drain`` (a transition of no agent).
 
+The paper's sniffer is a subnet of its own (agent ``sniffer``): ``sniffer_boot`` joins
+the bus as a node that only listens, and ``end`` (when every module has sent its
+messages) records what it captured from each module (``bus.sniffed``).
+
 Examples:
     >>> from petriflow.io.yaml import loads_net
     >>> net = loads_net(build(3, algorithm=1))
     >>> sorted(net.subnets), len([p for p in net.places.values() if p.channel])
-    (['m1', 'm2', 'm3'], 4)
+    (['m1', 'm2', 'm3', 'sniffer'], 4)
 """
 
 from __future__ import annotations
@@ -36,7 +40,7 @@ __all__ = ["build", "main"]
 
 
 def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_time: float = 0.02,
-          max_delay: float = 1.0, idle_window: float = 1.0, world: bool = False, **ignored: Any) -> str:
+          max_delay: float = 1.0, idle_window: float = 3.0, world: bool = False, **ignored: Any) -> str:
     """The chain's net as petriflow YAML (see the module).
 
     Args:
@@ -45,7 +49,8 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
         messages: messages each module sends.
         step_time: the control step (CPG and actuator), s.
         max_delay: algorithm 1's Delay ~ U[0, max_delay] s.
-        idle_window: algorithm 2's bus-available time ~ U[0, idle_window] s.
+        idle_window: algorithm 2's bus-available time ~ U[0, idle_window] s (3 s: 100
+            messages take about the paper's two minutes).
         world: the modules drive the joints of a chain in the world (the world file
             must hold it: :func:`petriflow.agents.bus.chain.world`).
         ignored: other sweep parameters (they go elsewhere).
@@ -137,6 +142,15 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
                         "transitions": transitions})
         end_in += end_from + [f"{name}_listen"]
     end_in += [p["id"] for p in top_places if p["id"].startswith("slot_")]
+    first_box = f"box_{chain[0]}_{chain[1]}"
+    subnets.append({"id": "sniffer", "agent": "sniffer", "label": "the sniffer on the bus",
+                    "places": ["sniffer_start", "sniffer_on"],
+                    "transitions": [
+                        {"id": "sniffer_boot", "label": "the sniffer joins the bus", "action": "bus.sniffer",
+                         "params": {"box": first_box}, "in": ["sniffer_start"], "out": ["sniffer_on"]},
+                        {"id": "end", "label": "every module sent its messages: the sniffer's record",
+                         "action": "bus.sniffed", "params": {"box": first_box}, "in": [*end_in, "sniffer_on"],
+                         "out": ["o"]}]})
     net = {
         "petriflow": 1,
         "net": f"bus-algorithm{algorithm}-{modules}",
@@ -145,9 +159,8 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
         "places": [{"id": "i", "tokens": 1}, "o", *top_places],
         "transitions": [
             {"id": "begin", "label": "power on", "in": ["i"],
-             "out": [f"{m}_start" for m in chain] + [s for s in end_in if s.startswith("slot_")]},
+             "out": [f"{m}_start" for m in chain] + [s for s in end_in if s.startswith("slot_")] + ["sniffer_start"]},
             *top_transitions,
-            {"id": "end", "label": "every module sent its messages", "in": end_in, "out": ["o"]},
         ],
         "final": {"o": 1},
     }

@@ -38,6 +38,8 @@ ACTIONS = {
     "bus.overflow": (f"{_F}:Overflow", "algorithm 2: the 1 s overflow interrupt"),
     "bus.receive": (f"{_F}:Receive", "the reception routine (a frame, or a loss notice)"),
     "bus.drain": (f"{_F}:Drain", "a frame for no module leaves the bus"),
+    "bus.sniffer": (f"{_F}:Sniffer", "the sniffer joins the bus as a node that only listens"),
+    "bus.sniffed": (f"{_F}:Sniffed", "the sniffer's record: frames captured per module"),
 }
 
 

@@ -199,7 +199,7 @@ def _ready_time(bus, data_bytes=8):
 def test_zigbee_first_backoff_is_zero_to_seven_unit_periods():
     """One frame on a quiet channel: it goes on the air after the UART, k·320 µs with
     0 <= k <= 7, the CCA and the turnaround; all eight k appear over seeds."""
-    bus = ZigbeeBus()
+    bus = ZigbeeBus(network=False)
     seen = set()
     for seed in range(200):
         sim = BusSimulator(bus, modules=[0, 1], seed=seed)
@@ -214,7 +214,7 @@ def test_zigbee_first_backoff_is_zero_to_seven_unit_periods():
 def test_zigbee_busy_channel_raises_the_backoff_exponent_and_gives_up():
     """While another radio holds the air, every CCA fails: backoff ranges 2^3, 2^4, 2^5,
     2^5, 2^5, then the frame is dropped for channel access failure."""
-    slow = ZigbeeBus(air_bitrate=1000.0)  # the first frame holds the air for 0.336 s
+    slow = ZigbeeBus(network=False, air_bitrate=1000.0)  # the first frame holds the air for 0.336 s
     rng = FixedBackoff(0)
     medium, clock = on_clock(slow, [0, 1, 2], rng)
     medium.request(frame(0, (2,), tag="jammer"))
@@ -231,7 +231,7 @@ def test_zigbee_busy_channel_raises_the_backoff_exponent_and_gives_up():
 def test_zigbee_radios_assessing_together_collide():
     """Two radios whose CCAs end at the same time both find the air clear, both send,
     both frames are garbled."""
-    medium, clock = on_clock(ZigbeeBus(), [0, 1, 2], FixedBackoff(0))
+    medium, clock = on_clock(ZigbeeBus(network=False), [0, 1, 2], FixedBackoff(0))
     medium.request(frame(0, (2,), tag="a"))
     medium.request(frame(1, (2,), tag="b"))
     clock.run(until=0.1)
@@ -243,7 +243,7 @@ def test_zigbee_radios_assessing_together_collide():
 
 def test_zigbee_radio_after_a_clear_assessment_waits_for_the_air():
     """A radio whose CCA comes after another's frame started defers: no collision."""
-    medium, clock = on_clock(ZigbeeBus(), [0, 1, 2], FixedBackoff(0))
+    medium, clock = on_clock(ZigbeeBus(network=False), [0, 1, 2], FixedBackoff(0))
     medium.request(frame(0, (2,), tag="a"))
     clock.run(until=0.0025)  # a is on the air now
     medium.request(frame(1, (2,), tag="b"))
@@ -257,7 +257,7 @@ def test_zigbee_weak_link_loses_frames_to_bit_errors():
     """Far below the noise floor every frame is lost on the link (RSSI-dependent loss);
     at the default power the neighbour hears everything."""
     for power, reason in ((-80.0, Loss.RADIO), (0.0, None)):
-        sim = BusSimulator(ZigbeeBus(tx_power_dbm=power), modules=[0, 1], seed=3)
+        sim = BusSimulator(ZigbeeBus(network=False, tx_power_dbm=power), modules=[0, 1], seed=3)
         for i in range(5):
             sim.send(0.05 * i, frame(0, (1,), tag=i))
             sim.read(0.05 * i + 0.04, 1)
@@ -269,12 +269,12 @@ def test_zigbee_weak_link_loses_frames_to_bit_errors():
 
 def test_zigbee_module_only_sees_its_own_radio():
     """The module cannot hear the air: the bus is 'free' for it while another radio sends."""
-    medium, _ = on_clock(ZigbeeBus(), [0, 1])
+    medium, _ = on_clock(ZigbeeBus(network=False), [0, 1])
     medium.request(frame(0))
     assert not medium.is_free(0) and medium.is_free(1)
 
 
-@pytest.mark.parametrize("bus", [SerialBus(), CanBus(), ZigbeeBus(shadowing_db=6.0)])
+@pytest.mark.parametrize("bus", [SerialBus(), CanBus(), ZigbeeBus(network=False, shadowing_db=6.0), ZigbeeBus(shadowing_db=6.0)])
 def test_same_seed_same_history(bus):
     """A seed fixes every draw: same seed, same transmissions and losses."""
 
