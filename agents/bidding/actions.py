@@ -154,10 +154,14 @@ class MakeInterface(InstantAction):
 
     agent_state = Interface
     resources = OFFICE
-    params = {"resolution": Param(float, 0.1, "global map cell (m)", low=1e-9)}
+    params = {"resolution": Param(float, 0.1, "global map cell (m)", low=1e-9),
+              "until": Param(str, "mapped", "END when every zone is mapped: in a laser's sight or reached"
+                             " (mapped; the paper maps \"until mapping the entire world\") or only when every"
+                             " zone is reached (reached)", choices=("mapped", "reached"))}
 
     def run(self, ctx: ActionContext) -> None:
         hmia = ctx.state = Interface(ctx.agent or ctx.transition)
+        hmia.until = self.params["until"]
         office = _office(ctx)
         if office is not None:
             from petriflow.agents.bidding.grid import GlobalMap
@@ -227,11 +231,16 @@ def _hmia_receive(ctx: ActionContext, hmia: Interface, message: Message) -> None
         points = message.body.get("points")
         if points is not None and len(points) and hmia.global_map is not None:
             hmia.points += len(points)
-            hmia.global_map.add(int(message.body.get("rank", 0)), np.asarray(points, dtype=float))
+            hmia.global_map.add(int(message.body.get("rank", 0)), np.asarray(points, dtype=float),
+                                real=message.body.get("real"))
         for zone in message.body.get("finished", ()):
             if zone not in hmia.finished:
                 hmia.finished.add(zone)
                 ctx.emit("bidding.zone_mapped", zone=zone + 1, robot=message.sender)
+        for zone in message.body.get("seen", ()):
+            if zone not in hmia.seen:
+                hmia.seen.add(zone)
+                ctx.emit("bidding.zone_seen", zone=zone + 1, robot=message.sender)
 
 
 def _robot_receive(ctx: ActionContext, ra: RobotAgent, message: Message) -> None:
@@ -256,6 +265,7 @@ def _robot_receive(ctx: ActionContext, ra: RobotAgent, message: Message) -> None
                 ra.ranks[message.sender] = int(body["rank"])
     elif kind == "MAP":
         ra.mapping = True
+        ra.sight = {int(z): (float(p[0]), float(p[1])) for z, p in enumerate(body.get("zones", ()))}
     elif kind == "END":
         ra.ended = True
         ra.mapping = False
@@ -281,7 +291,8 @@ def _hmia_alive(ctx: ActionContext, hmia: Interface) -> None:
             continue
         hmia.alive.discard(robot)
         hmia.drop(robot)
-        lost = sorted(z for z, owner in hmia.owner.items() if owner == robot and z not in hmia.finished)
+        mapped = hmia.mapped()
+        lost = sorted(z for z, owner in hmia.owner.items() if owner == robot and z not in mapped)
         for zone in lost:
             del hmia.owner[zone]
             if zone not in hmia.to_offer:
@@ -362,7 +373,9 @@ class StartMapping(_HmiaStep):
     """HMIA: every zone has an owner: MAP to every living RA (mapping starts)."""
 
     def step(self, ctx: ActionContext, hmia: Interface) -> None:
-        hmia.broadcast("MAP", hmia.name, [r for r in hmia.robots if r in hmia.alive])
+        # mapping until the world is mapped: the RAs look out for every zone (its position in sight)
+        body = {"zones": [tuple(z) for z in hmia.zones]} if hmia.until == "mapped" else None
+        hmia.broadcast("MAP", hmia.name, [r for r in hmia.robots if r in hmia.alive], body=body)
         hmia.map_sent = ctx.now
         ctx.emit("bidding.map", owners={str(z + 1): r for z, r in sorted(hmia.owner.items())})
 
@@ -379,11 +392,12 @@ class End(_HmiaStep):
         hmia.end_sent = ctx.now
         report: dict[str, Any] = {"time_s": round(ctx.now - (hmia.map_sent or 0.0), 6), "points": hmia.points}
         if hmia.global_map is not None:
-            from petriflow.agents.bidding.grid import accuracy
+            from petriflow.agents.bidding.grid import accuracy, fictitious
 
-            score = accuracy(hmia.global_map.occupied, hmia.truth.occupied, self.params["tolerance"])
+            score = fictitious(hmia.global_map)
+            fit = accuracy(hmia.global_map.occupied, hmia.truth.occupied, self.params["tolerance"])
             report.update(accuracy_pct=round(score.percent, 4), sigma=int(score.sigma), xi=int(score.xi),
-                          coverage=round(score.coverage, 4))
+                          fit_pct=round(fit.percent, 4), coverage=round(fit.coverage, 4))
         ctx.emit("bidding.end", **report)
 
 
@@ -405,13 +419,37 @@ class _RobotStep(InstantAction):
 
 
 class Ready(_RobotStep):
-    """RA, on INITIALIZE: take its pose and laser; INITIALIZED back."""
+    """RA, on INITIALIZE: take its pose, odometry and laser; INITIALIZED back.
 
-    resources = LIVE
+    ``localization: odom`` (default) gives the robot Stage's odometry error model
+    (:mod:`~petriflow.agents.bidding.odometry`): its error proportions are drawn now,
+    from ``odom_error`` (Stage's default ``[0.03, 0.03, 0.05]``) and this firing's
+    seeded generator; ``gps`` localises it perfectly."""
+
+    resources = {**OFFICE, **LIVE}
     params = {"radius": Param(float, 0.1, "wheel radius (m)", low=1e-9),
               "ppr": Param(int, 500, "encoder pulses per turn", low=1),
-              "track": Param(float, 0.33, "wheel track (m)", low=1e-9)}
+              "track": Param(float, 0.33, "wheel track (m)", low=1e-9),
+              "localization": Param(str, "odom", "odom (Stage's odometry error model; the paper's robots"
+                                    " localise by odometry, §4.1) or gps (the true pose)", choices=("odom", "gps")),
+              "odom_error": Param((list, type(None)), None, "Stage's odom_error [x, y, heading]: the largest"
+                                  " proportion of error per axis (default Stage 3.2's [0.03, 0.03, 0.05])")}
     requires = frozenset({"world"})
+
+    @classmethod
+    def check_params(cls, given: dict[str, Any], where: str) -> dict[str, Any]:
+        from petriflow.errors import NetFormatError
+
+        checked = super().check_params(given, where)
+        limits = checked["odom_error"]
+        if limits is not None and not (len(limits) == 3 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and 0 <= v < 2
+                for v in limits)):
+            error = NetFormatError(f"parameter 'odom_error': [x, y, heading], three numbers from 0 to 2, got"
+                                   f" {limits!r}", element=where)
+            error.param = "odom_error"
+            raise error
+        return checked
 
     def step(self, ctx: ActionContext, ra: RobotAgent) -> None:
         if ctx.world is None:
@@ -420,15 +458,22 @@ class Ready(_RobotStep):
 
         ra.robot = KinematicRobot(ctx.world, ra.name, radius=self.params["radius"], ppr=self.params["ppr"],
                                   track=self.params["track"])
+        if self.params["localization"] == "odom":
+            from petriflow.agents.bidding.odometry import STAGE_ODOM_ERROR, Odometry, draw_errors
+
+            limits = self.params["odom_error"]
+            ra.odometry = Odometry(ra.robot.pose, draw_errors(STAGE_ODOM_ERROR if limits is None else limits,
+                                                              ctx.rng))
         if ra.initialise is not None:
             ra.rank = int(ra.initialise.body.get("rank", ra.rank))
             ra.team = list(ra.initialise.body.get("team", [ra.name]))
         ra.ranks.update({name: rank for rank, name in enumerate(ra.team)})
         _robot_alive(ctx, ra)
         ra.initialised = True
-        x, y, yaw = ra.robot.pose
+        x, y, yaw = ra.pose()
         ra.queue(Message("INITIALIZED", ra.name, ra.hmia, body={"pose": (x, y, yaw)}))
-        ctx.emit("bidding.ready", pose=[round(x, 3), round(y, 3), round(yaw, 4)])
+        ctx.emit("bidding.ready", pose=[round(x, 3), round(y, 3), round(yaw, 4)],
+                 odometry=None if ra.odometry is None else ra.odometry.to_dict()["errors"])
 
 
 class Bid(_RobotStep):
@@ -450,7 +495,7 @@ class Bid(_RobotStep):
         if auction is None:
             raise ActionFailure("bidding.bid: no call for proposals")
         p = self.params
-        x, y, _ = ra.robot.pose
+        x, y, _ = ra.pose()
         travel = math.dist((x, y), auction.position) / p["speed"]
         held = len(ra.mine)  # the zones this robot already holds (eq. 6's sum over k < j)
         weights = Weights(p["alpha"], p["beta"], p["gamma"])
@@ -485,13 +530,19 @@ class Decide(_RobotStep):
 
 def _robot_alive(ctx: ActionContext, ra: RobotAgent) -> None:
     live = ctx.resource("live")
-    ra.set_alive({r for r in ra.team if live.alive(r)})
+    plan = ctx.resource("office")
+    if plan is None:
+        ra.set_alive({r for r in ra.team if live.alive(r)})
+    else:  # the run's running agents, read once per time step for the whole team
+        ra.set_alive(set(plan.running(live, ctx.now) & ra.members()))
 
 
 class Explore(Action):
-    """RA: drive to its zones nearest first, visiting each zone's waypoints and turning
-    a full circle at each, scanning the laser every ``scan_period`` s; each scan's new
-    world points (eq. 7-8) go to the HMIA (MAPPED), with the zones finished.
+    """RA: drive to its zones nearest first (the operator's order in a random
+    deployment), steering on where its odometry says it is, scanning the laser every
+    ``scan_period`` s; each scan's new world points (eq. 7-8, from the believed pose)
+    go to the HMIA (MAPPED), with the zones reached and the zones first in sight. Once
+    its zones are done it stands and goes on mapping until END (``idle: scan``).
 
     Ends after ``step`` s, or as soon as a message waits to be sent, so the work loop
     sends it and answers calls for proposals while mapping.
@@ -499,7 +550,7 @@ class Explore(Action):
 
     params = {
         "speed": Param(float, SPEED_M_S, "cruise speed (m/s)", low=1e-9),
-        "turn_rate": Param(float, 1.0, "turn rate (rad/s)", low=1e-9),
+        "turn_rate": Param(float, 1.0, "turn rate (rad/s; Stage 3.2's position controller: 1)", low=1e-9),
         "step": Param(float, 1.0, "longest run of one firing (s)", low=1e-9),
         "scan_period": Param(float, 1.0, "seconds between laser scans", low=0),
         "range": Param(float, 8.0, "laser range (m)", low=1e-9),
@@ -510,7 +561,10 @@ class Explore(Action):
         "cell": Param(float, 0.1, "a point is new when its cell (m) was not sent before", low=1e-9),
         "send": Param(str, "every", "MAPPED after every scan (every, the paper's: its message counts follow"
                       " the mapping time) or only after scans that saw new cells (new)", choices=("every", "new")),
-        "spin": Param(bool, True, "turn a full circle at every waypoint"),
+        "spin": Param(bool, False, "turn a full circle at every waypoint (the paper describes none)"),
+        "idle": Param(str, "scan", "once its zones are done: go on scanning and sending MAPPED until END"
+                      " (scan; the RA's procedure \"continues until receiving END\", §3.2.2) or stop (stop)",
+                      choices=("scan", "stop")),
         "visit": Param(str, "centre", "what mapping a zone means: drive to its position (centre, the paper's)"
                        " or through waypoints spread over its room (room)", choices=("centre", "room")),
         "clearance": Param(float, 0.8, "hold while a robot of smaller rank is this close ahead (m)",
@@ -528,6 +582,7 @@ class Explore(Action):
         ra.now = ctx.now
         self.left = self.params["step"]
         self.at = ctx.now
+        ra.keep_mapping = self.params["idle"] == "scan"
         if ra.robot is None:
             raise ActionFailure("bidding.explore: the robot agent is not initialised")
         # how far a teammate may drive between two questions of one time step (one step of
@@ -543,18 +598,22 @@ class Explore(Action):
             return Status.RUNNING
         self.dt = dt
         self.left -= dt
-        if not ra.route and ra.spin_left <= 0:
-            if not self._next(ctx):
+        standing = False
+        if not ra.route and ra.spin_left <= 0 and not self._next(ctx):
+            if not ra.keep_mapping:
                 ra.changed()
                 return Status.OK
-        if ra.spin_left > 0:
+            standing = True  # every zone done: stand and go on mapping until END
+        if standing:
+            pass
+        elif ra.spin_left > 0:
             w = self.params["turn_rate"]
             half = ra.robot.encoders.track / 2.0
-            ra.robot.drive(-w * half, w * half, dt)
+            self._drive(-w * half, w * half, dt)
             ra.spin_left -= w * dt
         elif not self._held(ctx):
             target = ra.route[0]
-            if ra.robot.step_towards(target, self.params["speed"], self.params["turn_rate"], dt, tolerance=0.05):
+            if self._towards(target, dt, tolerance=0.05):
                 ra.route.pop(0)
                 if not ra.route:
                     ra.passing = None
@@ -570,6 +629,36 @@ class Explore(Action):
             return Status.OK
         return Status.RUNNING
 
+    def _drive(self, left: float, right: float, dt: float) -> None:
+        """Turn the wheels: the body moves (the truth), the odometry integrates the
+        same wheel speeds with its errors (the robot's belief)."""
+        ra = self.ra
+        ra.robot.drive(left, right, dt)
+        if ra.odometry is not None:
+            ra.odometry.wheels(left, right, ra.robot.encoders.track, dt)
+
+    def _towards(self, goal: tuple[float, float], dt: float, tolerance: float) -> bool:
+        """One ``dt`` towards ``goal`` steered on where the robot believes it is: turn on
+        the spot to face it, then drive straight at it; ``True`` once (believed) within
+        ``tolerance``."""
+        ra = self.ra
+        x, y, yaw = ra.pose()
+        distance = math.hypot(goal[0] - x, goal[1] - y)
+        if distance <= tolerance:
+            return True
+        error = math.atan2(goal[1] - y, goal[0] - x) - yaw
+        error = math.atan2(math.sin(error), math.cos(error))
+        half = ra.robot.encoders.track / 2.0
+        if abs(error) > 0.02:
+            w = math.copysign(min(self.params["turn_rate"], abs(error) / dt), error)
+            self._drive(-w * half, w * half, dt)
+            return False
+        v = min(self.params["speed"], distance / dt)
+        w = error / dt * 0.5
+        self._drive(v - w * half, v + w * half, dt)
+        x, y, _ = ra.pose()
+        return math.hypot(goal[0] - x, goal[1] - y) <= tolerance
+
     def _next(self, ctx: ActionContext) -> bool:
         """Route to the next waypoint (of this zone, or of the nearest zone left)."""
         ra = self.ra
@@ -577,7 +666,7 @@ class Explore(Action):
             left = ra.left()
             if not left:
                 return False
-            x, y, _ = ra.robot.pose
+            x, y, _ = ra.pose()
             listed = [z for z in ra.order if z in left]
             zone = listed[0] if listed else left[tour((x, y), [ra.zones[z] for z in left])[0]]
             ra.plan = [zone]
@@ -592,7 +681,7 @@ class Explore(Action):
         if plan is None:
             ra.route = [goal]
             return True
-        route = plan.navigator(self.params["inflate"]).route(ra.robot.pose[:2], goal)
+        route = plan.navigator(self.params["inflate"]).route(ra.pose()[:2], goal)
         if route is None:
             ctx.emit("bidding.unreachable", goal=[round(goal[0], 3), round(goal[1], 3)])
             return bool(ra.waypoints) or self._finish_zone(ctx)
@@ -609,7 +698,9 @@ class Explore(Action):
         ra.done.add(zone)
         ra.queue(Message("MAPPED", ra.name, ra.hmia, zone=zone, body={"points": None, "finished": [zone],
                                                                       "rank": ra.rank}))
-        ctx.emit("bidding.zone_done", zone=zone + 1, distance_m=round(ra.robot.travelled, 3))
+        (bx, by, _), (tx, ty, _) = ra.pose(), ra.robot.pose
+        ctx.emit("bidding.zone_done", zone=zone + 1, distance_m=round(ra.robot.travelled, 3),
+                 drift_m=round(math.hypot(bx - tx, by - ty), 4))
 
     def _held(self, ctx: ActionContext) -> bool:
         """Hold while a robot of smaller rank is close ahead (no two robots wait for
@@ -628,7 +719,7 @@ class Explore(Action):
             return False
         where = ctx.world.position(blocker)
         navigator = plan.navigator(self.params["inflate"])
-        detour = navigator.around([(where[0], where[1], self.params["clearance"])]).route(ra.robot.pose[:2],
+        detour = navigator.around([(where[0], where[1], self.params["clearance"])]).route(ra.pose()[:2],
                                                                                            ra.route[-1])
         ctx.emit("bidding.detour", around=blocker, found=detour is not None)
         if detour is not None:
@@ -645,10 +736,11 @@ class Explore(Action):
         # who can be that close: the team's positions read once per step (margin: a step
         # of every robot between two questions of one step), instead of every robot's here
         near = None if plan is None else plan.near(world, ctx.now, x, y, clearance + self._margin)
-        for other in ra.alive:
+        # only the robots near (not the whole team: a step's cost must not grow with it),
+        # in rank order (the nearest in rank of those in the way, whatever the set's order)
+        candidates = ra.alive if near is None else (near & ra.alive)
+        for other in sorted(candidates, key=lambda name: (ra.ranks.get(name, ra.rank), name)):
             if other == ra.name or other == ra.passing or ra.ranks.get(other, ra.rank) >= ra.rank:
-                continue
-            if near is not None and other not in near:
                 continue
             where = world.position(other)
             if where is None:
@@ -666,25 +758,77 @@ class Explore(Action):
 
         ra = self.ra
         p = self.params
-        pose = ra.robot.pose
-        ranges, angles = scan(ctx.world, ra.name, pose, max_range=p["range"], fov_deg=p["fov"], beams=p["beams"],
-                              z=p["z"], ignore_teammates=p["filter_teammates"])
+        # the beams leave from where the robot is; it places their returns (eq. 7-8) where
+        # it believes it is
+        ranges, angles, bodies = scan(ctx.world, ra.name, ra.robot.pose, max_range=p["range"], fov_deg=p["fov"],
+                                      beams=p["beams"], z=p["z"], ignore_teammates=p["filter_teammates"],
+                                      hits=True)
+        pose = ra.pose()
         points = world_points(pose, ranges, angles, p["range"])
+        # which returns came off a real obstacle, which off a teammate (the simulator's
+        # knowledge, for eq. 10's scoring only)
+        hit = np.isfinite(ranges) & (ranges >= 0) & (ranges < p["range"]) & np.isfinite(angles)
+        real = ~np.isin(bodies[hit], self._team_bodies(ctx))
         ra.scans += 1
+        seen = self._sighted(pose, ranges, angles)
         every = p["send"] == "every"
         if not len(points):
-            if every:
-                ra.queue(Message("MAPPED", ra.name, ra.hmia, body={"points": None, "finished": [], "rank": ra.rank}))
+            if every or seen:
+                ra.queue(Message("MAPPED", ra.name, ra.hmia, body={"points": None, "finished": [], "seen": seen,
+                                                                   "rank": ra.rank}))
             return
         cells = np.floor(points / p["cell"]).astype(np.int64)
         keys = cells[:, 0] * 1_000_003 + cells[:, 1]
-        keys, first = np.unique(keys, return_index=True)
-        new = [k for k in range(len(keys)) if int(keys[k]) not in ra.seen]
-        if not new and not every:
+        keys, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+        # a cell is real when a real return fell in it; a cell sent as a teammate is sent
+        # again once a real return falls in it
+        real_cell = np.bincount(inverse.reshape(-1), weights=real.astype(float), minlength=len(keys)) > 0
+        new = [k for k in range(len(keys)) if int(keys[k]) not in ra.seen
+               and (real_cell[k] or int(keys[k]) not in ra.seen_teammate)]
+        if not new and not every and not seen:
             return
-        ra.seen.update(int(keys[k]) for k in new)
+        for k in new:
+            (ra.seen if real_cell[k] else ra.seen_teammate).add(int(keys[k]))
         fresh = points[first[new]].astype(np.float32)
-        ra.queue(Message("MAPPED", ra.name, ra.hmia, body={"points": fresh, "finished": [], "rank": ra.rank}))
+        ra.queue(Message("MAPPED", ra.name, ra.hmia, body={"points": fresh, "finished": [], "seen": seen,
+                                                           "rank": ra.rank, "real": real_cell[new]}))
+
+    def _team_bodies(self, ctx: ActionContext) -> np.ndarray:
+        """The pybullet bodies of the robot's teammates (what its laser may see that is
+        not a real obstacle)."""
+        bodies = getattr(self, "_bodies", None)
+        if bodies is None:
+            world = ctx.world
+            bodies = self._bodies = np.asarray(
+                [world.body(name) for name in self.ra.team if name != self.ra.name and name in world.agents],
+                dtype=np.int64)
+        return bodies
+
+    def _sighted(self, pose: tuple[float, float, float], ranges: np.ndarray, angles: np.ndarray) -> list[int]:
+        """The mission's zones this scan has in sight for the first time: within the
+        laser's range and field of view, and the beam nearest their bearing reaches past
+        them (nothing in between). Judged from where the robot believes it is."""
+        ra = self.ra
+        if not ra.sight or len(ra.sighted) == len(ra.sight) or not len(angles):
+            return []
+        x, y, yaw = pose
+        spacing = float(angles[1] - angles[0]) if len(angles) > 1 else math.pi
+        seen = []
+        for zone, (zx, zy) in ra.sight.items():
+            if zone in ra.sighted:
+                continue
+            distance = math.hypot(zx - x, zy - y)
+            if distance >= self.params["range"]:
+                continue
+            bearing = math.atan2(zy - y, zx - x) - yaw
+            bearing = math.atan2(math.sin(bearing), math.cos(bearing))
+            k = int(round((bearing - float(angles[0])) / spacing))
+            if not 0 <= k < len(angles) or abs(float(angles[k]) - bearing) > spacing:
+                continue
+            if ranges[k] >= distance:
+                seen.append(zone)
+        ra.sighted.update(seen)
+        return seen
 
 
 class Send(InstantAction):
@@ -710,7 +854,7 @@ class Wait(Action):
     """An agent with nothing to do: wait until something is (at most ``period`` s)."""
 
     agent_state = (Interface, RobotAgent)
-    resources = LIVE
+    resources = {**OFFICE, **LIVE}
     params = {"period": Param(float, 1.0, "longest wait (s)", low=1e-9)}
 
     def start(self, ctx: ActionContext) -> None:

@@ -67,13 +67,19 @@ class Interface(Mailbox):
         self.truth: Any = None
         self.points = 0
         self.now = 0.0
+        self.until = "mapped"          # END when every zone is mapped (in sight or reached), or only reached
+        self.seen: set[int] = set()   # zones a robot's laser has had in sight
+
+    def mapped(self) -> set[int]:
+        """The zones mapped so far: reached, or (``until == "mapped"``) in a laser's sight."""
+        return self.finished | self.seen if self.until == "mapped" else self.finished
 
     def deployed(self) -> bool:
         """Every zone has an owner (nothing left to auction or inform)."""
         return self.requested and not self.to_offer and self.auction is None and len(self.owner) == len(self.zones)
 
     def done(self) -> bool:
-        return self.map_sent is not None and len(self.finished) == len(self.zones)
+        return self.map_sent is not None and len(self.mapped()) == len(self.zones)
 
     def next_step(self) -> str | None:
         """What the HMIA should do now (``team``, ``inform``, ``cfp``, ``map``, ``end``), or ``None``."""
@@ -147,6 +153,9 @@ class RobotAgent(Mailbox):
         self.rank = rank
         self.hmia = hmia
         self.robot: Any = None        # the KinematicRobot, once initialised
+        self.odometry: Any = None     # its Stage odometry (localization odom), else None: the true pose
+        self.sight: dict[int, tuple[float, float]] = {}  # the mission's zones (from MAP), to see
+        self.sighted: set[int] = set()  # zones this robot's laser had in sight
         self.initialise: Message | None = None
         self.initialised = False
         self.auctions: deque[Auction] = deque()
@@ -156,6 +165,7 @@ class RobotAgent(Mailbox):
         self.order: list[int] = []    # the operator's list (random deployment): visited in its order
         self.done: set[int] = set()
         self.mapping = False
+        self.keep_mapping = True      # once its zones are done, go on scanning (MAPPED) until END
         self.ended = False
         self.alive: set[str] = set()
         self.team: list[str] = [name]
@@ -165,14 +175,22 @@ class RobotAgent(Mailbox):
         self.spin_left = 0.0
         self.held = 0.0               # seconds held behind a robot of smaller rank
         self.passing: str | None = None  # the robot a detour goes around
-        self.seen: set[tuple[int, int]] = set()
+        self.seen: set[int] = set()           # cells sent as real returns
+        self.seen_teammate: set[int] = set()  # cells sent as returns off teammates
         self.scans = 0
         self.now = 0.0
         self.waiting = 0.0
         self.ranks[name] = rank
+        self._members_of: list[str] | None = None
+        self._members: frozenset[str] = frozenset()
 
     def auction(self) -> Auction | None:
         return self.auctions[0] if self.auctions else None
+
+    def pose(self) -> tuple[float, float, float]:
+        """Where the robot believes it is (``localizeRobot()``): its odometry's estimate,
+        or the true pose when it localises perfectly (Stage's ``gps``)."""
+        return self.odometry.pose if self.odometry is not None else self.robot.pose
 
     def to_bid(self) -> bool:
         a = self.auction()
@@ -183,6 +201,14 @@ class RobotAgent(Mailbox):
         if a is None or a.own is None:
             return False
         return a.count(self.name, self.alive) == 0
+
+    def members(self) -> frozenset[str]:
+        """The team (made once per team list)."""
+        team = self.team
+        if self._members_of is not team:
+            self._members_of = team
+            self._members = frozenset(team)
+        return self._members
 
     def set_alive(self, alive: set[str]) -> None:
         """The teammates running now (what the heartbeats say); counts of missing
@@ -206,7 +232,7 @@ class RobotAgent(Mailbox):
             return "decide"
         if self.to_bid():
             return "bid"
-        if self.mapping and (self.route or self.spin_left > 0 or self.left()):
+        if self.mapping and (self.route or self.spin_left > 0 or self.left() or self.keep_mapping):
             return "explore"
         return None
 

@@ -54,10 +54,11 @@ __all__ = [
 
 #: The workspace's area L × W of §4.1 (32 m × 22 m).
 AREA_M2 = 32.0 * 22.0
-#: The robots' speed turning distance into the travel time ``P_ij`` (m/s). The paper
-#: gives none; 0.5 m/s is the top speed of a Pioneer 2DX as Player/Stage models it by
-#: default (an assumption).
-SPEED_M_S = 0.5
+#: The robots' speed turning distance into the travel time ``P_ij`` (m/s), and their
+#: cruise speed. The paper gives none; 0.4 m/s is the speed at which Stage 3.2 (the
+#: paper's simulator) drives a position model to a goal pose (``max_speed_x`` of its
+#: position controller, ``libstage/model_position.cc``; it turns at up to 1 rad/s).
+SPEED_M_S = 0.4
 
 
 @dataclass(frozen=True)

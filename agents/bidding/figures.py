@@ -25,6 +25,7 @@ def mission_map(robots: int, deployment: str, *, seed: int = 1, **options: Any) 
     """Run the mission in the paper's office; the HMIA's state at the end and the run outcome."""
     from petriflow import examples
     from petriflow.agents.bidding.nets import build
+    from petriflow.io.yaml import dumps_net
     from petriflow.runtime.registry import Registry
     from petriflow.runtime.session import run_files
 
@@ -32,9 +33,8 @@ def mission_map(robots: int, deployment: str, *, seed: int = 1, **options: Any) 
 
     class Keeping(MakeInterface):
         def run(self, ctx):
-            state = super().run(ctx)
-            kept.append(state)
-            return state
+            super().run(ctx)
+            kept.append(ctx.state)
 
     registry = Registry()
     registry.names()  # load the plugins first: this replaces one of their actions
@@ -43,13 +43,13 @@ def mission_map(robots: int, deployment: str, *, seed: int = 1, **options: Any) 
         folder = Path(folder)
         (folder / "world.yaml").write_text(examples.path("bidding", "world.yaml").read_text())
         (folder / "run.yaml").write_text(examples.path("bidding", "run.yaml").read_text())
-        (folder / "net.yaml").write_text(build(robots, deployment, **options))
+        (folder / "net.yaml").write_text(dumps_net(build(robots, deployment, **options)))
         outcome = run_files(folder / "net.yaml", seed=seed, registry=registry, keep_events=True)
     return kept[0], outcome
 
 
 def draw_maps(out: Path, seed: int = 1) -> list[Path]:
-    from petriflow.agents.bidding.grid import accuracy, draw_map
+    from petriflow.agents.bidding.grid import accuracy, draw_map, fictitious
     from petriflow.agents.bidding.office import paper_office
 
     office = paper_office()
@@ -57,10 +57,11 @@ def draw_maps(out: Path, seed: int = 1) -> list[Path]:
     for robots in (2, 4):
         for deployment in ("random", "autonomous"):
             hmia, outcome = mission_map(robots, deployment, seed=seed)
-            score = accuracy(hmia.global_map.occupied, hmia.truth.occupied, 1)
+            score = fictitious(hmia.global_map)
+            fit = accuracy(hmia.global_map.occupied, hmia.truth.occupied, 1)
             end = hmia.end_sent if hmia.end_sent is not None else outcome.result.time
             title = (f"{robots} robots, {deployment} deployment (seed {seed}): {end - hmia.map_sent:.0f} s,"
-                     f" accuracy {score.percent:.1f} %")
+                     f" accuracy {score.percent:.1f} % (fit {fit.percent:.0f} %)")
             path = out / f"map-{robots}-{deployment}.png"
             draw_map(hmia.global_map, path, office=office, title=title)
             written.append(path)

@@ -15,13 +15,22 @@ shape (:meth:`petriflow.agents.bidding.office.Office.truth` is one).
     Accuracy = (1 - ξ / σ) × 100
 
 with ``σ`` the size of the real obstacles and environment limits the team detected and
-``ξ`` the size of the fictitious ones (other robots seen by the laser, noise). Here
-sizes are counts of cells: an occupied map cell within ``tolerance_cells`` (Chebyshev
-distance) of an occupied ground-truth cell counts in ``σ``, any other in ``ξ``
-(:func:`accuracy`). The tolerance absorbs a hit on a wall's face falling in the cell
-beside the wall's rasterised outline. ``coverage``, the fraction of the truth's cells
-with a map cell within the tolerance, says how much of the building was mapped, which
-eq. 10 alone does not.
+``ξ`` the size of the fictitious ones, "obstacles that do not exist in the real
+worlds" (§4.3: the teammates the lasers saw). Sizes are counts of cells. Two readings:
+
+* :func:`fictitious` (the mission's ``accuracy_pct``): by what the beams hit: a cell
+  is real once a return off a wall or a piece of furniture fell in it, fictitious when
+  only returns off teammates did. A wall drawn off its place because a robot was not
+  where its odometry said is a real wall perceived.
+* :func:`accuracy` (``fit_pct``): against the ground truth: an occupied map cell
+  within ``tolerance_cells`` (Chebyshev distance) of an occupied ground-truth cell
+  counts in ``σ``, any other in ``ξ``. The tolerance absorbs a hit on a wall's face
+  falling in the cell beside the wall's rasterised outline; a wall drawn more than a
+  cell off its place counts as fictitious. ``coverage``, the fraction of the truth's
+  cells with a map cell within the tolerance, says how much of the building was mapped,
+  which eq. 10 alone does not.
+
+With exact localisation the two agree but for teammates seen beside a wall.
 
 Examples:
     >>> frame = Grid(origin=(0.0, 0.0), resolution=1.0, shape=(3, 4))
@@ -53,7 +62,7 @@ from petriflow.agents.bidding.errors import BiddingError
 if TYPE_CHECKING:  # pragma: no cover - for annotations only
     from petriflow.agents.bidding.office import Office
 
-__all__ = ["Grid", "GlobalMap", "Accuracy", "dilate", "accuracy", "draw_map"]
+__all__ = ["Grid", "GlobalMap", "Accuracy", "dilate", "accuracy", "fictitious", "draw_map"]
 
 
 @dataclass
@@ -144,20 +153,49 @@ class GlobalMap:
     def __init__(self, frame: Grid) -> None:
         self.frame = Grid(frame.origin, frame.resolution, frame.shape)
         self._occupied = np.zeros(frame.shape, dtype=bool)
+        self._real = np.zeros(frame.shape, dtype=bool)
         self._owner = np.full(frame.shape, -1, dtype=np.int32)
 
-    def add(self, robot_index: int, points: Any) -> int:
+    def add(self, robot_index: int, points: Any, real: Any = None) -> int:
         """Mark the cells of ``points`` (``(k, 2)`` world x, y) as seen by robot
-        ``robot_index`` (from 0); returns how many of them were not marked before."""
+        ``robot_index`` (from 0); returns how many of them were not marked before.
+
+        ``real`` (one bool per point; default all True) says which points are returns
+        off a real obstacle and which off a teammate (a fictitious one): a cell is real
+        once a real return fell in it (:func:`fictitious`)."""
         if isinstance(robot_index, bool) or not isinstance(robot_index, (int, np.integer)) or robot_index < 0:
             raise BiddingError(f"a robot index is an integer >= 0, got {robot_index!r}")
         rows, cols = self.frame.cell_of(points)
-        flat = np.unique(rows * self.frame.shape[1] + cols)
+        cells = rows * self.frame.shape[1] + cols
+        flat = np.unique(cells)
         occupied, owner = self._occupied.reshape(-1), self._owner.reshape(-1)
         new = flat[~occupied[flat]]
         occupied[new] = True
         owner[new] = robot_index
+        if real is None:
+            self._real.reshape(-1)[flat] = True
+        else:
+            labels = np.asarray(real, dtype=bool).reshape(-1)
+            if labels.size != _xy(points).shape[0]:
+                raise BiddingError(f"{labels.size} labels for {_xy(points).shape[0]} points")
+            # cell_of dropped the points outside the frame: keep their labels in step
+            self._real.reshape(-1)[cells[labels[self._inside(points)]]] = True
         return int(new.size)
+
+    def _inside(self, points: Any) -> np.ndarray:
+        """Which points fall inside the frame (the ones :meth:`Grid.cell_of` keeps)."""
+        xy = _xy(points)
+        x0, y0 = self.frame.origin
+        col = np.floor((xy[:, 0] - x0) / self.frame.resolution)
+        row = np.floor((xy[:, 1] - y0) / self.frame.resolution)
+        return (row >= 0) & (row < self.frame.shape[0]) & (col >= 0) & (col < self.frame.shape[1])
+
+    @property
+    def real(self) -> np.ndarray:
+        """Cells some return off a real obstacle fell in (read-only view)."""
+        view = self._real.view()
+        view.flags.writeable = False
+        return view
 
     @property
     def occupied(self) -> np.ndarray:
@@ -211,6 +249,33 @@ def dilate(mask: Any, radius: int) -> np.ndarray:
             moved[shift:] |= src[:-shift]
             moved[:-shift] |= src[shift:]
     return out
+
+
+def fictitious(global_map: GlobalMap) -> Accuracy:
+    """Eq. 10 by what the beams hit: ``sigma`` the map cells some return off a real
+    obstacle or wall fell in, ``xi`` the cells only returns off teammates fell in (the
+    paper's "fictive obstacles ... that do not exist in the real worlds", §4.3);
+    ``percent`` = (1 - xi / sigma) x 100 (clipped at 0; 100.0 for an empty map);
+    ``coverage`` is not known here (nan). A wall drawn off its place because the robot
+    was not where it believed (odometry) is still a real wall perceived.
+
+    Examples:
+        >>> team = GlobalMap(Grid((0.0, 0.0), 1.0, (2, 4)))
+        >>> team.add(0, [(0.5, 0.5), (1.5, 0.5), (2.5, 0.5), (3.5, 1.5)], real=[True, True, True, False])
+        4
+        >>> score = fictitious(team)
+        >>> score.sigma, score.xi, round(score.percent, 2)
+        (3, 1, 66.67)
+    """
+    occupied = np.asarray(global_map.occupied)
+    real = np.asarray(global_map.real) & occupied
+    sigma = int(np.count_nonzero(real))
+    xi = int(np.count_nonzero(occupied & ~real))
+    if sigma == 0:
+        percent = 100.0 if xi == 0 else 0.0
+    else:
+        percent = max(0.0, (1.0 - xi / sigma) * 100.0)
+    return Accuracy(sigma, xi, percent, float("nan"))
 
 
 def accuracy(map_occupied: Any, truth_occupied: Any, tolerance_cells: int = 1) -> Accuracy:

@@ -74,7 +74,8 @@ def world_points(pose: Any, ranges: Any, angles: Any, max_range: float) -> np.nd
 
 
 def scan(world: Any, agent: str, pose: Any, *, max_range: float = RANGE_M, fov_deg: float = FOV_DEG,
-         beams: int = BEAMS, z: float = 0.1, ignore_teammates: bool = False) -> tuple[np.ndarray, np.ndarray]:
+         beams: int = BEAMS, z: float = 0.1, ignore_teammates: bool = False,
+         hits: bool = False) -> tuple[np.ndarray, np.ndarray] | tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One sweep of ``agent``'s laser in a :class:`petriflow.world.World`.
 
     Args:
@@ -85,10 +86,14 @@ def scan(world: Any, agent: str, pose: Any, *, max_range: float = RANGE_M, fov_d
         max_range, fov_deg, beams: the laser (Table 1 by default).
         z: the height of the scanning plane (m).
         ignore_teammates: see through every robot of ``world.agents``.
+        hits: also return what each beam hit.
 
     Returns:
         ``(ranges, angles)``: float arrays of ``beams`` ranges (``max_range`` where a
-        beam hit nothing) and beam angles off the heading (rad), for :func:`world_points`.
+        beam hit nothing) and beam angles off the heading (rad), for :func:`world_points`;
+        with ``hits``, ``(ranges, angles, bodies)``, ``bodies`` the pybullet body each
+        beam hit (-1: nothing). What a beam hit is the simulator's knowledge, not the
+        robot's: it tells eq. 10's real obstacles from the fictitious ones (teammates).
 
     It runs pybullet's collision detection first (no time passes), so the rays see the
     bodies where they are even in a world not stepped since they were placed.
@@ -111,5 +116,44 @@ def scan(world: Any, agent: str, pose: Any, *, max_range: float = RANGE_M, fov_d
     low, high = world.p.getAABB(body, physicsClientId=world.client)
     hx, hy = (high[0] - low[0]) / 2.0, (high[1] - low[1]) / 2.0
     near = math.hypot(hx, hy) + 0.01 if pose is None or math.hypot(x - (low[0] + hx), y - (low[1] + hy)) < 0.05 else 0.0
-    ranges = cast(world, (x, y), theta, angles, max_range, z=z, ignore=ignore, near=near)
-    return np.asarray(ranges, dtype=float), np.asarray(angles, dtype=float)
+    if not hits:
+        ranges = cast(world, (x, y), theta, angles, max_range, z=z, ignore=ignore, near=near)
+        return np.asarray(ranges, dtype=float), np.asarray(angles, dtype=float)
+    ranges, bodies = _cast_hits(world, (x, y), theta, angles, max_range, z=z, ignore=ignore, near=near)
+    return ranges, np.asarray(angles, dtype=float), bodies
+
+
+def _cast_hits(world: Any, origin: tuple[float, float], heading: float, angles: list[float], max_range: float, *,
+               z: float, ignore: set[int], near: float) -> tuple[np.ndarray, np.ndarray]:
+    """Ranges and hit bodies of rays fanned from ``origin`` (one ``rayTestBatch`` per
+    round; a ray that hits an ignored body goes on from just past it)."""
+    p = world.p
+    x, y = origin
+    near = min(max(near, 0.0), max_range)
+    a = heading + np.asarray(angles, dtype=float)
+    c, s = np.cos(a), np.sin(a)
+    n = len(angles)
+    ranges = np.full(n, max_range, dtype=float)
+    bodies = np.full(n, -1, dtype=np.int64)
+    offset = np.full(n, near, dtype=float)
+    pending = list(range(n))
+    for _ in range(64):
+        if not pending:
+            break
+        starts = [(x + offset[i] * c[i], y + offset[i] * s[i], z) for i in pending]
+        ends = [(x + max_range * c[i], y + max_range * s[i], z) for i in pending]
+        again = []
+        for i, hit in zip(pending, p.rayTestBatch(starts, ends, physicsClientId=world.client)):
+            body, fraction = hit[0], hit[2]
+            if body < 0:
+                continue
+            length = max_range - offset[i]
+            if body in ignore:
+                offset[i] += fraction * length + 0.02
+                if offset[i] < max_range:
+                    again.append(i)
+                continue
+            ranges[i] = min(max_range, offset[i] + fraction * length)
+            bodies[i] = body
+        pending = again
+    return ranges, bodies

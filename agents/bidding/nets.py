@@ -39,6 +39,7 @@ from typing import Any
 
 import yaml
 
+from petriflow.agents.bidding.cost import SPEED_M_S
 from petriflow.net import Net
 from petriflow.netbuild import AgentBuilder, Mailbox, NetBuilder
 
@@ -92,37 +93,76 @@ def _sends(b: NetBuilder, agent: AgentBuilder, peers: list[Mailbox]) -> None:
                                 priority=SEND, inputs=["work"], outputs=["work"]), box)
 
 
+def _numbers(text: str, what: str) -> list[float]:
+    try:
+        return [float(v) for v in text.split()]
+    except ValueError:
+        raise ValueError(f"{what} is numbers separated by spaces, got {text!r}") from None
+
+
+def _lists(text: str) -> list[list[int]]:
+    """Zone lists written as text, a robot's after another's behind a slash.
+
+    Examples:
+        >>> _lists("2 8 1 6 5 / 7 3 4")
+        [[2, 8, 1, 6, 5], [7, 3, 4]]
+    """
+    try:
+        return [[int(z) for z in part.split()] for part in text.split("/")]
+    except ValueError:
+        raise ValueError(f"lists is zone numbers, one robot's after another's behind a '/', got {text!r}") from None
+
+
 def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[int]] | None = None,
-          zones: list[list[float]] | None = None, speed: float = 0.5, scan_period: float = 1.0,
-          filter_teammates: bool = False, spin: bool = True, visit: str = "centre", wait: float = 1.0,
-          **ignored: Any) -> Net:
+          zones: list[list[float]] | None = None, speed: float = SPEED_M_S, scan_period: float = 1.0,
+          filter_teammates: bool = False, spin: bool = False, visit: str = "centre", wait: float = 1.0,
+          localization: str = "odom", odom_error: list[float] | None = None, until: str = "mapped",
+          idle: str = "scan", **ignored: Any) -> Net:
     """The mission's net (see the module).
 
     Args:
         robots: robot agents in the team (1..200).
         deployment: ``autonomous`` (bidding) or ``random`` (the operator's lists).
-        lists: random deployment: each robot's zone numbers (1-based, visiting order);
-            default: drawn with the run's seed.
+        lists: random deployment: each robot's zone numbers (1-based, visiting order),
+            as lists or as text (``"2 8 1 6 5 / 7 3 4"``); default: drawn with the run's
+            seed.
         zones: zone positions; default: the world's office (``meta.office``).
-        speed: the robots' speed (m/s): their cruise speed and eq. 6's P_ij.
+        speed: the robots' speed (m/s): their cruise speed and eq. 6's P_ij (default
+            0.4, Stage 3.2's position controller).
         scan_period: seconds between laser scans.
         filter_teammates: drop laser returns on teammates.
-        spin: turn a full circle at each waypoint of a zone.
+        spin: turn a full circle at each waypoint of a zone (the paper describes none).
         visit: ``centre`` (drive to the zone's position, as the paper) or ``room``
             (through waypoints over the zone's room).
         wait: longest idle wait of an agent (s).
+        localization: ``odom`` (Stage's odometry error model, the robots' belief drifts)
+            or ``gps`` (the true pose).
+        odom_error: Stage's ``odom_error`` [x, y, heading] (default [0.03, 0.03, 0.05]),
+            or as text (``"0.05 0.05 0.1"``).
+        until: the HMIA ends the mission when every zone is ``mapped`` (in a laser's
+            sight, or reached) or only when every zone is ``reached``.
+        idle: an RA whose zones are done goes on mapping until END (``scan``) or
+            stops (``stop``).
         ignored: other sweep parameters (they go elsewhere).
     """
+    if isinstance(lists, str):  # "2 8 1 6 5 / 7 3 4": a sweep report prints text, not nested lists
+        lists = _lists(lists)
+    if isinstance(odom_error, str):  # "0.03 0.03 0.05"
+        odom_error = _numbers(odom_error, "odom_error")
+    if localization not in ("odom", "gps"):
+        raise ValueError(f"localization is odom or gps, not {localization!r}")
+    if until not in ("mapped", "reached"):
+        raise ValueError(f"until is mapped or reached, not {until!r}")
     if deployment not in ("autonomous", "random"):
         raise ValueError(f"deployment is autonomous or random, not {deployment!r}")
     if not 1 <= robots <= 200:
         raise ValueError(f"robots must be from 1 to 200, got {robots}")
     team = [f"robot{i + 1}" for i in range(robots)]
     mission: dict[str, Any] = {"hmia": "hmia", "robots": team, "deployment": deployment}
-    if lists is not None:
-        mission["lists"] = lists
+    if lists is not None:  # plain lists (a sweep file's values may be its reader's types)
+        mission["lists"] = [[int(z) for z in zs] for zs in lists]
     if zones is not None:
-        mission["zones"] = zones
+        mission["zones"] = [[float(v) for v in z] for z in zones]
     b = NetBuilder(f"bidding-{deployment}-{robots}", label=f"seed 004 collaborative mapping: {robots}"
                    f" robot{'s' if robots > 1 else ''}, {deployment} deployment")
     operator, _ = _agent(b, "operator", "the human operator", "bidding.operator", listens=False)
@@ -134,18 +174,23 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
     _sends(b, operator, [boxes["hmia"]])
     operator.transition("finish", label="mission sent", guard="bidding.finished", priority=FINISH,
                         inputs=["work"], outputs=["done"])
-    _loop(b, hmia, ("bidding.interface", "the interface agent", {}), [
+    _loop(b, hmia, ("bidding.interface", "the interface agent", {} if until == "mapped" else {"until": until}), [
         ("team", "bidding.team", "INITIALIZE the team", {}),
         ("inform", "bidding.inform", "random deployment: INFORM zone lists", {}),
         ("cfp", "bidding.cfp", "CFP: offer the next zone", {}),
         ("map", "bidding.map", "MAP: start mapping", {}),
-        ("end", "bidding.end", "END: every zone mapped", {}),
+        ("end", "bidding.end", "END: the world mapped", {}),
     ], [boxes[name] for name in team], wait)
     explore = {"speed": speed, "scan_period": scan_period, "filter_teammates": filter_teammates, "spin": spin,
                "visit": visit}
+    if idle != "scan":
+        explore["idle"] = idle
+    ready: dict[str, Any] = {} if localization == "odom" else {"localization": localization}
+    if odom_error is not None:
+        ready["odom_error"] = [float(v) for v in odom_error]
     for rank, (ra, _) in enumerate(ras):
         _loop(b, ra, ("bidding.robot", "robot agent", {"rank": rank}), [
-            ("ready", "bidding.ready", "INITIALIZED: laser and pose", {}),
+            ("ready", "bidding.ready", "INITIALIZED: laser and pose", dict(ready)),
             ("bid", "bidding.bid", "PROPOSE: eq. 6 cost", {"speed": speed}),
             ("decide", "bidding.decide", "best proposal; ALLOCATED if won", {}),
             ("explore", "bidding.explore", "map the zones: MAPPED", explore),

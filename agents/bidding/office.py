@@ -345,6 +345,17 @@ class Plan:
         self._navigators: dict[float, Any] = {}
         self._seen_at: float | None = None
         self._cells: dict[tuple[int, int], list[str]] = {}
+        self._running_at: float | None = None
+        self._running: frozenset[str] = frozenset()
+
+    def running(self, live: Any, now: float) -> frozenset[str]:
+        """The run's agents running at the time step ``now`` (``live``: the run's
+        ``core.liveness``), asked once per step for the whole team, not once per robot
+        asking: faults happen at the start of a step, before its firings."""
+        if self._running_at != now:
+            self._running_at = now
+            self._running = frozenset(live.running())
+        return self._running
 
     def near(self, world: Any, now: float, x: float, y: float, radius: float) -> set[str]:
         """The agents whose robots stood within ``radius`` m of ``(x, y)`` (a box test:

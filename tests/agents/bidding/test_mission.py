@@ -152,7 +152,7 @@ def test_transitions_fire_one_at_a_time():
         step("bid")
         propose = robot.outbox["robot2"][0]
         assert propose.kind == "PROPOSE" and propose.body["cost"] == pytest.approx(((6 - 0.5) ** 2 + 3.5 ** 2) ** 0.5
-                                                                                  / 0.5 / 3)
+                                                                                  / 0.4 / 3)
         assert not robot.bids_in()  # robot2's proposal is missing
         # robot2 bids lower: robot1 loses and sends no ALLOCATED
         receive(Message("PROPOSE", "robot2", "robot1", zone=5, body={"cost": 1.0, "rank": 1}))
@@ -171,7 +171,7 @@ def test_a_step_the_state_does_not_call_for_cannot_fire():
 
 
 def test_two_robot_mission_maps_every_zone_with_the_central_auctions_result(tmp_path):
-    outcome = _run(tmp_path, 2)
+    outcome = _run(tmp_path, 2, until="reached", localization="gps")
     assert outcome.result.reason == "final"
     office = paper_office()
     expected = autonomous([s[:2] for s in office.starts[:2]], office.zones)
@@ -191,7 +191,7 @@ def test_two_robot_mission_maps_every_zone_with_the_central_auctions_result(tmp_
 
 
 def test_a_broken_robots_zones_are_reauctioned_and_the_map_completes(tmp_path):
-    outcome = _run(tmp_path, 3, faults=[{"kill": "robot1", "at": 40}])
+    outcome = _run(tmp_path, 3, faults=[{"kill": "robot1", "at": 40}], until="reached")
     broken = _custom(outcome, "bidding.breakdown")
     assert [e.data["data"]["robot"] for e in broken] == ["robot1"] and broken[0].data["data"]["reoffered"]
     lost = set(broken[0].data["data"]["reoffered"])
@@ -204,7 +204,7 @@ def test_a_broken_robots_zones_are_reauctioned_and_the_map_completes(tmp_path):
 
 def test_random_deployment_follows_the_operators_lists(tmp_path):
     lists = [[2, 8, 1, 6, 5], [7, 3, 4]]  # Table 3, random deployment
-    outcome = _run(tmp_path, 2, "random", lists=lists)
+    outcome = _run(tmp_path, 2, "random", lists=lists, until="reached")
     assert outcome.result.reason == "final"
     done = {}
     for e in _custom(outcome, "bidding.zone_done"):
