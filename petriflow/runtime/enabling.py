@@ -118,14 +118,15 @@ class EnabledSet:
                              f" {reason_of(exc)}") from exc
 
     def refresh(self) -> None:
-        """Check the dirty transitions again (:meth:`can_fire`, with its common case,
-        a running transition or one short of tokens, decided inline)."""
+        """Check the dirty transitions again (:meth:`can_fire`, with its common cases,
+        a running transition, a state guard whose kept answer is no, or one short of
+        tokens, decided inline)."""
         dirty = self.dirty
         if dirty:
-            agenda, can_fire, running = self.agenda, self.can_fire, self.running
+            agenda, can_fire, running, answer = self.agenda, self.can_fire, self.running, self.answer
             counts, row, pre = self.tokens.counts, self.index.row, self.index.compiled.pre
             for t in dirty:
-                if t in running:
+                if t in running or answer[t] is False:  # running, or a state guard's kept "no"
                     agenda.discard(t)
                     continue
                 for p, w in pre[row[t]]:
