@@ -178,3 +178,19 @@ def test_the_inspection_example_runs_on_its_shipped_site():
     assert outcome.result.error is None and outcome.result.reason == "until"
     ended = {e.transition for e in outcome.events if e.kind == "end" and e.data.get("outcome", "ok") == "ok"}
     assert {"capture", "segment", "dispatch"} <= ended
+
+
+def test_a_picture_that_cannot_be_written_is_one_error_and_the_trace_is_kept(tmp_path, monkeypatch):
+    import petriflow.picture
+    from petriflow.errors import NetFormatError
+    from petriflow.runtime.session import run_files
+
+    def refuse(world, paths, out, title=""):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(petriflow.picture, "draw_run", refuse)
+    trace = tmp_path / "run.jsonl"
+    with pytest.raises(NetFormatError, match="cannot write the picture: Permission denied"):
+        run_files(NETS / "passage" / "passage.yaml", picture=tmp_path / "p.png", trace=trace)
+    assert trace.stat().st_size > 0 and not (tmp_path / "p.png").exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["run.jsonl"]

@@ -63,6 +63,9 @@ class RunExtras:
                 draw_run(scheduler.world, self.track.paths, partial,
                          title=f"{outcome.net.id}: {outcome.result.reason} at t = {outcome.result.time:g} s")
                 os.replace(partial, self.picture)
+            except OSError as exc:
+                raise NetFormatError(f"cannot write the picture: {getattr(exc, 'strerror', None) or exc}",
+                                     path=str(self.picture)) from None
             finally:
                 if partial.exists():
                     partial.unlink()
