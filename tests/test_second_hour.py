@@ -194,3 +194,26 @@ def test_a_picture_that_cannot_be_written_is_one_error_and_the_trace_is_kept(tmp
         run_files(NETS / "passage" / "passage.yaml", picture=tmp_path / "p.png", trace=trace)
     assert trace.stat().st_size > 0 and not (tmp_path / "p.png").exists()
     assert [p.name for p in tmp_path.iterdir()] == ["run.jsonl"]
+
+
+def test_an_output_on_a_file_system_that_refuses_files_is_refused_before_the_run(tmp_path, monkeypatch):
+    """Permission bits do not tell everything (the superuser, read-only mounts): the
+    check tries to make a file where each output goes, before anything runs."""
+    import tempfile
+
+    from petriflow.errors import NetFormatError
+    from petriflow.runtime.session import run_files
+
+    made = tempfile.NamedTemporaryFile
+
+    def refusing(*args, dir=None, **kwargs):
+        if dir is not None and str(dir).startswith(str(tmp_path / "ro")):
+            raise OSError(30, "Read-only file system")
+        return made(*args, dir=dir, **kwargs)
+
+    (tmp_path / "ro").mkdir()
+    monkeypatch.setattr(tempfile, "NamedTemporaryFile", refusing)
+    with pytest.raises(NetFormatError, match="--trace: cannot write into"):
+        run_files(NETS / "passage" / "passage.yaml", trace=tmp_path / "ro" / "t.jsonl",
+                  db=tmp_path / "run.sqlite")
+    assert not (tmp_path / "run.sqlite").exists()

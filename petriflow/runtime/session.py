@@ -278,8 +278,20 @@ def _check_outputs(outputs: dict[str, str | Path | None], read: list[Path | str 
         folder = where.parent
         while not folder.exists() and folder != folder.parent:
             folder = folder.parent
-        if not os.access(folder, os.W_OK | os.X_OK):
+        if not os.access(folder, os.W_OK | os.X_OK) or not _can_create_in(folder):
             raise NetFormatError(f"{option}: cannot write into {folder}", path=str(path))
+
+
+def _can_create_in(folder: Path) -> bool:
+    """Whether a file can be made in ``folder`` (tried: permission bits do not tell for the
+    superuser, nor on read-only or pseudo file systems such as /proc)."""
+    import tempfile
+
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".petriflow-", suffix=".probe"):
+            return True
+    except OSError:
+        return False
 
 
 def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: Path | None,
