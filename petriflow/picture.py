@@ -2,47 +2,19 @@
 
 ``petriflow run NET --picture out.png`` (or ``run_files(..., picture=...)``) draws it at
 the end of the run, from the world as it is then: every fixed body (walls, furniture,
-posts) as its outline from pybullet (a box as its rotated rectangle, anything else as
-its bounding box), every agent's path as a line from a circle (start) to a triangle
+posts) as its outline (:func:`petriflow.runtime.poses.outlines`, what the run viewer
+draws too), every agent's path as a line from a circle (start) to a triangle
 (where it ended), named. The ground plane is left out.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
+from petriflow.runtime.poses import outlines as fixed_outlines
+
 __all__ = ["draw_run"]
-
-
-def _outlines(world: Any) -> list[list[tuple[float, float]]]:
-    """The fixed bodies' outlines in the ground plane (robots and the plane left out)."""
-    p, client = world.p, world.client
-    robots = set(world.agents.values())
-    shapes = []
-    for name, body in world.bodies.items():
-        if name in robots or name == "plane":
-            continue
-        box = None
-        data = p.getCollisionShapeData(body, -1, physicsClientId=client)
-        if p.getNumJoints(body, physicsClientId=client) == 0 and len(data) == 1 and data[0][2] == p.GEOM_BOX:
-            box = data[0][3]  # full extents
-        if box is not None:
-            (x, y, _), orientation = p.getBasePositionAndOrientation(body, physicsClientId=client)
-            yaw = p.getEulerFromQuaternion(orientation)[2]
-            c, s = math.cos(yaw), math.sin(yaw)
-            hx, hy = box[0] / 2, box[1] / 2
-            shapes.append([(x + c * dx - s * dy, y + s * dx + c * dy)
-                           for dx, dy in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))])
-        else:
-            low, high = p.getAABB(body, -1, physicsClientId=client)
-            for link in range(p.getNumJoints(body, physicsClientId=client)):
-                a, b = p.getAABB(body, link, physicsClientId=client)
-                low = [min(u, v) for u, v in zip(low, a)]
-                high = [max(u, v) for u, v in zip(high, b)]
-            shapes.append([(low[0], low[1]), (high[0], low[1]), (high[0], high[1]), (low[0], high[1])])
-    return shapes
 
 
 def draw_run(world: Any, paths: dict[str, list[tuple[float, float, float]]], out: str | Path,
@@ -55,7 +27,7 @@ def draw_run(world: Any, paths: dict[str, list[tuple[float, float, float]]], out
     import matplotlib.pyplot as plt
     from matplotlib.patches import Polygon
 
-    outlines = _outlines(world)
+    outlines = [shape["points"] for shape in fixed_outlines(world)]
     xs = [x for shape in outlines for x, _ in shape] + [x for path in paths.values() for _, x, _ in path]
     ys = [y for shape in outlines for _, y in shape] + [y for path in paths.values() for _, _, y in path]
     if not xs:
