@@ -52,11 +52,9 @@ class Store:
         self.path = None if path is None else Path(path)
         self.db: sqlite3.Connection | None = None
 
-    def check(self, meta: dict[str, str], resume: bool) -> None:
-        """Refuse early, creating nothing: ``path`` exists without ``resume``, is
-        missing with it, or holds another sweep (see :meth:`begin`)."""
-        if self.path is None:
-            return
+    def _refuse(self, resume: bool) -> bool:
+        """Whether the database exists; refuses one that exists without ``resume``, is
+        missing with it, or is a folder."""
         where = str(self.path)
         exists = self.path.exists()
         if exists and not resume:
@@ -65,7 +63,14 @@ class Store:
             raise StoreError(f"{where}: no such results database to resume")
         if self.path.is_dir():
             raise NetFormatError("--db names a folder, not a file", path=where)
-        if exists:
+        return exists
+
+    def check(self, meta: dict[str, str], resume: bool) -> None:
+        """Refuse early, creating nothing: ``path`` exists without ``resume``, is
+        missing with it, or holds another sweep (see :meth:`begin`)."""
+        if self.path is None:
+            return
+        if self._refuse(resume):
             self.begin(meta, resume=True)
             self.close()
 
@@ -84,14 +89,7 @@ class Store:
             self.db.executescript(_SCHEMA)
             self._meta({"format": FORMAT, **meta})
             return
-        where = str(self.path)
-        exists = self.path.exists()
-        if exists and not resume:
-            raise StoreError(f"{where}: already exists; use --resume to finish that sweep, or another --db")
-        if not exists and resume:
-            raise StoreError(f"{where}: no such results database to resume")
-        if self.path.is_dir():
-            raise NetFormatError("--db names a folder, not a file", path=where)
+        where, exists = str(self.path), self._refuse(resume)
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.db = sqlite3.connect(where, timeout=5.0, isolation_level=None)
