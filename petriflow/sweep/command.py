@@ -76,6 +76,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         sweep = sweep.with_seeds(args.trials)
     from petriflow.runtime.session import _check_outputs
 
+    if _job_working_dir() is not None:
+        for flag, value in (("--db", args.db), ("--csv", args.csv), ("--plot", args.plot)):
+            if value is not None and not Path(value).is_absolute():
+                raise PetriflowError(f"{flag} {value}: under `ray job submit --working-dir` a relative path"
+                                     " lands in Ray's temporary copy of the working directory, which Ray may"
+                                     f" remove; give an absolute path on the head node ({flag} /data/"
+                                     f"{Path(value).name})")
     _check_outputs({"--db": args.db, "--csv": args.csv, "--plot": args.plot},
                    [Path(sweep.path)] + ([Path(sweep.run)] if sweep.run else []))
     if not args.progress_every > 0:
@@ -128,6 +135,18 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             if path:
                 print(f"  wrote {path}")
     return 1 if result.failures else 0
+
+
+def _job_working_dir() -> str | None:
+    """The working directory (a package URI) of the Ray job this process is the
+    entrypoint of (``ray job submit --working-dir``: the current folder is then Ray's
+    unpacked copy of it), else ``None``."""
+    text = os.environ.get("RAY_JOB_CONFIG_JSON_ENV_VAR")
+    try:
+        runtime_env = json.loads(text).get("runtime_env") if text else None
+    except (ValueError, AttributeError):
+        return None
+    return (runtime_env.get("working_dir") or None) if isinstance(runtime_env, dict) else None
 
 
 @contextlib.contextmanager

@@ -6,7 +6,9 @@ there only the loopback interface exists, so every node registers 127.0.0.1 and 
 server is reachable from outside; when the cluster is closed, the namespace's first
 process ends and the kernel ends every process left in it (nothing is stopped by
 name, so another Ray on the machine is never touched). The cluster uses token
-authentication, with a token of its own passed to every process in the environment.
+authentication, with a token of its own passed to every process in the environment,
+and finds ``ray`` and ``petriflow`` on ``PATH`` (this Python's ``bin`` folder first),
+as in a shell with the environment activated.
 """
 
 from __future__ import annotations
@@ -62,6 +64,7 @@ class Cluster:
         self.bin = Path(sys.executable).parent
         self.env = dict(os.environ, RAY_AUTH_MODE="token", RAY_AUTH_TOKEN=secrets.token_hex(16),
                         RAY_USAGE_STATS_ENABLED="0", **FAST_HEALTH)
+        self.env["PATH"] = f"{self.bin}{os.pathsep}{self.env.get('PATH', '')}"
         self.env.pop("RAY_ADDRESS", None)
         self.holder = subprocess.Popen(
             ["unshare", "-rnpf", "--mount-proc", "--kill-child", "sh", "-c", "ip link set lo up && exec sleep 1800"],
@@ -81,15 +84,19 @@ class Cluster:
         self.nodes: list[subprocess.Popen] = []
         self.address = "127.0.0.1:6379"
 
-    def command(self, argv: list[str]) -> list[str]:
-        return ["nsenter", "-t", str(self.target), "-U", "-n", "-p", "-m", "--preserve-credentials", *argv]
+    def command(self, argv: list[str], cwd: str | Path | None = None) -> list[str]:
+        """``argv`` run in the namespaces (in ``cwd``: entering the mount namespace
+        would otherwise leave it in ``/``)."""
+        where = [f"--wd={cwd}"] if cwd is not None else []
+        return ["nsenter", "-t", str(self.target), "-U", "-n", "-p", "-m", "--preserve-credentials", *where, *argv]
 
     def run(self, argv: list[str], **options) -> subprocess.CompletedProcess:
-        return subprocess.run(self.command(argv), env=options.pop("env", self.env), **options)
+        return subprocess.run(self.command(argv, options.pop("cwd", None)), env=options.pop("env", self.env),
+                              **options)
 
     def popen(self, argv: list[str], **options) -> subprocess.Popen:
-        return subprocess.Popen(self.command(argv), env=options.pop("env", self.env), start_new_session=True,
-                                **options)
+        return subprocess.Popen(self.command(argv, options.pop("cwd", None)), env=options.pop("env", self.env),
+                                start_new_session=True, **options)
 
     def _node(self, argv: list[str], log: str) -> subprocess.Popen:
         handle = open(self.folder / log, "w")
@@ -97,12 +104,37 @@ class Cluster:
         self.nodes.append(node)
         return node
 
-    def start_head(self, cpus: int = 1) -> subprocess.Popen:
+    def start_head(self, cpus: int = 1, dashboard: bool = False) -> subprocess.Popen:
+        """The head node; with ``dashboard``, Ray's dashboard and job server too (it needs
+        ``ray[default]``), at :attr:`jobs` (``ray job submit --address ...``)."""
+        flags = (["--include-dashboard=true", "--dashboard-host", "127.0.0.1", "--dashboard-port", "8265"]
+                 if dashboard else ["--include-dashboard=false"])
         head = self._node([str(self.bin / "ray"), "start", "--head", "--block", "--port", "6379",
-                           "--num-cpus", str(cpus), "--node-ip-address", "127.0.0.1",
-                           "--include-dashboard=false", "--disable-usage-stats"], "head.log")
+                           "--num-cpus", str(cpus), "--node-ip-address", "127.0.0.1", *flags,
+                           "--disable-usage-stats"], "head.log")
         self.started(head, "head.log")
+        if dashboard:
+            self.answers(self.jobs)
         return head
+
+    #: The job server's address, on a head started with ``dashboard=True``.
+    jobs = "http://127.0.0.1:8265"
+
+    def answers(self, address: str, timeout: float = 120) -> None:
+        """Wait until the job server at ``address`` lists jobs (``ray job list``)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                done = self.run([str(self.bin / "ray"), "job", "list", "--address", address], capture_output=True,
+                                text=True, timeout=60)
+            except subprocess.TimeoutExpired:
+                done = None
+            if done is not None and done.returncode == 0:
+                return
+            if time.monotonic() > deadline:
+                why = done.stderr[-600:] if done is not None else "ray job list did not answer"
+                raise RuntimeError(f"the job server at {address} does not answer: {why}")
+            time.sleep(0.5)
 
     def add_worker(self, cpus: int = 1, bin_folder: Path | None = None, log: str = "worker.log",
                    env: dict[str, str] | None = None) -> subprocess.Popen:

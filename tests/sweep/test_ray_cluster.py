@@ -1,6 +1,7 @@
 """Sweeps on a real Ray cluster: a head node and a worker node started with ``ray start``,
 token authentication, the driver run as a user runs it (``petriflow sweep --backend
-ray --ray-address 127.0.0.1:6379``), a node killed mid-sweep.
+ray --ray-address 127.0.0.1:6379``, or on the head through ``ray job submit``), a node
+killed mid-sweep.
 
 The cluster lives in namespaces of its own (``tests/sweep/raycluster.py``); these tests
 are ``slow`` (CI runs them) and skip where namespaces or Ray are missing.
@@ -9,6 +10,8 @@ are ``slow`` (CI runs them) and skip where namespaces or Ray are missing.
 from __future__ import annotations
 
 import json
+import re
+import shutil
 import sqlite3
 import subprocess
 import sys
@@ -233,3 +236,56 @@ def test_a_local_ray_instance_started_for_the_sweep_gives_the_local_pools_rows(f
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["rows"] == json.loads(json.dumps(local.rows))
     assert recorded(db) == recorded(clean)
+
+
+def test_a_sweep_submitted_as_a_ray_job_runs_on_the_head_and_outlives_its_submitter(folder, tmp_path):
+    """The recipe of docs/sweep-format.md: ``ray job submit --address http://HEAD:8265
+    --working-dir . -- petriflow sweep SPEC.yaml --backend ray --db /ABSOLUTE/PATH``
+    from the folder of the sweep's files; the submitting command is killed mid-sweep
+    and the job goes on. A relative --db is refused (it would land in Ray's copy of
+    the working directory)."""
+    pytest.importorskip("aiohttp", reason="ray job submit and the job server need ray[default]")
+    project = tmp_path / "project"
+    project.mkdir()
+    for name in ("odd.yaml", "run.yaml", "sweep_test_actions.py"):
+        shutil.copy(folder / name, project / name)
+    spec = sleepy_sweep(folder, project, trials=4, wall=0.5)
+    spec.write_text(spec.read_text().replace(f"net: {folder}/odd.yaml", "net: odd.yaml"))
+    # the local pool's rows, from a process of its own (this one may have imported the
+    # actions module from the session's folder, and a module name is imported once)
+    clean = tmp_path / "clean.sqlite"
+    local = subprocess.run([sys.executable, "-m", "petriflow.cli", "sweep", str(spec), "--workers", "2", "--db",
+                            str(clean), "--quiet"], capture_output=True, text=True, timeout=300)
+    assert local.returncode == 0, local.stderr
+    made = Cluster(tmp_path / "jobs-cluster")
+
+    def submit(db: str) -> list[str]:  # `ray` and `petriflow`: found on PATH, in the environment's bin folder
+        return ["ray", "job", "submit", "--address", made.jobs, "--working-dir", ".", "--",
+                "petriflow", "sweep", spec.name, "--backend", "ray", "--db", db]
+
+    try:
+        made.start_head(cpus=1, dashboard=True)
+        made.add_worker(cpus=1)
+        refused = made.run(submit("results.sqlite"), cwd=project, capture_output=True, text=True, timeout=300)
+        db = tmp_path / "results.sqlite"
+        log = tmp_path / "submit.log"
+        with open(log, "w") as handle:
+            submitter = made.popen(submit(str(db)), cwd=project, stdout=handle, stderr=subprocess.STDOUT)
+        deadline = time.monotonic() + 240
+        while count(db) < 1 and submitter.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert submitter.poll() is None, log.read_text()
+        Cluster.kill(submitter)  # the submitting command (its machine) goes away mid-sweep
+        assert count(db) < 8
+        job = re.search(r"raysubmit_\w+", log.read_text()).group(0)
+        made.run(["ray", "job", "logs", "--address", made.jobs, "--follow", job], capture_output=True, timeout=300)
+        status = made.run(["ray", "job", "status", "--address", made.jobs, job], capture_output=True, text=True,
+                          timeout=120)
+    finally:
+        made.close()
+    assert refused.returncode == 1
+    assert "--db results.sqlite: under `ray job submit --working-dir` a relative path" in refused.stdout
+    assert f"Job '{job}' succeeded" in status.stdout, status.stdout + status.stderr
+    assert recorded(db) == recorded(clean)
+    assert sorted(p.name for p in project.iterdir()) == ["cluster.yaml", "odd.yaml", "run.yaml",
+                                                         "sweep_test_actions.py"]

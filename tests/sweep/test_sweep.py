@@ -170,6 +170,27 @@ def test_results_database_refuses_reuse_and_other_sweeps(folder, tmp_path, capsy
         assert connection.execute("SELECT COUNT(*), COUNT(DISTINCT params || seed) FROM trials").fetchone() == (6, 6)
 
 
+def test_as_a_ray_jobs_entrypoint_outputs_need_absolute_paths(folder, tmp_path, capsys, monkeypatch):
+    """Under ``ray job submit --working-dir``, the current folder is Ray's temporary
+    copy of the working directory: a relative --db, --csv or --plot is refused, one
+    line, before any trial runs; absolute ones are written."""
+    path = random_sweep(folder, tmp_path, trials=1)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("RAY_JOB_CONFIG_JSON_ENV_VAR", json.dumps(
+        {"runtime_env": {"working_dir": "gcs://_ray_pkg_0123456789abcdef.zip"}, "metadata": {}}))
+    for flag, name in (("--db", "results.sqlite"), ("--csv", "r.csv"), ("--plot", "r.png")):
+        assert main(["sweep", str(path), flag, name, "--workers", "1"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.splitlines() == [err]
+        assert f"{flag} {name}: under `ray job submit --working-dir`" in err and f"{flag} /data/{name}" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+    assert main(["sweep", str(path), "--db", str(tmp_path / "results.sqlite"), "--workers", "1"]) == 0
+    assert (tmp_path / "results.sqlite").is_file()
+    monkeypatch.setenv("RAY_JOB_CONFIG_JSON_ENV_VAR", json.dumps({"runtime_env": {}, "metadata": {}}))
+    assert main(["sweep", str(path), "--db", "again.sqlite", "--workers", "1"]) == 0  # no working_dir: as ever
+    assert (tmp_path / "again.sqlite").is_file()
+
+
 @pytest.mark.parametrize("argv, fragment", [
     (["--workers", "0"], "--workers must be at least 1"),
     (["--trials", "0"], "--trials must be from 1"),
