@@ -124,20 +124,30 @@ class EnabledSet:
         dirty = self.dirty
         if dirty:
             agenda, can_fire, running, answer = self.agenda, self.can_fire, self.running, self.answer
-            counts, row, pre = self.tokens.counts, self.index.row, self.index.compiled.pre
+            counts, row, pre, guard = self.tokens.counts, self.index.row, self.index.compiled.pre, self.index.guard
+            agent, alive = self.index.agent, self.alive
+            add, discard, on = agenda.add, agenda.discard, agenda.on
             for t in dirty:
                 if t in running or answer[t] is False:  # running, or a state guard's kept "no"
-                    agenda.discard(t)
+                    if on[t]:
+                        discard(t)
                     continue
                 for p, w in pre[row[t]]:
                     if counts[p] < w:
-                        agenda.discard(t)
+                        if on[t]:
+                            discard(t)
                         break
                 else:
-                    if can_fire(t):
-                        agenda.add(t)
+                    if guard[t] is None:  # no guard: its agent's liveness decides
+                        a = agent[t]
+                        if a is None or alive.get(a, True):
+                            add(t)
+                        else:
+                            discard(t)
+                    elif can_fire(t):
+                        add(t)
                     else:
-                        agenda.discard(t)
+                        discard(t)
             dirty.clear()
 
     def pick(self, draw: Callable[[], float]) -> int | None:

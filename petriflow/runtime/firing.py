@@ -74,14 +74,19 @@ class Firer:
         self._declared = [getattr(cls, "resources", None) or None for cls in index.action_class]
         compiled, consumers = index.compiled, index.consumers
         # per transition, what a firing marks for re-checking: the consumers of the places
-        # it takes from or empties (itself among them; the tuples are shared, not copied)
-        self._touched = [tuple(consumers[p] for p in (*(p for p, _ in compiled.pre[index.row[t]]),
-                                                      *compiled.reset[index.row[t]])) + ((t,),)
-                         for t in range(len(index.ids))]
+        # it takes from or empties (the tuples are shared, not copied), less a place only
+        # it consumes from (the transition itself is settled once its action starts)
+        self._touched = [tuple(group for group in dict.fromkeys(
+            consumers[p] for p in (*(p for p, _ in compiled.pre[index.row[t]]), *compiled.reset[index.row[t]]))
+            if group != (t,)) for t in range(len(index.ids))]
+        self._running = self.runner.running
+        self._agenda = enabled.agenda
         self._acts = [self.agents.any_readers(index.agent[t]) for t in range(len(index.ids))]
         # per compiled row, the consumers of its non-channel output places
         self._fed = [tuple(consumers[p] for p, _ in compiled.post[r] if not index.channel[p])
                      for r in range(len(compiled.transitions))]
+        # per compiled row, whether it puts tokens into channel places (messages)
+        self._sends = [any(index.channel[p] for p, _ in compiled.post[r]) for r in range(len(compiled.transitions))]
         self.count = 0
         self.progress = 0
         self.limit: int | None = None
@@ -94,6 +99,7 @@ class Firer:
         """Fire until nothing more can fire at this instant (or the firing limit)."""
         limit, draw, enabled = self.limit, self._rng.random, self.enabled
         agenda, dirty, refresh, fire = enabled.agenda, enabled.dirty, enabled.refresh, self.fire
+        watch = limits.FIRINGS_PER_INSTANT - 64
         while limit is None or self.count < limit:
             if dirty:
                 refresh()
@@ -102,7 +108,7 @@ class Firer:
             t = agenda.pick(draw)
             fire(t)
             self.now_count += 1
-            if self.now_count > limits.FIRINGS_PER_INSTANT - 64:
+            if self.now_count > watch:
                 self._zeno(t)
 
     def new_instant(self) -> None:
@@ -150,8 +156,12 @@ class Firer:
             self._cancel_region(t, number, withdrawn)
         now = kernel.tick * kernel.dt
         ctx = ActionContext(tid, agent, index.params[t], inputs, self.world, self._seed_prefix + str(number),
-                            now, now, _run=self, _declared=self._declared[t])
+                            now, now, None, False, None, "", None, None, self, self._declared[t])
         self.runner.start(t, number, ctx)
+        if t in self._running:  # running: it cannot fire again before its action ends (which marks it)
+            self._agenda.discard(t)
+        else:  # ended at once: check it again
+            dirty.add(t)
 
     def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:
         cancelled = self.runner.cancel(list(self.index.cancels[t]))
@@ -170,7 +180,7 @@ class Firer:
         self.progress = self.kernel.tick
         if self._acts[t]:
             self.agents.acted(ctx.agent)
-        row = self.index.route[t][outcome]
+        row = self.index.ok_row[t] if outcome is Outcome.OK else self.index.route[t][outcome]
         if row is None and outcome is not Outcome.CANCELLED and outcome is not Outcome.OK:
             reason = ctx.reason or outcome.value
             recorder.emit(_END, tid, ctx.agent, firing=number, outcome=outcome.value, produced={}, reason=reason)
@@ -207,10 +217,10 @@ class Firer:
         dirty = self.enabled.dirty
         for group in self._fed[row]:
             dirty.update(group)
-        compiled = self.index.compiled
-        places = compiled.places
         sent: list[tuple[str, Any]] = []
-        for p, w in compiled.post[row]:
-            if channel[p]:
-                sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
+        if self._sends[row]:
+            places = self.index.compiled.places
+            for p, w in self.index.compiled.post[row]:
+                if channel[p]:
+                    sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
         return produced, sent

@@ -49,6 +49,7 @@ class RunIndex:
         of_agent: ``{agent: [transition indices]}``.
         row: per transition, its compiled row (the plain firing).
         route: per transition, ``{outcome: compiled row or None}``.
+        ok_row: per transition, its ``ok`` outcome's row (``route[t][Outcome.OK]``).
         consumers: per place index, the transitions that consume from it.
         channel: per place index, whether it is a channel place.
         cancels: per transition, the transitions of its cancellation region.
@@ -73,6 +74,7 @@ class RunIndex:
                 self.of_agent.setdefault(agent, []).append(t)
         self.row = [compiled.transition_index[t] for t in ids]
         self.route = [{o: compiled.row(t, o) for o in Outcome} for t in ids]
+        self.ok_row = [route[Outcome.OK] for route in self.route]
         consumers: list[list[int]] = [[] for _ in compiled.places]
         for t, row in enumerate(self.row):
             for p, _ in compiled.pre[row]:

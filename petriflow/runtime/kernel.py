@@ -146,6 +146,16 @@ class Kernel:
             self.pending += 1
             bucket[1].append(event)
 
+    def schedule_poll(self, tick: int, event: Scheduled, key: int) -> None:
+        """Schedule a :data:`POLL` ``event`` at ``tick`` (after the current tick), its
+        polls of that tick ordered by ``key`` (what :meth:`schedule` does, for the
+        commonest event of a run)."""
+        bucket = self._buckets.get(tick)
+        if bucket is None:
+            bucket = self._bucket(tick)
+        self._order += 1
+        bucket[0].append((key, self._order, event))
+
     def _bucket(self, tick: int) -> tuple[list, list, list]:
         bucket = self._buckets.get(tick)
         if bucket is None:

@@ -53,16 +53,6 @@ class Firing(Scheduled):
         self.polled = -1
         self.running = False
 
-    def begin(self, number: int, ctx: ActionContext, deadline: float | None) -> None:
-        """Begin firing ``number`` (the transition's previous firing has ended)."""
-        self.number = number
-        self.ctx = ctx
-        self.deadline = deadline
-        self.cancelling = None
-        self.wake = -1
-        self.polled = -1
-        self.running = True
-
     def live(self, tick: int) -> bool:
         return self.running and self.wake == tick
 
@@ -117,10 +107,12 @@ class ActionRunner:
             ctx.reason = self._setup_error[t]
             self.finish(number, t, ctx, Outcome.FAILED)
             return
-        now = self.kernel.now
+        kernel = self.kernel
+        now = ctx.now
         timeout = self.index.timeout[t]
-        firing = self._slot[t]
-        firing.begin(number, ctx, None if timeout is None else now + timeout)
+        firing = self._slot[t]  # its record begins firing `number` (the previous one has ended)
+        firing.number, firing.ctx, firing.deadline = number, ctx, None if timeout is None else now + timeout
+        firing.cancelling, firing.wake, firing.polled, firing.running = None, -1, -1, True
         self.running[t] = firing
         try:
             action.start(ctx)
@@ -129,13 +121,14 @@ class ActionRunner:
             self._stop(firing)
             self.finish(number, t, ctx, Outcome.FAILED)
             return
-        kernel = self.kernel
         if timeout is not None:
             tick = max(kernel.tick + 1, kernel.ticks_at(firing.deadline))
             kernel.schedule(tick, Deadline(firing, number), key=number)
         wake = action.wake_at
         if wake is not None and not action.needs_world and wake > now + 1e-12:
-            self._wake(firing, max(kernel.tick + 1, kernel.ticks_at(wake)))  # first poll when it asked
+            tick = kernel.ticks_at(wake)  # first poll when it asked
+            firing.wake = tick = tick if tick > kernel.tick else kernel.tick + 1
+            kernel.schedule_poll(tick, firing, number)
         else:
             self.poll(firing)
 
@@ -157,7 +150,7 @@ class ActionRunner:
         kernel = self.kernel
         firing.polled = tick = kernel.tick
         ctx, action = firing.ctx, firing.action
-        ctx.now = now = kernel.now
+        ctx.now = now = tick * kernel.dt
         if firing.cancelling is None and firing.deadline is not None and now >= firing.deadline - 1e-9:
             firing.cancelling = Outcome.TIMEOUT
         if firing.cancelling is not None:
@@ -168,18 +161,23 @@ class ActionRunner:
         except Exception as exc:
             ctx.reason = reason_of(exc)
             status = Status.FAILED
-        if status is Status.RUNNING:
+        if status is Status.OK:
+            outcome = Outcome.OK
+        elif status is Status.RUNNING:
             if action.needs_world:
                 self._wake(firing, tick + 1)
             else:
                 wake = action.wake_at
                 self._wake(firing, tick + 1 if wake is None else max(tick + 1, kernel.ticks_at(wake)))
             return
-        if not isinstance(status, Status):
-            ctx.reason = f"poll() returned {status!r}, not a Status"
-            status = Status.FAILED
-        self._stop(firing)
-        self.finish(firing.number, firing.index, ctx, Outcome.OK if status is Status.OK else Outcome.FAILED)
+        else:
+            if status is not Status.FAILED:
+                ctx.reason = f"poll() returned {status!r}, not a Status"
+            outcome = Outcome.FAILED
+        firing.running = False  # (what _stop does, inline)
+        del self.running[firing.index]
+        self.enabled.dirty.add(firing.index)
+        self.finish(firing.number, firing.index, ctx, outcome)
 
     def _drive_cancel(self, firing: Firing, ctx: ActionContext, action: Action, tick: int) -> None:
         outcome = firing.cancelling
@@ -191,7 +189,9 @@ class ActionRunner:
         if not done:
             self._wake(firing, tick + 1)
             return
-        self._stop(firing)
+        firing.running = False  # (what _stop does, inline)
+        del self.running[firing.index]
+        self.enabled.dirty.add(firing.index)
         self.finish(firing.number, firing.index, ctx, outcome)
 
     def _stop(self, firing: Firing) -> None:
@@ -201,7 +201,7 @@ class ActionRunner:
 
     def _wake(self, firing: Firing, tick: int) -> None:
         firing.wake = tick
-        self.kernel.schedule(tick, firing, key=firing.number)
+        self.kernel.schedule_poll(tick, firing, firing.number)
 
     def in_firing_order(self) -> list[Firing]:
         """The firings running now, oldest first."""

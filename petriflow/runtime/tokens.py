@@ -2,10 +2,10 @@
 
 :class:`TokenStore` is a run's marking: per place, the data of its tokens in arrival
 order, beside the count vector that :class:`~petriflow.engine.CompiledNet`'s firing
-rule reads. Starting a firing and ending it go through the compiled net's
-:meth:`~petriflow.engine.CompiledNet.consume` and
-:meth:`~petriflow.engine.CompiledNet.produce`: the runtime and the token game share
-one firing rule.
+rule reads. Starting a firing and ending it apply the compiled net's rows (its
+``pre`` and ``post`` arcs, what :meth:`~petriflow.engine.CompiledNet.consume` and
+:meth:`~petriflow.engine.CompiledNet.produce` apply) to the counts and the data
+together: the runtime and the token game share one firing rule.
 
 :class:`Agenda` holds the transitions enabled right now, by priority, in net order,
 and picks one: the highest priority wins and a tie is broken by one draw of the run's
@@ -44,6 +44,9 @@ class Agenda:
 
     Args:
         priorities: per transition index, its priority.
+
+    Attributes:
+        on: per transition index, whether it is in the agenda (read it, never write it).
     """
 
     def __init__(self, priorities: Sequence[int]) -> None:
@@ -51,19 +54,19 @@ class Agenda:
         self._levels: list[list[int]] = [[] for _ in levels]
         level_of = {p: i for i, p in enumerate(levels)}
         self._level = [self._levels[level_of[p]] for p in priorities]
-        self._on = [False] * len(priorities)
+        self.on = [False] * len(priorities)
         self._count = 0
 
     def __len__(self) -> int:
         return self._count
 
     def __contains__(self, t: int) -> bool:
-        return self._on[t]
+        return self.on[t]
 
     def add(self, t: int) -> None:
         """Mark transition ``t`` enabled (no-op if it is)."""
-        if not self._on[t]:
-            self._on[t] = True
+        if not self.on[t]:
+            self.on[t] = True
             self._count += 1
             level = self._level[t]
             if not level or level[-1] < t:
@@ -73,8 +76,8 @@ class Agenda:
 
     def discard(self, t: int) -> None:
         """Mark transition ``t`` not enabled (no-op if it is not)."""
-        if self._on[t]:
-            self._on[t] = False
+        if self.on[t]:
+            self.on[t] = False
             self._count -= 1
             level = self._level[t]
             if level[-1] == t:
@@ -94,7 +97,7 @@ class Agenda:
 
     def members(self) -> list[int]:
         """The enabled transitions, in net order."""
-        return [t for t, on in enumerate(self._on) if on]
+        return [t for t, on in enumerate(self.on) if on]
 
 
 class TokenStore:
@@ -155,13 +158,14 @@ class TokenStore:
         if reset:
             return self._consume_with_reset(row)
         taken = {}
-        for p, w in compiled.pre[row]:
+        for p, w in compiled.pre[row]:  # the compiled rule's consume, with the tokens' data
             queue = data[p]
             taken[places[p]] = [queue.popleft()] if w == 1 else [queue.popleft() for _ in range(w)]
+            count = counts[p]
+            counts[p] = count - w
             if final is not None:
-                count, wanted = counts[p], final[p]
+                wanted = final[p]
                 self.mismatch += (count - w != wanted) - (count != wanted)
-        compiled.consume(counts, row)
         return taken, {}
 
     def _consume_with_reset(self, row: int) -> tuple[dict[str, list[Any]], dict[str, int]]:
@@ -194,11 +198,8 @@ class TokenStore:
         """
         produced = {}
         counts, data, places, final = self.counts, self.data, self.places, self._final
-        post = self.compiled.post[row]
-        skipped = False
-        for p, w in post:
+        for p, w in self.compiled.post[row]:  # the compiled rule's produce, less what travels through channels
             if skip[p]:
-                skipped = True
                 continue
             item = outputs.get(places[p], result) if outputs else result
             if w == 1:
@@ -206,15 +207,11 @@ class TokenStore:
             else:
                 data[p].extend([item] * w)
             produced[places[p]] = w
+            count = counts[p]
+            counts[p] = count + w
             if final is not None:
-                count, wanted = counts[p], final[p]
+                wanted = final[p]
                 self.mismatch += (count + w != wanted) - (count != wanted)
-        if skipped:  # the rule's counts, less what travels through channels
-            for p, w in post:
-                if not skip[p]:
-                    counts[p] += w
-        else:
-            self.compiled.produce(counts, row)
         return produced
 
     def add(self, i: int, item: Any) -> None:
