@@ -31,6 +31,7 @@ from typing import Any, Mapping
 import yaml
 
 from petriflow import limits
+from petriflow.collector import paused
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
 from petriflow.net import OPERATOR_KINDS, OUTCOMES, Net, Operator, Transition
 from petriflow.workflow import add_operator, operator_groups
@@ -553,7 +554,8 @@ def loads_net(text: str, *, path: str | None = None, name: str | None = None) ->
     """
     default = name or (Path(path).stem if path else "net")
     try:
-        net = _Reader(parse_yaml(text), default).read()
+        with paused():  # no cycles among what is built (petriflow.collector)
+            net = _Reader(parse_yaml(text), default).read()
         net.path = path
         return net
     except NetFormatError as exc:

@@ -126,7 +126,9 @@ class Registry:
     """Maps action, guard and metric names to code.
 
     Args:
-        load_plugins: read the ``petriflow.actions`` entry points on first use.
+        load_plugins: read the ``petriflow.actions`` entry points when first needed: a
+            listing, or a name not registered without them (a net of ``core.*`` actions
+            loads no plugin).
     """
 
     def __init__(self, load_plugins: bool = True) -> None:
@@ -216,7 +218,8 @@ class Registry:
 
     def channel_model(self, name: str) -> type | None:
         """The channel model class registered as ``name``, or ``None``."""
-        self._load_plugins()
+        if name not in self._channels:
+            self._load_plugins()
         target = self._channels.get(name)
         if isinstance(target, str):
             module_name, _, attribute = target.partition(":")
@@ -277,7 +280,8 @@ class Registry:
         Raises:
             UnknownActionError: nothing is registered under that name (with close matches).
         """
-        self._load_plugins()
+        if name not in self._actions:  # the plugins load when a name is not known without them
+            self._load_plugins()
         spec = self._actions.get(name)
         if spec is None:
             raise self._unknown("action", name, self._actions)
@@ -285,7 +289,8 @@ class Registry:
 
     def metric_spec(self, name: str) -> MetricSpec:
         """The metric registered as ``name`` (UnknownActionError with hints if none)."""
-        self._load_plugins()
+        if name not in self._metrics:
+            self._load_plugins()
         if name not in self._metrics:
             raise self._unknown("metric", name, self._metrics)
         return self._metrics[name]
@@ -297,7 +302,8 @@ class Registry:
 
     def guard(self, name: str) -> Predicate:
         """The predicate registered as ``name`` (UnknownActionError with hints if none)."""
-        self._load_plugins()
+        if name not in self._predicates:
+            self._load_plugins()
         if name not in self._predicates:
             raise self._unknown("guard", name, self._predicates)
         return self._predicates[name]

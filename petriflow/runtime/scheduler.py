@@ -65,6 +65,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from petriflow import limits
+from petriflow.collector import paused
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 from petriflow.net import Net
@@ -145,6 +146,7 @@ class Scheduler:
             channel of the configuration names nothing in the net.
     """
 
+    @paused()  # indexing a large net makes no cycles (petriflow.collector)
     def __init__(self, net: Net, *, world: Any = None, config: RunConfig | dict | None = None, seed: int | None = None,
                  registry: Registry | None = None, path: str | None = None, binding: Binding | None = None,
                  clock: Clock | None = None) -> None:

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
 
+from petriflow.collector import paused
 from petriflow.errors import NetFormatError
 from petriflow.net import Net
 from petriflow.runtime.assembly import open_run, validate
@@ -190,6 +191,7 @@ def net_config(net: Net, path: Path) -> RunConfig | None:
     return RunConfig.from_dict(named, str(path), base=str(path.parent), line=net.lines.get("run"))
 
 
+@paused()  # reading and binding a large net makes no cycles (petriflow.collector)
 def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = None,
             world: str | Path | None = None, registry: Registry | None = None,
             import_actions: bool = True) -> Prepared:
