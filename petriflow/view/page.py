@@ -16,7 +16,7 @@ import json
 from importlib import resources
 from typing import Any
 
-__all__ = ["asset", "pack", "render"]
+__all__ = ["asset", "pack", "pack_bytes", "render"]
 
 
 def asset(name: str) -> str:
@@ -33,7 +33,12 @@ def pack(text: str) -> str:
         >>> gzip.decompress(base64.b64decode(pack("abc"))).decode()
         'abc'
     """
-    return base64.b64encode(gzip.compress(text.encode("utf-8"), compresslevel=9, mtime=0)).decode("ascii")
+    return pack_bytes(text.encode("utf-8"))
+
+
+def pack_bytes(data: bytes) -> str:
+    """``data`` gzip-compressed (no time stamp) and base64-encoded."""
+    return base64.b64encode(gzip.compress(data, compresslevel=9, mtime=0)).decode("ascii")
 
 
 def _script_json(data: Any) -> str:

@@ -1,7 +1,9 @@
 """A run's page: the trace replayed in the browser.
 
-The page holds the whole trace (every event, compressed: nothing of the JSON Lines
-file is left out, and each event's full record is shown when it is picked), the net
+The page holds the whole trace (every event, in the columns of
+:mod:`petriflow.view.columns`, compressed: nothing of the JSON Lines file is left out,
+and each event's full record is rebuilt and shown when it is listed or picked), the
+replay computed once (:func:`model`, held as :func:`stored` keeps it), the net
 drawn by :func:`petriflow.export.to_dot` with no tokens (the page puts the marking in),
 and what it needs to know about the net's transitions. The token game is replayed by
 the page's script with the rule of :func:`petriflow.runtime.replay.markings`, so the
@@ -19,9 +21,10 @@ from typing import Any
 
 from petriflow.errors import PetriflowError
 from petriflow.runtime.trace import read_trace
-from petriflow.view.page import pack, render
+from petriflow.view.columns import encoded
+from petriflow.view.page import pack, pack_bytes, render
 
-__all__ = ["run_page", "net_picture", "model", "unpacked"]
+__all__ = ["run_page", "net_picture", "model", "unpacked", "stored", "restored"]
 
 
 def net_picture(net: Any) -> tuple[str | None, str | None]:
@@ -253,14 +256,14 @@ _KEEP = {"run": {"marking", "agents", "net", "seed", "dt"}, "start": {"firing", 
 DEFAULT_MAX_MB = 20.0
 
 
-def _lines(events: list[Any], limit: int | None) -> tuple[str, int]:
-    """The events as JSON lines; with ``limit``, each event's data values longer than
-    ``limit`` characters that the page does not need (token data copied into ``inputs``
-    and ``result``, an action's own reports) replaced by a note saying how long they
-    were and on which line of the trace they are. Returns the text and how many events
-    lost something."""
+def _shortened(events: list[Any], limit: int | None) -> tuple[list[Any], int]:
+    """The events; with ``limit``, each event's data values longer than ``limit``
+    characters that the page does not need (token data copied into ``inputs`` and
+    ``result``, an action's own reports) replaced by a note saying how long they were
+    and on which line of the trace they are. Returns the events and how many lost
+    something."""
     if limit is None:
-        return "\n".join(e.to_json() for e in events), 0
+        return events, 0
     out, shortened = [], 0
     for number, event in enumerate(events, start=1):
         keep = _KEEP.get(event.kind)
@@ -275,8 +278,75 @@ def _lines(events: list[Any], limit: int | None) -> tuple[str, int]:
             if cut:
                 shortened += 1
                 event = type(event)(event.seq, event.time, event.kind, event.transition, event.agent, {**data, **cut})
-        out.append(event.to_json())
-    return "\n".join(out), shortened
+        out.append(event)
+    return out, shortened
+
+
+def stored(m: dict[str, Any], templates: list[int]) -> dict[str, Any]:
+    """The :func:`model` as the page holds it, beside the events' columns
+    (:mod:`petriflow.view.columns`): without what the page reads from those (each
+    event's kind, time, seq, agent and transition; which events start a firing, its
+    transition and agent; a message's sender; the poses and outlines of the pose
+    events), the events marked failed as gaps between them, and the changes to the
+    marking per template (``templates[i]``: event ``i``'s), as the first event of that
+    template made them, with the events that made other changes listed apart
+    (``d_other``: gap from the previous such event, then its changes as place, n,
+    place, n...). :func:`restored` undoes it."""
+    out = {k: v for k, v in m.items() if k not in (
+        "kind", "time", "seq", "agent", "transition", "bad", "d_count", "d_place", "d_n",
+        "f_start", "f_transition", "f_agent", "m_from", "poses", "outlines")}
+    bad = [i for i, b in enumerate(m["bad"]) if b]
+    out["bad"] = [b - a for a, b in zip([0] + bad, bad)]
+    by_template: dict[int, list[int]] = {}
+    other: list[Any] = []
+    at = last = 0
+    for i, (count, template) in enumerate(zip(m["d_count"], templates)):
+        change = [x for k in range(at, at + count) for x in (m["d_place"][k], m["d_n"][k])]
+        at += count
+        known = by_template.setdefault(template, change)
+        if known != change:
+            other.append([i - last, change])
+            last = i
+    out["t_change"] = [by_template.get(t, []) for t in range(max(templates, default=-1) + 1)]
+    out["d_other"] = other
+    return out
+
+
+def restored(s: dict[str, Any], records: list[dict[str, Any]], templates: list[int]) -> dict[str, Any]:
+    """The :func:`model` (its compact form) back from :func:`stored` and the events'
+    records and template numbers (as the page's script restores it)."""
+    from itertools import accumulate
+
+    from petriflow.runtime.trace import Event
+
+    m = {k: v for k, v in s.items() if k not in ("t_change", "d_other")}
+    indices = [i for i, r in enumerate(records) if r["kind"] == "pose"]
+    names = {key: {name: k for k, name in enumerate(s[key])} for key in ("agents", "transitions", "kinds")}
+    agent = [-1 if r["agent"] is None else names["agents"][r["agent"]] for r in records]
+    transition = [-1 if r["transition"] is None else names["transitions"][r["transition"]] for r in records]
+    m.update(kind=[names["kinds"][r["kind"]] for r in records], time=[r["time"] for r in records],
+             agent=agent, transition=transition)
+    seq = [r["seq"] for r in records]
+    m["seq"] = None if seq == list(range(len(records))) else seq
+    bad = set(accumulate(s["bad"]))
+    m["bad"] = [1 if i in bad else 0 for i in range(len(records))]
+    other = dict(zip(accumulate(gap for gap, _ in s["d_other"]), (change for _, change in s["d_other"])))
+    m["d_count"], m["d_place"], m["d_n"] = [], [], []
+    for i, t in enumerate(templates):
+        change = other.get(i, s["t_change"][t])
+        m["d_count"].append(len(change) // 2)
+        m["d_place"].extend(change[0::2])
+        m["d_n"].extend(change[1::2])
+    starts = [i for i, r in enumerate(records) if r["kind"] == "start"]
+    m["f_start"] = [b - a for a, b in zip([0] + starts, starts)]
+    m["f_transition"] = [transition[i] for i in starts]
+    m["f_agent"] = [agent[i] for i in starts]
+    m["m_from"] = [agent[i] for i in accumulate(s["m_send"])]
+    poses = model([Event.from_dict(r) for r in records if r["kind"] == "pose"])
+    m["outlines"] = poses["outlines"]
+    m["poses"] = {body: [[indices[k] for k in track[0]], *track[1:]]
+                  for body, track in poses["poses"].items()}
+    return m
 
 
 def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float = DEFAULT_MAX_MB) -> str:
@@ -302,14 +372,15 @@ def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float 
                                  " which the net does not have")
         svg, why = net_picture(loaded)
     first = events[0].data if events[0].kind == "run" else {}
-    replayed = pack(json.dumps(model(events, list(loaded.places) if loaded is not None else None),
-                               separators=(",", ":"), allow_nan=False))
-    budget = max_mb * 1e6 - len(replayed) - len(pack(svg or "")) - 200_000  # the page's own code and styles
+    replay = model(events, list(loaded.places) if loaded is not None else None)
+    budget = max_mb * 1e6 - len(pack(svg or "")) - 200_000  # the page's own code and styles
     shortened, limit = 0, None
     for limit in (None, 1024, 256, 64):  # each event whole, else its bulky data left out, less and less
-        lines, shortened = _lines(events, limit)
-        packed = pack(lines)
-        if len(packed) <= budget:
+        kept, shortened = _shortened(events, limit)
+        block, templates = encoded(kept)
+        packed = pack_bytes(block)
+        replayed = pack(json.dumps(stored(replay, templates), separators=(",", ":"), allow_nan=False))
+        if len(packed) + len(replayed) <= budget:
             break
     name = str(first.get("net") or trace.stem)
     data = {
@@ -320,7 +391,7 @@ def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float 
         "seed": first.get("seed"),
         "events": len(events),
         "trace_bytes": trace.stat().st_size,
-        "packed": packed,
+        "columns": packed,
         "model": replayed,
         "shortened": {"events": shortened, "limit": limit, "max_mb": max_mb} if shortened else None,
         "svg": None if svg is None else pack(svg),

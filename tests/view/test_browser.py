@@ -10,6 +10,7 @@ A screenshot of each page is written next to the test's files (and into
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import time
@@ -77,6 +78,13 @@ def screenshot(driver, tmp_path: Path, name: str) -> Path:
     return shot
 
 
+def records(driver) -> list[dict]:
+    """Every event's record as the open page rebuilds it from its columns."""
+    text = driver.execute_script("const out = []; for (let i = 0; i < window.pfView.count; i++)"
+                                 " out.push(JSON.stringify(window.pfView.record(i))); return out.join('\\n');")
+    return [json.loads(line) for line in text.split("\n")]
+
+
 def move_slider(driver, n: int) -> None:
     """As a user drags it: the range input's value changes and it fires ``input``."""
     driver.execute_script("const s = document.getElementById('slider'); s.value = arguments[0];"
@@ -93,6 +101,7 @@ def test_run_page_replays_the_trace(browser, which, net, agent, request, tmp_pat
     page = petriflow.view(trace, net=nets_folder() / net, out=tmp_path / "run.html")
     open_page(browser, page)
     assert browser.execute_script("return window.pfView.count") == len(events)
+    assert records(browser) == [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()]
     assert browser.find_elements(By.CSS_SELECTOR, "#net svg g.node")  # the net is drawn
     after = [m.to_dict() for _, m in markings(events)]
     for n in (len(events) // 3, (2 * len(events)) // 3, len(events) - 1):
@@ -136,6 +145,17 @@ def test_a_page_without_the_net_lists_the_places(browser, bidding_trace, tmp_pat
     move_slider(browser, n)
     assert browser.execute_script("return window.pfView.shownMarking()") == list(markings(events[: n + 1]))[-1][1].to_dict()
     assert browser.find_elements(By.CSS_SELECTOR, "#marking-list tr[data-place]")
+    assert console_errors(browser) == []
+
+
+def test_the_page_rebuilds_awkward_records_exactly(browser, awkward_events, tmp_path):
+    trace = tmp_path / "awkward.jsonl"
+    trace.write_text("".join(e.to_json() + "\n" for e in awkward_events), encoding="utf-8")
+    open_page(browser, petriflow.view(trace, out=tmp_path / "awkward.html"))
+    assert records(browser) == [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()]
+    move_slider(browser, 7)  # the list shows the rebuilt record
+    detail = browser.find_element(By.ID, "event-detail").text
+    assert '"name": "label 7"' in detail and '"mark": "\\u00010.0"' in detail
     assert console_errors(browser) == []
 
 

@@ -17,11 +17,23 @@ from petriflow.cli import main
 from petriflow.runtime.replay import markings
 from petriflow.runtime.trace import read_trace
 from petriflow.examples import folder as nets_folder
-from petriflow.view.run_page import model, unpacked
+from petriflow.view.columns import decoded
+from petriflow.view.run_page import model, restored, unpacked
 
 
 def _unpack(text: str) -> str:
     return gzip.decompress(base64.b64decode(text)).decode("utf-8")
+
+
+def _records(data: dict) -> list[dict]:
+    """Every event's record as the page's columns hold it."""
+    return decoded(gzip.decompress(base64.b64decode(data["columns"])))[0]
+
+
+def _page_model(data: dict) -> dict:
+    """The replay model a page holds, with what it reads from the events' columns put back."""
+    records, templates = decoded(gzip.decompress(base64.b64decode(data["columns"])))
+    return restored(json.loads(_unpack(data["model"])), records, templates)
 
 
 def _marking_after_each(m: dict) -> list[dict[str, int]]:
@@ -142,11 +154,11 @@ def test_a_page_carries_every_event_and_fetches_nothing(bidding_trace, tmp_path,
     text = page.read_text(encoding="utf-8")
     assert "<script src" not in text and "<link" not in text and "@import" not in text
     data = page_data(page)
-    lines = _unpack(data["packed"]).split("\n")
-    assert lines == bidding_trace.read_text(encoding="utf-8").splitlines()  # nothing lost
+    lines = bidding_trace.read_text(encoding="utf-8").splitlines()
+    assert _records(data) == [json.loads(line) for line in lines]  # nothing lost
     assert _unpack(data["svg"]).startswith("<svg") and data["events"] == len(lines)
-    replayed = json.loads(_unpack(data["model"]))
-    assert len(replayed["kind"]) == len(lines)
+    replayed = _page_model(data)
+    assert replayed == json.loads(json.dumps(model(read_trace(bidding_trace), data["net_places"])))
     assert replayed["poses"] and replayed["outlines"]  # the world can be drawn
 
 
@@ -265,9 +277,9 @@ def test_a_page_over_its_size_keeps_every_event_and_says_what_it_left_out(smart_
     whole = page_data(petriflow.view(smart_trace, out=tmp_path / "whole.html"))
     small = page_data(petriflow.view(smart_trace, out=tmp_path / "small.html", max_mb=0.2))
     assert whole["shortened"] is None
-    assert small["shortened"]["events"] > 0 and len(small["packed"]) < len(whole["packed"])
+    assert small["shortened"]["events"] > 0 and len(small["columns"]) < len(whole["columns"])
     events = read_trace(smart_trace)
-    records = [json.loads(line) for line in _unpack(small["packed"]).split("\n")]
+    records = _records(small)
     assert len(records) == len(events)  # every event is still there
     for number, (record, event) in enumerate(zip(records, events), start=1):
         assert (record["seq"], record["kind"], record["time"], record["agent"]) == (event.seq, event.kind, event.time,
@@ -275,7 +287,7 @@ def test_a_page_over_its_size_keeps_every_event_and_says_what_it_left_out(smart_
         for key, value in record["data"].items():
             if value != event.data[key]:
                 assert value.startswith("<left out of the page") and f"line {number} of the trace" in value
-    assert json.loads(_unpack(small["model"])) == json.loads(_unpack(whole["model"]))  # the replay is whole
+    assert _page_model(small) == _page_model(whole) == json.loads(json.dumps(model(events)))  # replay whole
 
 
 @pytest.mark.parametrize("net, until, draw", [
@@ -290,7 +302,8 @@ def test_every_shipped_scenario_has_a_page(net, until, draw, tmp_path, page_data
     run_files(nets_folder() / net, trace=trace, until=until, poses=1.0)
     events = read_trace(trace)
     data = page_data(petriflow.view(trace, net=nets_folder() / net if draw else None, out=tmp_path / "run.html"))
-    replayed = unpacked(json.loads(_unpack(data["model"])))
+    replayed = unpacked(_page_model(data))
+    assert _records(data) == [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()]
     assert _marking_after_each(replayed) == [m.to_dict() for _, m in markings(events)]
     assert replayed["poses"] and bool(data["svg"]) == draw  # the world (and the net) can be drawn
 

@@ -12,6 +12,15 @@ window.PF = (function () {
     return await new Response(stream).text();
   }
 
+  /** The bytes packed by petriflow.view.page.pack_bytes (gzip + base64), inflated by the browser. */
+  async function inflateBytes(b64) {
+    const binary = atob(b64);
+    const bytes = new Uint8Array(binary.length);
+    for (let i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
+    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip"));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+
   const PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf",
                    "#bcbd22", "#7f7f7f", "#393b79", "#ad494a", "#637939", "#8c6d31", "#843c39", "#7b4173"];
   const colours = new Map();
@@ -68,5 +77,5 @@ window.PF = (function () {
 
   function forget(canvas) { sizes.delete(canvas); }
 
-  return { data, inflate, colour, lastAtMost, fmt, fit, forget, showError };
+  return { data, inflate, inflateBytes, colour, lastAtMost, fmt, fit, forget, showError };
 })();

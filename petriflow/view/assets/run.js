@@ -1,4 +1,4 @@
-/* petriflow view: a run's page. Replays the trace held (compressed) in the page:
+/* petriflow view: a run's page. Replays the trace held (in columns, compressed) in the page:
    the token game by the rule of petriflow.runtime.replay.markings, the firings, the
    messages and the world's poses, at the event the slider chooses. */
 "use strict";
@@ -12,8 +12,7 @@
 
   let N = 0;                        // events
   let M = null;                     // the model petriflow.view.run_page.model computed
-  let lines = [];                   // each event's JSON line, parsed when shown
-  const parsed = new Map();
+  const parsed = new Map();         // events' records rebuilt, the last few thousand shown
   let times = null, kindOf = null, agentOf = null, transOf = null, bad = null;
   let dStart = null, dPlace = null, dN = null;
   let placeNames = [];
@@ -32,11 +31,114 @@
   let current = 0;
   let playing = false;
 
-  /** Event i as recorded (its JSON line, parsed once). */
+  // The events' columns (petriflow.view.columns): templates and the numbers they miss -----
+  let STEP = 256;                   // where each column is read is kept every so many events (more
+                                    // with very many columns: at most about 2 million positions kept)
+  const E = { templates: [], columns: [], uses: [], timeAt: [], order: null, seq: null, cursors: [] };
+
+  /** The columns of the block petriflow.view.columns.encode wrote, decoded; the templates parsed. */
+  function readColumns(bytes) {
+    const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+    const size = view.getUint32(0, true);
+    const header = JSON.parse(new TextDecoder().decode(bytes.subarray(4, 4 + size)));
+    let at = 4 + size;
+    for (const about of header.columns) {
+      const n = about.count, values = new Float64Array(n);
+      if (about.type === "f") {
+        for (let k = 0; k < n; k++) values[k] = view.getFloat64(at + 8 * k, true);
+      } else {
+        let p = at;
+        for (let k = 0; k < n; k++) {
+          let u = 0, scale = 1, b;
+          do { b = bytes[p++]; u += (b & 127) * scale; scale *= 128; } while (b >= 128);
+          values[k] = u % 2 ? -(u + 1) / 2 : u / 2;
+        }
+        if (about.delta === 1) for (let k = 1; k < n; k++) values[k] += values[k - 1];
+      }
+      at += about.bytes;
+      E.columns.push({ values, strings: about.strings || null, delta: about.delta, scale: about.type === "d" ? about.scale : 0 });
+    }
+    E.templates = header.templates;
+    E.order = E.columns[header.template].values;
+    E.seq = header.seq === null ? null : E.columns[header.seq].values;
+    const mark = text => text.slice(1).split(".").map(Number);
+    for (const t of E.templates) {
+      const counts = new Map();
+      const walk = v => {
+        if (typeof v === "string") {
+          if (v.charCodeAt(0) === 1) { const [c, j] = mark(v); counts.set(c, Math.max(counts.get(c) || 0, j + 1)); }
+        } else if (Array.isArray(v)) v.forEach(walk);
+        else if (v && typeof v === "object") Object.values(v).forEach(walk);
+      };
+      walk(t[3]); walk(t[4]);
+      E.uses.push(Int32Array.from([].concat(...counts.entries())));
+      E.timeAt.push(typeof t[4] === "string" && t[4].charCodeAt(0) === 1 ? mark(t[4]) : null);
+    }
+    const N = header.events;
+    STEP = Math.max(256, Math.ceil(N * E.columns.length / 2e6));
+    if (E.columns.some(c => c.delta === 2)) {   // each value less the one before at its template's place
+      const last = E.templates.map(() => new Map()), cursor = new Int32Array(E.columns.length);
+      for (let i = 0; i < N; i++) {
+        const t = E.order[i], uses = E.uses[t];
+        for (let k = 0; k < uses.length; k += 2) {
+          const c = uses[k], n = uses[k + 1], column = E.columns[c];
+          if (column.delta === 2) {
+            let before = last[t].get(c);
+            if (!before) last[t].set(c, (before = new Float64Array(n)));
+            for (let j = 0; j < n; j++) before[j] = (column.values[cursor[c] + j] += before[j]);
+          }
+          cursor[c] += n;
+        }
+      }
+    }
+    for (const column of E.columns) {
+      if (column.scale) { const d = 10 ** column.scale; for (let k = 0; k < column.values.length; k++) column.values[k] /= d; }
+    }
+    // each event's time; where each column is read, every STEP events
+    const cursor = new Int32Array(E.columns.length);
+    const out = new Float64Array(N);
+    for (let i = 0; i < N; i++) {
+      if (i % STEP === 0) E.cursors.push(Int32Array.from(cursor));
+      const t = E.order[i], at = E.timeAt[t], uses = E.uses[t];
+      out[i] = at ? E.columns[at[0]].values[cursor[at[0]] + at[1]] : E.templates[t][4];
+      for (let k = 0; k < uses.length; k += 2) cursor[uses[k]] += uses[k + 1];
+    }
+    return out;
+  }
+
+  /** Event i's record, rebuilt from its template and columns (as its JSON line has it). */
+  function record(i) {
+    const c0 = Math.floor(i / STEP), cursor = Int32Array.from(E.cursors[c0]);
+    for (let k = c0 * STEP; k < i; k++) {
+      const uses = E.uses[E.order[k]];
+      for (let q = 0; q < uses.length; q += 2) cursor[uses[q]] += uses[q + 1];
+    }
+    const fill = v => {
+      if (typeof v === "string") {
+        if (v.charCodeAt(0) !== 1) return v;
+        const dot = v.indexOf("."), c = +v.slice(1, dot), column = E.columns[c];
+        const x = column.values[cursor[c] + +v.slice(dot + 1)];
+        return column.strings ? column.strings[x] : x;
+      }
+      if (Array.isArray(v)) return v.map(fill);
+      if (v && typeof v === "object") {
+        const o = {};
+        for (const key of Object.keys(v)) Object.defineProperty(o, key, { value: fill(v[key]), enumerable: true, writable: true });
+        return o;
+      }
+      return v;
+    };
+    const [kind, transition, agent, data, time] = E.templates[E.order[i]];
+    return { agent, data: fill(data), kind, seq: seqOf(i), time: fill(time), transition };
+  }
+
+  function seqOf(i) { return E.seq ? E.seq[i] : i; }
+
+  /** Event i as recorded (rebuilt once, while it stays among the last few thousand shown). */
   function ev(i) {
     let e = parsed.get(i);
     if (!e) {
-      e = JSON.parse(lines[i]);
+      e = record(i);
       if (parsed.size > 5000) parsed.clear();
       parsed.set(i, e);
     }
@@ -59,21 +161,41 @@
 
   // Reading the model once ---------------------------------------------------------------
   function index() {
-    N = M.kind.length;
-    // undo the compact storing (see petriflow.view.run_page.model)
-    M.d_start = [0]; for (const n of M.d_count) M.d_start.push(M.d_start[M.d_start.length - 1] + n);
-    for (const [key, end] of [["f_start", "f_end"], ["m_send", "m_end"]]) {
-      let at = 0;
-      M[key] = M[key].map(gap => (at += gap));
-      M[end] = M[end].map((offset, k) => (offset < 0 ? -1 : offset + M[key][k]));
+    // what the page reads from the columns rather than the model (see petriflow.view.run_page.stored)
+    N = E.order.length;
+    const numbers = key => new Map(M[key].map((name, k) => [name, k]));
+    const kinds = numbers("kinds"), agents = numbers("agents"), transitions = numbers("transitions");
+    const tKind = E.templates.map(t => kinds.get(t[0]));
+    const tTransition = E.templates.map(t => (t[1] === null ? -1 : transitions.get(t[1])));
+    const tAgent = E.templates.map(t => (t[2] === null ? -1 : agents.get(t[2])));
+    kindOf = new Int8Array(N); agentOf = new Int32Array(N); transOf = new Int32Array(N); bad = new Uint8Array(N);
+    const other = new Map();
+    let at = 0;
+    for (const [gap, change] of M.d_other) other.set((at += gap), change);
+    const change = i => other.get(i) || M.t_change[E.order[i]];
+    dStart = new Int32Array(N + 1);
+    for (let i = 0; i < N; i++) {
+      const t = E.order[i];
+      kindOf[i] = tKind[t]; agentOf[i] = tAgent[t]; transOf[i] = tTransition[t];
+      dStart[i + 1] = dStart[i] + change(i).length / 2;
     }
-    if (!M.seq) M.seq = Array.from({ length: N }, (_, k) => k);
-    times = Float64Array.from(M.time);
-    kindOf = Int8Array.from(M.kind);
-    agentOf = Int32Array.from(M.agent);
-    transOf = Int32Array.from(M.transition);
-    bad = Uint8Array.from(M.bad);
-    dStart = Int32Array.from(M.d_start); dPlace = Int32Array.from(M.d_place); dN = Int32Array.from(M.d_n);
+    dPlace = new Int32Array(dStart[N]); dN = new Int32Array(dStart[N]);
+    for (let i = 0; i < N; i++) {
+      const c = change(i);
+      for (let k = 0; k < c.length; k += 2) { dPlace[dStart[i] + k / 2] = c[k]; dN[dStart[i] + k / 2] = c[k + 1]; }
+    }
+    at = 0;
+    for (const gap of M.bad) bad[(at += gap)] = 1;
+    const start = kinds.get("start");
+    M.f_start = [];
+    for (let i = 0; i < N; i++) if (kindOf[i] === start) M.f_start.push(i);
+    M.f_end = M.f_end.map((offset, k) => (offset < 0 ? -1 : offset + M.f_start[k]));
+    M.f_transition = M.f_start.map(i => transOf[i]);
+    M.f_agent = M.f_start.map(i => agentOf[i]);
+    at = 0;
+    M.m_send = M.m_send.map(gap => (at += gap));
+    M.m_end = M.m_end.map((offset, k) => (offset < 0 ? -1 : offset + M.m_send[k]));
+    M.m_from = M.m_send.map(i => agentOf[i]);
     placeNames = M.places;
     placeNames.forEach((p, k) => placeIndex.set(p, k));
     const counts = new Int32Array(placeNames.length);
@@ -107,11 +229,23 @@
     const fateCounts = {};
     for (const m of messages) fateCounts[m.fate] = (fateCounts[m.fate] || 0) + 1;
     messageCounts = `${messages.length} messages: ` + Object.entries(fateCounts).map(([k, v]) => `${v} ${k}`).join(", ");
-    for (const [body, track] of Object.entries(M.poses)) {
+    // the bodies' poses and the world's outlines, from the pose events (as run_page.model reads them)
+    const tracks = new Map(), pose = kinds.get("pose");
+    for (let i = 0; i < N; i++) {
+      if (kindOf[i] !== pose) continue;
+      const d = record(i).data;
+      if (Array.isArray(d.outlines)) outlines = d.outlines;
+      for (const [body, p] of Object.entries(d.poses || {})) {
+        if (!Array.isArray(p) || p.length < 2) continue;
+        if (!tracks.has(body)) tracks.set(body, [[], [], [], [], []]);
+        const track = tracks.get(body);
+        [i, times[i], p[0], p[1], p.length > 2 ? p[2] : 0].forEach((v, k) => track[k].push(v));
+      }
+    }
+    for (const [body, track] of tracks) {
       bodies.set(body, { idx: Int32Array.from(track[0]), t: Float64Array.from(track[1]), x: Float64Array.from(track[2]),
                          y: Float64Array.from(track[3]), yaw: Float64Array.from(track[4]) });
     }
-    outlines = M.outlines || [];
     const names = new Set(D.run_agents);
     for (const m of messages) { if (m.from) names.add(m.from); if (m.to) names.add(m.to); }
     lifelines = Array.from(names);
@@ -674,7 +808,7 @@
     const running = runningAt(i).length;
     const tr = transOf[i] >= 0 ? " " + M.transitions[transOf[i]] : "";
     document.getElementById("now").textContent =
-      `event ${i} (seq ${M.seq[i]}) of ${N - 1} · t = ${times[i].toFixed(3)} s · ${M.kinds[kindOf[i]]}${tr} · ${running} running`;
+      `event ${i} (seq ${seqOf(i)}) of ${N - 1} · t = ${times[i].toFixed(3)} s · ${M.kinds[kindOf[i]]}${tr} · ${running} running`;
     const P = window.pfView.parts;
     let t = performance.now();
     const lap = name => { const n = performance.now(); P[name] = (P[name] || 0) + n - t; t = n; };
@@ -754,11 +888,11 @@
     const T = window.pfView.timing = {};
     let mark = started;
     const lap = name => { const t = performance.now(); T[name] = t - mark; mark = t; };
-    const [text, model, svg] = await Promise.all([PF.inflate(D.packed), PF.inflate(D.model),
-                                                  D.svg ? PF.inflate(D.svg) : Promise.resolve(null)]);
+    const [bytes, model, svg] = await Promise.all([PF.inflateBytes(D.columns), PF.inflate(D.model),
+                                                   D.svg ? PF.inflate(D.svg) : Promise.resolve(null)]);
     netSvg = svg;
     lap("inflate");
-    lines = text.split("\n");
+    times = readColumns(bytes);
     M = JSON.parse(model);
     lap("parse");
     index();
@@ -787,6 +921,8 @@
     get count() { return N; },
     get bodies() { return bodies.size; },
     markingAt: i => markingObject(markingAt(i)),
+    /** Event i's record as the page rebuilds it from its columns (what the event list shows). */
+    record: i => record(i),
     /** The marking the page shows now, read back from the net (or the place list). */
     shownMarking() {
       const out = {};
