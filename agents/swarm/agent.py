@@ -27,8 +27,10 @@ Examples:
 
 from __future__ import annotations
 
+from array import array
 from collections import deque
 from dataclasses import dataclass, field
+from itertools import chain
 from typing import Any
 
 from petriflow.agents.comm.framework import History, Message, plan
@@ -51,26 +53,183 @@ def packet_bytes(packet: tuple) -> int:
 
 @dataclass
 class SwarmHistory(History):
-    """Seed 000's history (the same rules and arrays), with its rows also indexed by
-    source, so new data of a source updates only that source's rows instead of
-    scanning all of them (a swarm robot's history holds many sources)."""
+    """Seed 000's history: the same data and history arrays (``data``, ``rows``) and
+    the same three rules, kept so that a robot with many sources and neighbours can
+    afford them. Items are hashable (a cell is a tuple) and there is no ``identity``
+    (an item is its source's), so:
 
-    _source_rows: dict[int, list[list[int]]] = field(default_factory=dict, repr=False)
+    * what this agent and each peer hold are sets of ``(source, item)`` pairs made
+      inline (``held``), with no call per item;
+    * the history array's counts are one ``array("q")`` of four numbers a row (from,
+      to, sent, pending), each row found by ``(from, to)`` and by source, so new data
+      of a source updates only that source's rows; ``rows`` gives them as lists. A
+      swarm's robots hold hundreds of thousands of rows: as lists, Python's cycle
+      collector would walk every one of them at each of its full collections;
+    * a source that :meth:`outgoing` found nothing of for a peer it has no row towards
+      (all of it came from that peer, or the peer holds it) is looked at again only
+      from the first item kept since: items are only appended and what a peer holds
+      only grows, so the earlier ones still give nothing;
+    * rule 3 takes the last ``pending`` items from the end, not from a copy of all;
+    * what went to a peer is in what the peer holds (``held``), not also in lists per
+      peer and source (``given`` stays empty): the rules read only the former.
+
+    The answers are :class:`History`'s, item for item and in the same order (tested
+    beside it with random operations)."""
+
+    _source_rows: dict[int, list[int]] = field(default_factory=dict, repr=False)  # source -> rows' offsets
     #: Items kept so far: what the rules send a peer changes only when this grows.
     version: int = 0
+    _clean: dict[tuple[int, int], int] = field(default_factory=dict, repr=False)  # (peer, source) -> items checked
+    _counts: Any = field(default_factory=lambda: array("q"), repr=False)           # 4 a row: from, to, sent, pending
 
-    def _keep(self, source: int, item: Any, via: int) -> None:
-        super()._keep(source, item, via)
-        self.version += 1
+    def __post_init__(self) -> None:
+        if self.identity is not None:
+            raise ValueError("SwarmHistory keeps items as their source's: no identity")
+
+    @property  # type: ignore[override]
+    def rows(self) -> list[list[int]]:
+        """The history array: ``[from, to, sent, pending]`` per row, in the order made
+        (a copy)."""
+        counts = self._counts
+        return [counts[at:at + 4].tolist() for at in range(0, len(counts), 4)]
+
+    @rows.setter
+    def rows(self, rows: list[list[int]]) -> None:
+        if rows:  # (the dataclass's __init__ sets an empty one)
+            raise ValueError("a swarm history's rows are made by its rules, not given")
+        self._counts = array("q")
+
+    def _new_row(self, source: int, to: int, sent: int) -> None:
+        counts = self._counts
+        at = len(counts)
+        counts.extend((source, to, sent, 0))
+        self._rows[(source, to)] = at
+        offsets = self._source_rows.get(source)
+        if offsets is None:
+            self._source_rows[source] = [at]
+        else:
+            offsets.append(at)
 
     def _add_row(self, row: list[int]) -> None:
-        super()._add_row(row)
-        self._source_rows.setdefault(row[0], []).append(row)
+        self._new_row(row[0], row[1], row[2])
+        self._counts[-1] = row[3]
+
+    def _row(self, source: int, to: int) -> list[int] | None:
+        at = self._rows.get((source, to))
+        return None if at is None else self._counts[at:at + 4].tolist()
+
+    def sent_count(self, peer: int, source: int) -> int:
+        at = self._rows.get((source, peer))
+        return 0 if at is None else self._counts[at + 2]
+
+    def pending(self, peer: int, source: int) -> int:
+        at = self._rows.get((source, peer))
+        return 0 if at is None else self._counts[at + 3]
+
+    def _keep(self, source: int, item: Any, via: int) -> None:
+        self.data.append((source, item, via))
+        entries = self._by_source.get(source)
+        if entries is None:
+            entries = self._by_source[source] = []
+        entries.append((item, via))
+        self._held.add((source, item))
+        self.version += 1
+
+    def has(self, source: int, item: Any) -> bool:
+        return (source, item) in self._held
 
     def _more(self, source: int, count: int, sender: int) -> None:
-        for row in self._source_rows.get(source, ()):
-            if row[1] not in (self.me, sender):
-                row[3] += count
+        me, counts = self.me, self._counts
+        for at in self._source_rows.get(source, ()):
+            to = counts[at + 1]
+            if to != me and to != sender:
+                counts[at + 3] += count
+
+    def _note(self, peer: int, source: int, items: list[Any]) -> None:
+        held = self.held.get(peer)
+        if held is None:
+            held = self.held[peer] = set()
+        held.update([(source, item) for item in items])
+
+    def lacks(self, peer: int, source: int, items: list[Any]) -> list[Any]:
+        held = self.held.get(peer)
+        if not held:
+            return list(items)
+        return [item for item in items if (source, item) not in held]
+
+    def receive(self, sender: int, source: int, items: list[Any]) -> list[Any]:
+        mine = self._held
+        pairs = [(source, item) for item in items]
+        new = []
+        for pair in pairs:
+            if pair not in mine:
+                self._keep(source, pair[1], sender)
+                new.append(pair[1])
+        held = self.held.get(sender)
+        if held is None:
+            self.held[sender] = set(pairs)
+        else:
+            held.update(pairs)
+        at = self._rows.get((source, self.me))
+        if at is None:
+            self._new_row(source, self.me, len(items))
+        else:
+            self._counts[at + 2] += len(items)
+        if new:
+            self._more(source, len(new), sender)
+        return new
+
+    def outgoing(self, peer: int) -> list[tuple[int, list[Any], str]]:
+        out = []
+        rows, clean, counts = self._rows, self._clean, self._counts
+        held = self.held.get(peer) or ()
+        for source, entries in self._by_source.items():
+            if source == peer:
+                continue
+            at = rows.get((source, peer))
+            if at is None:  # rules 1 and 2: all of it that the peer lacks
+                start = clean.get((peer, source), 0)
+                if start == len(entries):
+                    continue
+                items = [item for item, via in entries[start:] if via != peer and (source, item) not in held]
+                if not items:
+                    clean[(peer, source)] = len(entries)
+                    continue
+                out.append((source, items, "new"))
+                continue
+            pending = counts[at + 3]
+            if pending <= 0:
+                continue
+            tail = []
+            for item, via in reversed(entries):  # rule 3: the last ``pending`` items not from the peer
+                if via != peer:
+                    tail.append(item)
+                    if len(tail) == pending:
+                        break
+            items = [item for item in reversed(tail) if (source, item) not in held]
+            if not items:
+                counts[at + 3] = 0  # the peer holds all of it already: nothing is pending
+                continue
+            out.append((source, items, "pending"))
+        return out
+
+    def sent(self, peer: int, source: int, items: list[Any]) -> None:
+        at = self._rows.get((source, peer))
+        if at is None:
+            self._new_row(source, peer, len(items))
+        else:
+            counts = self._counts
+            counts[at + 2] += len(items)
+            counts[at + 3] = 0
+        self._note(peer, source, items)
+
+    def unsent(self, peer: int, source: int) -> list[Any]:
+        # what went to the peer, the peer holds (sent notes it): its holdings decide
+        held = self.held.get(peer) or ()
+        return [item for item, via in self._by_source.get(source, ()) if via != peer and (source, item) not in held]
+
+    def count_for(self, peer: int, source: int) -> int:
+        return len(self._by_source.get(source, ()))
 
 
 @dataclass(eq=False)
@@ -97,6 +256,8 @@ class Scout(AgentState):
     horizon: int = 0                                           # cells around it whose data it keeps (0: all)
     sent_bytes: int = 0
     frames: int = 0
+    _near_at: int = field(default=-1, repr=False)                # the cell _near_cells was made for
+    _near_cells: frozenset = field(default=frozenset(), repr=False)
 
     def __post_init__(self) -> None:
         AgentState.__init__(self)
@@ -202,12 +363,12 @@ class Scout(AgentState):
                     continue
                 self.asked.add((peer, message.source))
             else:
-                self.history.sent(address, message.source, list(message.vertices))
+                self.history.sent(address, message.source, message.vertices)
             self._queue(peer, message)
 
     def _queue(self, peer: str, message: Message) -> None:
         box = self.outbox.setdefault(peer, [])
-        box.append((message.code, message.source, message.count, message.final, list(message.vertices)))
+        box.append((message.code, message.source, message.count, message.final, tuple(message.vertices)))
         if len(box) == 1 and sum(1 for b in self.outbox.values() if b) == 1:
             self.touch("outbox")  # the outbox was empty: the guards' answer changes
 
@@ -220,6 +381,18 @@ class Scout(AgentState):
         self.sent_bytes += size
         self.frames += 1
         return {"to": to, "size": size, "from": self.address}
+
+    def _near(self) -> frozenset:
+        """The maze's cells within ``horizon`` rows and columns of where the robot is
+        (made again only when it has moved on)."""
+        if self._near_at != self.here:
+            cols, reach = self.cols, self.horizon
+            row, col = divmod(self.here, cols)
+            first, last = max(0, col - reach), min(cols, col + reach + 1)
+            self._near_cells = frozenset(chain.from_iterable(
+                range(r * cols + first, r * cols + last) for r in range(max(0, row - reach), min(self.rows, row + reach + 1))))
+            self._near_at = self.here
+        return self._near_cells
 
     def receive(self, sender: str, address: int, packet: tuple) -> int:
         """One packet from a neighbour; returns the number of cells new to this robot."""
@@ -238,13 +411,13 @@ class Scout(AgentState):
                 history.sent(address, source, chosen)
                 self._queue(sender, Message(2, source, history.count(source), self.address, address, list(chosen)))
             return 0
-        items = [tuple(i) for i in items]
         if self.horizon:  # a robot keeps (and passes on) the map around it only
-            row, col = divmod(self.here, self.cols)
-            reach = self.horizon
-            items = [i for i in items if abs(i[0] // self.cols - row) <= reach and abs(i[0] % self.cols - col) <= reach]
+            near = self._near()
+            items = [tuple(i) for i in items if i[0] in near]
             if not items:
                 return 0
+        else:
+            items = [tuple(i) for i in items]
         new = 0
         for item in history.receive(address, source, items):
             cell, bits = item[0], item[3]

@@ -250,6 +250,8 @@ class RadioIndex:
         self.method = method
         self.radius = model.range(threshold_dbm)
         self._walls: dict[tuple, int] = {}
+        # the k-d tree (scipy's, imported now: at the first query it would cost that query)
+        self._tree_class = _kdtree() if method in ("auto", "kdtree") else None
         #: Ray-tested candidate pairs so far (the cost the index saves is the rest).
         self.tested = 0
 
@@ -266,7 +268,7 @@ class RadioIndex:
         it once for all the radios asking while nothing moves."""
         import numpy as np
 
-        tree = _kdtree()
+        tree = self._tree_class
         if tree is None or self.method not in ("auto", "kdtree"):
             return None
         return tree(np.asarray(points, dtype=float).reshape(-1, 2))
@@ -299,26 +301,27 @@ class RadioIndex:
         rssi = m.tx_power_dbm - m.reference_loss_db - 10.0 * m.exponent * np.log10(np.maximum(d, m.min_distance))
         if self.world is None or not self.wall_db > 0:
             return rssi >= self.threshold_dbm
+        # only the pairs' own points: a radio asking alone has a few candidates among many points
+        at_a, at_b = pts[pairs[:, 0]], pts[pairs[:, 1]]
         if self.wall_cell:
             c = self.wall_cell
-            at = (np.floor(pts / c) + 0.5) * c
-        else:
-            at = pts
+            at_a, at_b = (np.floor(at_a / c) + 0.5) * c, (np.floor(at_b / c) + 0.5) * c
         # a place to the centimetre as one integer (within 10 km: 2e6 cm a side)
-        cm = np.round(at * 100.0).astype(np.int64) + 1_000_000
-        place = cm[:, 0] * 4_000_000 + cm[:, 1]
-        a, b = place[pairs[:, 0]], place[pairs[:, 1]]
+        cm_a = np.round(at_a * 100.0).astype(np.int64) + 1_000_000
+        cm_b = np.round(at_b * 100.0).astype(np.int64) + 1_000_000
+        a, b = cm_a[:, 0] * 4_000_000 + cm_a[:, 1], cm_b[:, 0] * 4_000_000 + cm_b[:, 1]
         low, high = np.minimum(a, b), np.maximum(a, b)
         keys = list(zip(low.tolist(), high.tolist()))
         cache = self._walls
-        unknown: dict[tuple, tuple] = {}
-        for k, key in enumerate(keys):
-            if key not in cache and key not in unknown:
-                unknown[key] = (at[pairs[k, 0]], at[pairs[k, 1]])
-        if unknown:
+        missing = [k for k, key in enumerate(keys) if key not in cache]
+        if missing:
+            unknown: dict[tuple, tuple] = {}
+            for k in missing:
+                if keys[k] not in unknown:
+                    unknown[keys[k]] = (at_a[k], at_b[k])
             self.tested += len(unknown)
             counted = walls_along(self.world, [a for a, _ in unknown.values()], [b for _, b in unknown.values()],
                                   z=self.z)
             cache.update(zip(unknown, counted))
-        walls = np.array([cache[k] for k in keys], dtype=float)
+        walls = np.fromiter(map(cache.__getitem__, keys), dtype=float, count=len(keys))
         return rssi - walls * self.wall_db >= self.threshold_dbm

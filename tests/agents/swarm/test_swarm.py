@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from petriflow.agents.comm.framework import History
+from petriflow.agents.comm.framework import History, plan
 from petriflow.agents.swarm.agent import OPEN, Scout, SwarmHistory
 from petriflow.agents.swarm.nets import build, world
 from petriflow.analysis.report import check_net
@@ -53,6 +53,44 @@ def test_the_swarm_history_follows_seed_000s_rules_exactly():
             indexed.sent(peer, source, items)
         assert plain.rows == indexed.rows
         assert plain.outgoing(peer) == indexed.outgoing(peer)
+
+
+def test_the_swarm_history_plans_what_seed_000s_plans_over_long_exchanges():
+    """Algorithm 1 over both histories, for every peer after every operation: the same
+    packets, the same rows, what each peer holds the same (the shortcuts the swarm's
+    history takes must not show)."""
+    rng = random.Random(11)
+    plain, indexed = History(1), SwarmHistory(1)
+    peers = range(2, 9)
+    for step in range(1500):
+        kind = rng.random()
+        peer, source = rng.choice(peers), rng.randint(1, 8)
+        if kind < 0.2:
+            item = (rng.randint(0, 80), 0.5, 1.5, rng.randint(0, 15))
+            assert plain.add_own(item) == indexed.add_own(item)
+        elif kind < 0.5:
+            items = [(rng.randint(0, 80), 0.5, 1.5, rng.randint(0, 15)) for _ in range(rng.randint(1, 6))]
+            assert plain.receive(peer, source, items) == indexed.receive(peer, source, items)
+        elif kind < 0.75:  # a plan goes out as Algorithm 1 says, and the items sent are noted
+            planned = [(m.code, m.source, m.count, m.vertices) for m in plan(plain, peer)]
+            assert planned == [(m.code, m.source, m.count, m.vertices) for m in plan(indexed, peer)]
+            for code, src, _, vertices in planned:
+                if code == 3:
+                    plain.sent(peer, src, list(vertices))
+                    indexed.sent(peer, src, list(vertices))
+        else:  # a request answered
+            chosen = plain.unsent(peer, source)[:rng.randint(1, 4)]
+            assert chosen == indexed.unsent(peer, source)[:len(chosen)]
+            if chosen:
+                plain.sent(peer, source, chosen)
+                indexed.sent(peer, source, chosen)
+        assert plain.rows == indexed.rows
+        assert plain.held == indexed.held
+        for other in peers:
+            for src in range(1, 9):
+                assert (plain.pending(other, src), plain.sent_count(other, src), plain.count_for(other, src)) == \
+                    (indexed.pending(other, src), indexed.sent_count(other, src), indexed.count_for(other, src))
+    assert plain.data == indexed.data
 
 
 def _exchange(a: Scout, b: Scout, rounds: int = 4) -> None:
