@@ -899,23 +899,40 @@ class ZigbeeMedium(BusMedium):
         since = now - _CCA
         self._recent = [t for t in self._recent if t.end > since]
 
-    def _transmit(self, module: int) -> None:
+    def _transmission(self, frame: Frame) -> Transmission:
+        """``frame`` sent from now, for its airtime at the air bitrate."""
         now = self.clock.now
-        frame = self._queues[module][0]
         bits = self.bus.frame_bits(frame)
-        transmission = Transmission(frame, now, now + bits / self.bus.air_bitrate, bits)
+        return Transmission(frame, now, now + bits / self.bus.air_bitrate, bits)
+
+    def _put_on_air(self, transmission: Transmission) -> None:
+        """Start ``transmission``: on the air with another, both are garbled now; its
+        end is scheduled (:meth:`_end`)."""
         self._active.append(transmission)
         self._started(transmission)
-        if len(self._active) > 1:  # on the air with another: both garbled now
+        if len(self._active) > 1:
             for other in self._active:
                 self._garble(other)
         self.clock.at(transmission.end, self._end, transmission, rank=MEDIUM)
 
-    def _end(self, transmission: Transmission) -> None:
+    def _take_off_air(self, transmission: Transmission) -> float:
+        """``transmission`` has ended: off the air, kept a CCA for carrier sense; the time now."""
         now = self.clock.now
         self._active.remove(transmission)
         self._forget(now)
         self._recent.append(transmission)
+        return now
+
+    @staticmethod
+    def _spacing(transmission: Transmission) -> float:
+        """The interframe spacing after ``transmission`` (long after a long MAC frame)."""
+        return _LIFS if transmission.bits // 8 - 6 > _MAX_SIFS_FRAME_BYTES else _SIFS
+
+    def _transmit(self, module: int) -> None:
+        self._put_on_air(self._transmission(self._queues[module][0]))
+
+    def _end(self, transmission: Transmission) -> None:
+        now = self._take_off_air(transmission)
         frame = transmission.frame
         self._ended(transmission)
         if not transmission.garbled:
@@ -927,9 +944,7 @@ class ZigbeeMedium(BusMedium):
                     self.clock.at(now + out, self._arrive, frame, module, rank=MEDIUM)
                 else:
                     self._lost(Lost(frame, module, Loss.RADIO, now))
-        mac_bytes = transmission.bits // 8 - 6
-        spacing = _LIFS if mac_bytes > _MAX_SIFS_FRAME_BYTES else _SIFS
-        self._next(frame.sender, now + spacing)
+        self._next(frame.sender, now + self._spacing(transmission))
 
     def _next(self, module: int, when: float) -> None:
         """The radio is done with its head frame; it may take the next one at ``when``."""
@@ -1169,30 +1184,19 @@ class ZigbeeNetworkMedium(ZigbeeMedium):
         transmission.garbled = True  # other copies may still arrive: decided at the end
 
     def _transmit(self, module: int) -> None:
-        now = self.clock.now
         broadcast, kind = self._radio[module][0]
-        bits = self.bus.frame_bits(broadcast.frame)
-        transmission = Transmission(broadcast.frame, now, now + bits / self.bus.air_bitrate, bits)
+        transmission = self._transmission(broadcast.frame)
         self._on_air[transmission] = (module, broadcast, kind)
-        self._active.append(transmission)
-        self._started(transmission)
-        if len(self._active) > 1:
-            for other in self._active:
-                self._garble(other)
-        self.clock.at(transmission.end, self._end, transmission, rank=MEDIUM)
+        self._put_on_air(transmission)
 
     def _end(self, transmission: Transmission) -> None:
-        now = self.clock.now
-        self._active.remove(transmission)
-        self._forget(now)
-        self._recent.append(transmission)
+        now = self._take_off_air(transmission)
         node, broadcast, kind = self._on_air.pop(transmission)
         if not transmission.garbled:
             broadcast.intact = True
         self._ended(transmission)
         self._after(node, broadcast, kind, transmission)
-        mac_bytes = transmission.bits // 8 - 6
-        self._next(node, now + (_LIFS if mac_bytes > _MAX_SIFS_FRAME_BYTES else _SIFS))
+        self._next(node, now + self._spacing(transmission))
 
     def _after(self, node: int, broadcast: _Broadcast, kind: str, transmission: Transmission | None) -> None:
         """``node``'s transmission of ``broadcast`` is over (``None``: CSMA/CA gave up)."""
