@@ -17,14 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-try:
-    import numba
+from petriflow.analysis._numba import njit
 
-    _cache = __name__ == "petriflow.analysis._farkas"
-    _jit = numba.njit(cache=_cache, nogil=True)
-except ImportError:  # pragma: no cover - exercised only where numba is missing
-    def _jit(function):
-        return function
+_jit = njit(__name__)
 
 __all__ = ["OK", "OVER_BUDGET", "FULL", "adjacent_pairs", "popcounts"]
 

@@ -16,14 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
-try:
-    import numba
+from petriflow.analysis._numba import njit
 
-    _cache = __name__ == "petriflow.analysis._symkernel"
-    _jit = numba.njit(cache=_cache, nogil=True)
-except ImportError:  # pragma: no cover - exercised only where numba is missing
-    def _jit(function):
-        return function
+_jit = njit(__name__)
 
 __all__ = ["canonicalise", "explore", "rehash", "row_hash"]
 
