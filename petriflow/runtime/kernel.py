@@ -138,18 +138,19 @@ class Kernel:
         ``key`` orders the polls of one tick (default: scheduling order); applies keep
         the order they were scheduled in.
         """
-        bucket = self._bucket(max(tick, self.tick))
-        self._order += 1
+        tick = max(tick, self.tick)
         if event.phase == POLL:
-            bucket[0].append((self._order if key is None else key, self._order, event))
-        else:
-            self.pending += 1
-            bucket[1].append(event)
+            self.schedule_poll(tick, event, self._order + 1 if key is None else key)
+            return
+        bucket = self._bucket(tick)
+        self._order += 1
+        self.pending += 1
+        bucket[1].append(event)
 
     def schedule_poll(self, tick: int, event: Scheduled, key: int) -> None:
-        """Schedule a :data:`POLL` ``event`` at ``tick`` (after the current tick), its
-        polls of that tick ordered by ``key`` (what :meth:`schedule` does, for the
-        commonest event of a run)."""
+        """Schedule a :data:`POLL` ``event`` at ``tick`` (not before the current tick),
+        ordered among the polls of that tick by ``key``: :meth:`schedule` for the
+        commonest event of a run, without its checks."""
         bucket = self._buckets.get(tick)
         if bucket is None:
             bucket = self._bucket(tick)

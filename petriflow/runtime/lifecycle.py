@@ -126,9 +126,7 @@ class ActionRunner:
             kernel.schedule(tick, Deadline(firing, number), key=number)
         wake = action.wake_at
         if wake is not None and not action.needs_world and wake > now + 1e-12:
-            tick = kernel.ticks_at(wake)  # first poll when it asked
-            firing.wake = tick = tick if tick > kernel.tick else kernel.tick + 1
-            kernel.schedule_poll(tick, firing, number)
+            self._wake(firing, max(kernel.tick + 1, kernel.ticks_at(wake)))  # first poll when it asked
         else:
             self.poll(firing)
 
@@ -174,9 +172,7 @@ class ActionRunner:
             if status is not Status.FAILED:
                 ctx.reason = f"poll() returned {status!r}, not a Status"
             outcome = Outcome.FAILED
-        firing.running = False  # (what _stop does, inline)
-        del self.running[firing.index]
-        self.enabled.dirty.add(firing.index)
+        self._stop(firing)
         self.finish(firing.number, firing.index, ctx, outcome)
 
     def _drive_cancel(self, firing: Firing, ctx: ActionContext, action: Action, tick: int) -> None:
@@ -189,9 +185,7 @@ class ActionRunner:
         if not done:
             self._wake(firing, tick + 1)
             return
-        firing.running = False  # (what _stop does, inline)
-        del self.running[firing.index]
-        self.enabled.dirty.add(firing.index)
+        self._stop(firing)
         self.finish(firing.number, firing.index, ctx, outcome)
 
     def _stop(self, firing: Firing) -> None:
