@@ -41,7 +41,7 @@ JSON_DEPTH = 64
 PNML_PAGE_DEPTH = 100
 #: Entries of the dense matrix the P- and T-invariant search starts from
 #: (places x (places + transitions)); beyond it the invariants are skipped with a note.
-INVARIANT_CELLS = 2_000_000
+INVARIANT_CELLS = 16_000_000
 #: Entries (places x transitions) up to which the reachability report computes the
 #: incidence matrix's basis (elimination is cubic); beyond it the basis is skipped.
 BASIS_ENTRIES = 1_000_000

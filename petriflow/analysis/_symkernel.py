@@ -20,7 +20,7 @@ from petriflow.analysis._numba import njit
 
 _jit = njit(__name__)
 
-__all__ = ["canonicalise", "explore", "rehash", "row_hash"]
+__all__ = ["canonicalise", "explore", "explore_stubborn", "rehash", "row_hash"]
 
 OK, GROW, LIMIT, REHASH, OVERFLOW = 0, 1, 2, 3, 4
 
@@ -222,6 +222,219 @@ def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, paren
                 edge_row[ne] = t
                 ne += 1
         enabled_count[head] = count
+        head += 1
+        offsets[head] = ne
+    counters[0], counters[1], counters[2] = n, head, ne
+    if n > max_states:
+        return LIMIT
+    return OK
+
+
+@_jit
+def _closure(row, seed, pre_p, pre_w, pre_n, en_mask, stamp, inside, mark, stack,
+             conf_ptr, conf_idx, inc_ptr, inc_idx, limit, work_cap, members):
+    """The D1/D2 closure of ``seed`` in the marking ``row``: its enabled members go to
+    ``members``; returns how many, or -1 once that reaches ``limit`` or the work
+    (relations followed) exceeds ``work_cap``. ``inside[u] == mark`` marks the set."""
+    inside[seed] = mark
+    stack[0] = seed
+    top = 1
+    n_in = 0
+    work = 0
+    while top > 0:
+        top -= 1
+        t = stack[top]
+        if en_mask[t] == stamp:
+            members[n_in] = t
+            n_in += 1
+            if n_in >= limit:
+                return -1
+            lo = conf_ptr[t]
+            hi = conf_ptr[t + 1]
+            work += hi - lo
+            for i in range(lo, hi):
+                u = conf_idx[i]
+                if inside[u] != mark:
+                    inside[u] = mark
+                    stack[top] = u
+                    top += 1
+        else:
+            # D2: one input place short of tokens (its scapegoat), the one with the
+            # fewest producers outside the set; all its producers join
+            best_p = -1
+            best_c = 1 << 62
+            for k in range(pre_n[t]):
+                p = pre_p[t, k]
+                if row[p] < pre_w[t, k]:
+                    c = 0
+                    for i in range(inc_ptr[p], inc_ptr[p + 1]):
+                        if inside[inc_idx[i]] != mark:
+                            c += 1
+                    work += inc_ptr[p + 1] - inc_ptr[p]
+                    if c < best_c:
+                        best_c = c
+                        best_p = p
+                        if c == 0:
+                            break
+            for i in range(inc_ptr[best_p], inc_ptr[best_p + 1]):
+                u = inc_idx[i]
+                if inside[u] != mark:
+                    inside[u] = mark
+                    stack[top] = u
+                    top += 1
+        if work > work_cap:
+            return -1
+    return n_in
+
+
+@_jit
+def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_row, parent,
+                     parent_row, enabled_count, seen_by, fired, seen_enabled,
+                     pre_p, pre_w, pre_n, post_p, post_w, post_n,
+                     group_k, group_b, group_off, blocks, named_g, named_a, named_n,
+                     moves, conf_ptr, conf_idx, inc_ptr, inc_idx, seed_order,
+                     n_seeds, work_cap, max_states):
+    """:func:`explore` restricted to stubborn sets, for nets without reset arcs.
+
+    Only the rows that change the marking (``moves``) take part: ``enabled_count`` is
+    the number of them enabled (0: no marking but itself is reachable from this one).
+    Per state, up to ``n_seeds`` enabled rows (in ``seed_order``) are tried as seeds of
+    a D1/D2 closure (``conf_*``: the rows that can disable a row or be disabled by it;
+    ``inc_*``: per place, the rows that raise its count), each within ``work_cap``
+    relations; the smallest is fired, every member of it. With no closure smaller than
+    all enabled rows, every enabled row is stubborn and only one per orbit of the
+    marking's stabiliser is fired, as in :func:`explore`. ``seen_enabled`` marks every
+    row enabled in some explored marking (moving or not)."""
+    n_cols = rows.shape[1]
+    n_rows = pre_n.shape[0]
+    row = np.empty(n_cols, dtype=np.uint8)
+    scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
+    n_groups = group_k.shape[0]
+    max_k = 1
+    for g in range(n_groups):
+        max_k = max(max_k, group_k[g])
+    run = np.zeros((max(1, n_groups), max_k), dtype=np.int64)
+    en_mask = np.full(n_rows, -1, dtype=np.int64)
+    en_list = np.empty(n_rows, dtype=np.int64)
+    inside = np.full(n_rows, -1, dtype=np.int64)
+    stack = np.empty(n_rows + 1, dtype=np.int64)
+    members = np.empty(n_rows + 1, dtype=np.int64)
+    chosen = np.empty(n_rows + 1, dtype=np.int64)
+    mark = 0
+    n = counters[0]
+    head = counters[1]
+    ne = counters[2]
+    while head < n:
+        if n + n_rows > rows.shape[0] or ne + n_rows > edge_target.shape[0]:
+            counters[0], counters[1], counters[2] = n, head, ne
+            return GROW
+        if 2 * (n + n_rows) > table.shape[0]:
+            counters[0], counters[1], counters[2] = n, head, ne
+            return REHASH
+        if n > max_states:
+            counters[0], counters[1], counters[2] = n, head, ne
+            return LIMIT
+        offsets[head] = ne
+        state = rows[head]
+        n_en = 0
+        for t in range(n_rows):
+            enabled = True
+            for k in range(pre_n[t]):
+                if state[pre_p[t, k]] < pre_w[t, k]:
+                    enabled = False
+                    break
+            if enabled:
+                seen_enabled[t] = True
+                if moves[t]:
+                    en_mask[t] = head
+                    en_list[n_en] = t
+                    n_en += 1
+        enabled_count[head] = n_en
+        if n_en == 0:
+            head += 1
+            offsets[head] = ne
+            continue
+        n_chosen = 0
+        tries = 0
+        for i in range(seed_order.shape[0]):
+            t = seed_order[i]
+            if en_mask[t] != head:
+                continue
+            tries += 1
+            mark += 1
+            limit = n_en if n_chosen == 0 else n_chosen
+            got = _closure(state, t, pre_p, pre_w, pre_n, en_mask, head, inside, mark, stack,
+                           conf_ptr, conf_idx, inc_ptr, inc_idx, limit, work_cap, members)
+            if got > 0:
+                n_chosen = got
+                for j in range(got):
+                    chosen[j] = members[j]
+                if got == 1:
+                    break
+            if tries >= n_seeds:
+                break
+        full = n_chosen == 0
+        if full:
+            # all enabled rows, one per orbit of the stabiliser
+            for g in range(n_groups):
+                b = group_b[g]
+                off = group_off[g]
+                run[g, 0] = 0
+                for a in range(1, group_k[g]):
+                    same = True
+                    for j in range(b):
+                        if state[blocks[off + a * b + j]] != state[blocks[off + (a - 1) * b + j]]:
+                            same = False
+                            break
+                    run[g, a] = run[g, a - 1] if same else a
+            for j in range(n_en):
+                t = en_list[j]
+                representative = True
+                for k in range(named_n[t]):
+                    g = named_g[t, k]
+                    a = named_a[t, k]
+                    start = run[g, a]
+                    expected = start
+                    for q in range(k):
+                        if named_g[t, q] == g and run[g, named_a[t, q]] == start:
+                            expected += 1
+                    if a != expected:
+                        representative = False
+                        break
+                if representative:
+                    chosen[n_chosen] = t
+                    n_chosen += 1
+        for j in range(n_chosen):
+            t = chosen[j]
+            fired[t] = True
+            for c in range(n_cols):
+                row[c] = state[c]
+            for k in range(pre_n[t]):
+                row[pre_p[t, k]] -= pre_w[t, k]
+            for k in range(post_n[t]):
+                value = np.int64(row[post_p[t, k]]) + post_w[t, k]
+                if value > 255:
+                    counters[0], counters[1], counters[2] = n, head, ne
+                    return OVERFLOW
+                row[post_p[t, k]] = value
+            canonicalise(row, group_k, group_b, group_off, blocks, scratch)
+            h = row_hash(row)
+            found, slot = _find(rows, hashes, table, row, h, n_cols)
+            if found < 0:
+                found = n
+                for c in range(n_cols):
+                    rows[n, c] = row[c]
+                hashes[n] = h
+                table[slot] = n + 1
+                parent[n] = head
+                parent_row[n] = t
+                seen_by[n] = -1
+                n += 1
+            if seen_by[found] != head:
+                seen_by[found] = head
+                edge_target[ne] = found
+                edge_row[ne] = t
+                ne += 1
         head += 1
         offsets[head] = ne
     counters[0], counters[1], counters[2] = n, head, ne

@@ -78,7 +78,7 @@ def check_with_method(net: Net, method: str, **budgets) -> dict[str, Any]:
             notes.append(f"symmetry reduction not used ({why}): explicit state space")
     if result is None and method == "stubborn":
         result = report.check_net(net, method=None, **dict(budgets, max_states=1))
-        result["error"] = ("--method stubborn explores no state space: deadlocks by stubborn sets,"
+        result["error"] = ("--method stubborn explores no full state space: deadlocks (and a WF-net's soundness) by stubborn sets,"
                            " the properties they do not preserve undecided")
         result["partial"] = None
         result["undecided"] = [k for k in ("states", "edges", "live", "reversible", "dead_transitions",
@@ -116,8 +116,12 @@ def check_with_method(net: Net, method: str, **budgets) -> dict[str, Any]:
         _liveness_fallback(net, start, result, methods, notes, budgets)
     if structure.is_wf_net and method in ("auto", "structural"):
         _structural(net, result, methods, notes)
-    if method == "stubborn" or (method == "auto" and not result["complete"]
-                                and result.get("deadlock_free") is None):
+    reduced = structure.is_wf_net and start == Marking({structure.source: 1})
+    if reduced and (method == "stubborn" or (method == "auto" and not result["complete"]
+                                             and result.get("sound") is None)):
+        _reduced(net, result, methods, notes, budgets)
+    elif method == "stubborn" or (method == "auto" and not result["complete"]
+                                  and result.get("deadlock_free") is None):
         _stubborn(net, structure, start, result, methods, notes, budgets)
     if notes:
         result["method_notes"] = notes
@@ -235,6 +239,46 @@ def _stubborn(net: Net, structure, start, result: dict, methods: dict, notes: li
     for key in ("deadlock_free", "sound"):
         if result.get(key) is not None and key in result.get("undecided", []):
             result["undecided"].remove(key)
+
+
+def _reduced(net: Net, result: dict, methods: dict, notes: list[str], budgets: dict) -> None:
+    """Soundness on the stubborn-set graph up to symmetry, when nothing else decided it."""
+    from petriflow.analysis.reduced_soundness import reduced_soundness
+
+    covered = (result.get("invariants") or {}).get("covered_by_p_semiflows")
+    found = reduced_soundness(net, max_states=budgets.get("max_states") or 2_000_000,
+                              covered=covered if covered is not None else None)
+    result["reduced"] = {"states": found.states, "edges": found.edges, "groups": found.groups,
+                         "complete": found.complete, "sound": found.sound,
+                         "option_to_complete": found.option_to_complete,
+                         "proper_completion": found.proper_completion,
+                         "no_dead_transitions": found.no_dead_transitions,
+                         "transitions_not_seen_enabled": found.unseen[:100]}
+    result["states_visited"][found.method] = found.states
+    where = (f"stubborn sets up to permutations of {', '.join(str(len(g)) for g in found.groups)}"
+             f" agents" if found.groups else "stubborn sets")
+    result.setdefault("violations", []).extend(v.to_dict() for v in found.violations)
+    if found.sound is None:
+        notes.append(f"soundness not decided on the reduced graph ({where}, {found.states:,}"
+                     f" markings): {found.reason}")
+        return
+    result["sound"] = found.sound
+    methods["sound"] = found.method
+    if found.proper_completion:
+        result["bounded"] = True
+        methods["bounded"] = "P-semiflows"
+    if found.no_dead_transitions and found.option_to_complete:
+        result["dead_transitions"] = []
+        methods["dead_transitions"] = found.method
+    if found.option_to_complete:
+        result["stuck_markings"] = 0
+        result["deadlock_free"] = False      # the final marking is reachable and enables nothing
+        methods["deadlock_free"] = found.method
+    for key in ("sound", "bounded", "dead_transitions", "deadlock_free"):
+        if result.get(key) is not None and key in (result.get("undecided") or []):
+            result["undecided"].remove(key)
+    notes.append(f"soundness: {'sound' if found.sound else 'not sound'} on the reduced graph"
+                 f" ({where}, {found.states:,} markings)")
 
 
 # Symmetry ----------------------------------------------------------------------------

@@ -47,12 +47,90 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy as np
+
 from petriflow.analysis.reachability import DEFAULT_MAX_STATES, StateSpaceLimit
 from petriflow.engine import CompiledNet
 from petriflow.marking import Marking
 from petriflow.net import Net
 
-__all__ = ["StubbornResult", "reaches_marking", "stubborn_deadlocks"]
+__all__ = ["Relations", "StubbornResult", "reaches_marking", "relations", "stubborn_deadlocks"]
+
+#: Seeds tried per marking by the compiled search (:func:`relations`), and the most
+#: relations one closure may follow before it is given up (then every enabled row is
+#: taken: always stubborn).
+COMPILED_SEEDS = 4
+COMPILED_WORK_CAP = 4096
+
+
+@dataclass
+class Relations:
+    """The static relations of the compiled stubborn-set search, as arrays.
+
+    Only rows that change the marking (``moves``) take part: a row whose preset equals
+    its postset leads back to the marking it fires in.
+
+    Attributes:
+        moves: per row, whether firing it changes the marking.
+        conf_ptr, conf_idx: per moving row ``t``, in compressed-row form, the moving rows
+            that can disable ``t`` (lower the count of one of its input places) or that
+            ``t`` can disable (it lowers the count of one of their input places): an
+            enabled member of a stubborn set brings them all in (D1).
+        inc_ptr, inc_idx: per place, the moving rows that raise its count: a disabled
+            member brings in those of one input place short of tokens (D2).
+        seed_order: the moving rows, fewest D1 relations first (the seeds tried first).
+        seeds, work_cap: :data:`COMPILED_SEEDS`, :data:`COMPILED_WORK_CAP`.
+    """
+
+    moves: np.ndarray
+    conf_ptr: np.ndarray
+    conf_idx: np.ndarray
+    inc_ptr: np.ndarray
+    inc_idx: np.ndarray
+    seed_order: np.ndarray
+    seeds: int = COMPILED_SEEDS
+    work_cap: int = COMPILED_WORK_CAP
+
+
+def relations(compiled: CompiledNet) -> Relations:
+    """The :class:`Relations` of a net without reset arcs (arc weights taken into
+    account: a row that puts back what it takes from a place neither lowers nor raises
+    it)."""
+    n_rows = len(compiled.transitions)
+    n_places = len(compiled.places)
+    net_effect = compiled.post_matrix - compiled.pre_matrix
+    moves = (net_effect != 0).any(axis=1) if n_rows else np.zeros(0, dtype=bool)
+    needers: list[list[int]] = [[] for _ in range(n_places)]
+    lowerers: list[list[int]] = [[] for _ in range(n_places)]
+    raisers: list[list[int]] = [[] for _ in range(n_places)]
+    for t in np.flatnonzero(moves).tolist():
+        for p, _ in compiled.pre[t]:
+            needers[p].append(t)
+        for p in np.flatnonzero(net_effect[t] < 0).tolist():
+            lowerers[p].append(t)
+        for p in np.flatnonzero(net_effect[t] > 0).tolist():
+            raisers[p].append(t)
+    conf: list[list[int]] = [[] for _ in range(n_rows)]
+    for t in np.flatnonzero(moves).tolist():
+        found: set[int] = set()
+        for p, _ in compiled.pre[t]:
+            found.update(lowerers[p])
+        for p in np.flatnonzero(net_effect[t] < 0).tolist():
+            found.update(needers[p])
+        found.discard(t)
+        conf[t] = sorted(found)
+    conf_ptr, conf_idx = _csr(conf)
+    inc_ptr, inc_idx = _csr(raisers)
+    order = sorted(np.flatnonzero(moves).tolist(), key=lambda t: (len(conf[t]), t))
+    return Relations(moves.astype(np.bool_), conf_ptr, conf_idx, inc_ptr, inc_idx,
+                     np.asarray(order, dtype=np.int64))
+
+
+def _csr(lists: list[list[int]]) -> tuple[np.ndarray, np.ndarray]:
+    ptr = np.zeros(len(lists) + 1, dtype=np.int64)
+    ptr[1:] = np.cumsum([len(x) for x in lists])
+    idx = np.asarray([u for x in lists for u in x], dtype=np.int64)
+    return ptr, idx
 
 
 @dataclass

@@ -267,6 +267,9 @@ class SymmetricSpace:
         orbit: per state, the number of markings of its orbit (Python integers).
         complete: ``False`` when ``max_states`` stopped the exploration (the first
             ``expanded`` states then have all their edges).
+        stubborn: explored with stubborn sets (:func:`symmetric_graph`): the edges are
+            a reduced graph's, ``enabled_count`` counts the enabled rows that change the
+            marking, ``seen_enabled`` marks the rows enabled in an explored marking.
     """
 
     compiled: CompiledNet = field(repr=False)
@@ -281,6 +284,8 @@ class SymmetricSpace:
     fired: np.ndarray = field(repr=False)
     expanded: int
     complete: bool = True
+    seen_enabled: np.ndarray | None = field(default=None, repr=False)
+    stubborn: bool = False
     _orbit: list[int] | None = field(default=None, repr=False)
 
     @property
@@ -475,8 +480,16 @@ def transition_orbits(compiled: CompiledNet, groups: list[SymmetryGroup]) -> np.
 def symmetric_graph(net: Net, start: Mapping[str, int] | None = None, *,
                     groups: list[SymmetryGroup] | None = None,
                     max_states: int = DEFAULT_MAX_STATES,
-                    compiled: CompiledNet | None = None) -> SymmetricSpace:
+                    compiled: CompiledNet | None = None,
+                    stubborn: bool = False) -> SymmetricSpace:
     """Explore the canonical markings reachable from ``start``.
+
+    With ``stubborn``, each marking fires only a stubborn set of the rows that change
+    the marking (:func:`~petriflow.analysis.stubborn.relations`): the quotient of a
+    stubborn-set reduced graph, which keeps every deadlock and, from each of its
+    markings, whether a deadlock can be reached (docs/analysis.md); ``enabled_count``
+    then counts the enabled rows that change the marking, and ``seen_enabled`` marks
+    the rows enabled in some explored marking. The net must have no reset arcs.
 
     The net must be bounded with at most 255 tokens in a place (the caller proves
     boundedness first; a count beyond 255 raises :class:`SymmetryUnsupported`).
@@ -529,13 +542,28 @@ def symmetric_graph(net: Net, start: Mapping[str, int] | None = None, *,
     fired = np.zeros(len(compiled.transitions), dtype=np.bool_)
     named_g, named_a, named_n = _named(compiled, groups)
     counters = np.asarray([1, 0, 0], dtype=np.int64)
+    seen_enabled = np.zeros(len(compiled.transitions), dtype=np.bool_)
+    if stubborn:
+        if compiled.has_resets:
+            raise SymmetryUnsupported("stubborn sets need a net without reset arcs")
+        from petriflow.analysis.stubborn import relations
+        rel = relations(compiled)
     while True:
         with np.errstate(over="ignore"):     # the hash wraps on purpose (plain Python)
-            status = kernel.explore(rows, hashes, table, counters, offsets, edge_target, edge_row,
-                                    parent, parent_row, enabled_count, seen_by, fired,
-                                    pre_p, pre_w, pre_n, post_p, post_w, post_n,
-                                    reset_p, reset_n, group_k, group_b, group_off, blocks,
-                                    named_g, named_a, named_n, max_states)
+            if stubborn:
+                status = kernel.explore_stubborn(
+                    rows, hashes, table, counters, offsets, edge_target, edge_row, parent,
+                    parent_row, enabled_count, seen_by, fired, seen_enabled,
+                    pre_p, pre_w, pre_n, post_p, post_w, post_n, group_k, group_b,
+                    group_off, blocks, named_g, named_a, named_n, rel.moves, rel.conf_ptr,
+                    rel.conf_idx, rel.inc_ptr, rel.inc_idx, rel.seed_order, rel.seeds,
+                    rel.work_cap, max_states)
+            else:
+                status = kernel.explore(rows, hashes, table, counters, offsets, edge_target,
+                                        edge_row, parent, parent_row, enabled_count, seen_by,
+                                        fired, pre_p, pre_w, pre_n, post_p, post_w, post_n,
+                                        reset_p, reset_n, group_k, group_b, group_off, blocks,
+                                        named_g, named_a, named_n, max_states)
         if status == kernel.OK or status == kernel.LIMIT:
             break
         if status == kernel.OVERFLOW:
@@ -562,7 +590,8 @@ def symmetric_graph(net: Net, start: Mapping[str, int] | None = None, *,
     space = SymmetricSpace(compiled, groups, rows[:n].copy(), offsets[: head + 1].copy(),
                            edge_target[:ne].copy(), edge_row[:ne].copy(), parent[:n].copy(),
                            parent_row[:n].copy(), enabled_count[:n].copy(), fired,
-                           expanded=head, complete=head == n)
+                           expanded=head, complete=head == n, seen_enabled=seen_enabled,
+                           stubborn=stubborn)
     if not space.complete:
         # states beyond the expanded ones have no edges yet
         offsets_full = np.concatenate([space.edge_offsets,
