@@ -408,9 +408,12 @@ def reduction_cases(quick: bool) -> list[tuple[str, str, Callable[[], Net]]]:
         ("bidding-autonomous-20", "explicit", bidding(20, "autonomous")),
         ("bidding-autonomous-20", "auto", bidding(20, "autonomous")),
         ("bidding-random-20", "auto", bidding(20, "random")),
+        ("bidding-autonomous-20", "stubborn", bidding(20, "autonomous")),
     ]
     if not quick:
-        found += [("bidding-autonomous-100", "auto", bidding(100, "autonomous"))]
+        found += [("bidding-autonomous-100", "stubborn", bidding(100, "autonomous")),
+                  ("bidding-random-100", "stubborn", bidding(100, "random")),
+                  ("bidding-autonomous-100", "auto", bidding(100, "autonomous"))]
     return found if not quick else found[:3]
 
 

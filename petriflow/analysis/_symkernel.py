@@ -117,6 +117,97 @@ def rehash(hashes, n, table):
 
 
 @_jit
+def _runs(state, run, run_len, group_k, group_b, group_off, blocks):
+    """Runs of equal blocks of a canonical marking: ``run[g, a]`` the first agent of
+    agent ``a``'s run in group ``g``, ``run_len[g, a]`` the run's length."""
+    for g in range(group_k.shape[0]):
+        b = group_b[g]
+        off = group_off[g]
+        k = group_k[g]
+        run[g, 0] = 0
+        for a in range(1, k):
+            same = True
+            for j in range(b):
+                if state[blocks[off + a * b + j]] != state[blocks[off + (a - 1) * b + j]]:
+                    same = False
+                    break
+            run[g, a] = run[g, a - 1] if same else a
+        a = k - 1
+        while a >= 0:
+            first = run[g, a]
+            for x in range(first, a + 1):
+                run_len[g, x] = a + 1 - first
+            a = first - 1
+
+
+@_jit
+def _multiplicity(t, run, run_len, named_g, named_a, named_n):
+    """0 when row ``t`` is not the representative of its orbit under the marking's
+    stabiliser (each agent it names, in order, the lowest of its run not named before
+    it), else the number of rows of that orbit (all enabled or none)."""
+    size = 1
+    for k in range(named_n[t]):
+        g = named_g[t, k]
+        a = named_a[t, k]
+        start = run[g, a]
+        before = 0
+        for q in range(k):
+            if named_g[t, q] == g and run[g, named_a[t, q]] == start:
+                before += 1
+        if a != start + before:
+            return 0
+        size *= run_len[g, a] - before
+    return size
+
+
+@_jit
+def _enabled(state, t, pre_p, pre_w, pre_n):
+    for k in range(pre_n[t]):
+        if state[pre_p[t, k]] < pre_w[t, k]:
+            return False
+    return True
+
+
+@_jit
+def _successor(rows, hashes, table, parent, parent_row, seen_by, edge_target, edge_row,
+               row, scratch, head, t, n, ne, pre_p, pre_w, pre_n, post_p, post_w, post_n,
+               reset_p, reset_n, group_k, group_b, group_off, blocks):
+    """Fire ``t`` in state ``head``, store the canonical successor if new and the edge
+    if not yet there. Returns ``(n, ne, overflow)``."""
+    n_cols = rows.shape[1]
+    for c in range(n_cols):
+        row[c] = rows[head, c]
+    for k in range(pre_n[t]):
+        row[pre_p[t, k]] -= pre_w[t, k]
+    for k in range(reset_n[t]):
+        row[reset_p[t, k]] = 0
+    for k in range(post_n[t]):
+        value = np.int64(row[post_p[t, k]]) + post_w[t, k]
+        if value > 255:
+            return n, ne, True
+        row[post_p[t, k]] = value
+    canonicalise(row, group_k, group_b, group_off, blocks, scratch)
+    h = row_hash(row)
+    found, slot = _find(rows, hashes, table, row, h, n_cols)
+    if found < 0:
+        found = n
+        for c in range(n_cols):
+            rows[n, c] = row[c]
+        hashes[n] = h
+        table[slot] = n + 1
+        parent[n] = head
+        parent_row[n] = t
+        seen_by[n] = -1
+        n += 1
+    if seen_by[found] != head:
+        seen_by[found] = head
+        edge_target[ne] = found
+        edge_row[ne] = t
+        ne += 1
+    return n, ne, False
+
+
+@_jit
 def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, parent, parent_row,
             enabled_count, seen_by, fired,
             pre_p, pre_w, pre_n, post_p, post_w, post_n, reset_p, reset_n,
@@ -124,22 +215,21 @@ def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, paren
     """Expand states ``counters[1]`` .. while any are left; ``counters`` = ``[states,
     next state to expand, edges]`` is updated in place. Returns a status code.
 
-    Per state, every enabled row is counted (``enabled_count``: the out-degree of each
-    marking of the orbit), but only one row per orbit of the marking's stabiliser is
-    fired: agents with equal blocks are interchangeable there, so a row naming agents
-    ``a_1, a_2, ...`` (``named_g``/``named_a``, in the order they appear in its id) is
-    fired only when each ``a_k`` is the lowest agent of its run of equal blocks not named
-    before it. Each distinct successor is one edge (``seen_by`` deduplicates); ``fired``
-    marks the rows fired."""
-    n_cols = rows.shape[1]
+    In a canonical marking agents with equal blocks are interchangeable (its
+    stabiliser), so of each orbit of rows under it only the representative
+    (:func:`_multiplicity`) is tested and fired, and counted as many times as its orbit
+    has rows (``enabled_count``: the out-degree of each marking of the orbit). Each
+    distinct successor is one edge (``seen_by`` deduplicates); ``fired`` marks the rows
+    fired."""
     n_rows = pre_n.shape[0]
-    row = np.empty(n_cols, dtype=np.uint8)
+    row = np.empty(rows.shape[1], dtype=np.uint8)
     scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
     n_groups = group_k.shape[0]
     max_k = 1
     for g in range(n_groups):
         max_k = max(max_k, group_k[g])
     run = np.zeros((max(1, n_groups), max_k), dtype=np.int64)
+    run_len = np.ones((max(1, n_groups), max_k), dtype=np.int64)
     n = counters[0]
     head = counters[1]
     ne = counters[2]
@@ -154,73 +244,24 @@ def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, paren
             counters[0], counters[1], counters[2] = n, head, ne
             return LIMIT
         offsets[head] = ne
-        # runs of equal blocks: run[g, a] = the first agent of a's run
-        for g in range(n_groups):
-            b = group_b[g]
-            off = group_off[g]
-            run[g, 0] = 0
-            for a in range(1, group_k[g]):
-                same = True
-                for j in range(b):
-                    if rows[head, blocks[off + a * b + j]] != rows[head, blocks[off + (a - 1) * b + j]]:
-                        same = False
-                        break
-                run[g, a] = run[g, a - 1] if same else a
+        state = rows[head]
+        _runs(state, run, run_len, group_k, group_b, group_off, blocks)
         count = 0
         for t in range(n_rows):
-            enabled = True
-            for k in range(pre_n[t]):
-                if rows[head, pre_p[t, k]] < pre_w[t, k]:
-                    enabled = False
-                    break
-            if not enabled:
+            if not _enabled(state, t, pre_p, pre_w, pre_n):
                 continue
-            count += 1
-            representative = True
-            for k in range(named_n[t]):
-                g = named_g[t, k]
-                a = named_a[t, k]
-                start = run[g, a]
-                expected = start
-                for q in range(k):
-                    if named_g[t, q] == g and run[g, named_a[t, q]] == start:
-                        expected += 1
-                if a != expected:
-                    representative = False
-                    break
-            if not representative:
+            size = _multiplicity(t, run, run_len, named_g, named_a, named_n)
+            if size == 0:
                 continue
+            count += size
             fired[t] = True
-            for c in range(n_cols):
-                row[c] = rows[head, c]
-            for k in range(pre_n[t]):
-                row[pre_p[t, k]] -= pre_w[t, k]
-            for k in range(reset_n[t]):
-                row[reset_p[t, k]] = 0
-            for k in range(post_n[t]):
-                value = np.int64(row[post_p[t, k]]) + post_w[t, k]
-                if value > 255:
-                    counters[0], counters[1], counters[2] = n, head, ne
-                    return OVERFLOW
-                row[post_p[t, k]] = value
-            canonicalise(row, group_k, group_b, group_off, blocks, scratch)
-            h = row_hash(row)
-            found, slot = _find(rows, hashes, table, row, h, n_cols)
-            if found < 0:
-                found = n
-                for c in range(n_cols):
-                    rows[n, c] = row[c]
-                hashes[n] = h
-                table[slot] = n + 1
-                parent[n] = head
-                parent_row[n] = t
-                seen_by[n] = -1
-                n += 1
-            if seen_by[found] != head:
-                seen_by[found] = head
-                edge_target[ne] = found
-                edge_row[ne] = t
-                ne += 1
+            n, ne, overflow = _successor(rows, hashes, table, parent, parent_row, seen_by,
+                                         edge_target, edge_row, row, scratch, head, t, n, ne,
+                                         pre_p, pre_w, pre_n, post_p, post_w, post_n,
+                                         reset_p, reset_n, group_k, group_b, group_off, blocks)
+            if overflow:
+                counters[0], counters[1], counters[2] = n, head, ne
+                return OVERFLOW
         enabled_count[head] = count
         head += 1
         offsets[head] = ne
@@ -231,11 +272,12 @@ def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, paren
 
 
 @_jit
-def _closure(row, seed, pre_p, pre_w, pre_n, en_mask, stamp, inside, mark, stack,
+def _closure(state, seed, pre_p, pre_w, pre_n, inside, mark, stack,
              conf_ptr, conf_idx, inc_ptr, inc_idx, limit, work_cap, members):
-    """The D1/D2 closure of ``seed`` in the marking ``row``: its enabled members go to
-    ``members``; returns how many, or -1 once that reaches ``limit`` or the work
-    (relations followed) exceeds ``work_cap``. ``inside[u] == mark`` marks the set."""
+    """The D1/D2 closure of ``seed`` in the marking ``state``: its enabled members go to
+    ``members``; returns how many (-1 once that reaches ``limit`` or the work, relations
+    followed, exceeds ``work_cap``) and the work done. ``inside[u] == mark`` marks the
+    set."""
     inside[seed] = mark
     stack[0] = seed
     top = 1
@@ -244,11 +286,11 @@ def _closure(row, seed, pre_p, pre_w, pre_n, en_mask, stamp, inside, mark, stack
     while top > 0:
         top -= 1
         t = stack[top]
-        if en_mask[t] == stamp:
+        if _enabled(state, t, pre_p, pre_w, pre_n):
             members[n_in] = t
             n_in += 1
             if n_in >= limit:
-                return -1
+                return -1, work
             lo = conf_ptr[t]
             hi = conf_ptr[t + 1]
             work += hi - lo
@@ -265,7 +307,7 @@ def _closure(row, seed, pre_p, pre_w, pre_n, en_mask, stamp, inside, mark, stack
             best_c = 1 << 62
             for k in range(pre_n[t]):
                 p = pre_p[t, k]
-                if row[p] < pre_w[t, k]:
+                if state[p] < pre_w[t, k]:
                     c = 0
                     for i in range(inc_ptr[p], inc_ptr[p + 1]):
                         if inside[inc_idx[i]] != mark:
@@ -283,8 +325,8 @@ def _closure(row, seed, pre_p, pre_w, pre_n, en_mask, stamp, inside, mark, stack
                     stack[top] = u
                     top += 1
         if work > work_cap:
-            return -1
-    return n_in
+            return -1, work
+    return n_in, work
 
 
 @_jit
@@ -292,30 +334,33 @@ def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_r
                      parent_row, enabled_count, seen_by, fired, seen_enabled,
                      pre_p, pre_w, pre_n, post_p, post_w, post_n,
                      group_k, group_b, group_off, blocks, named_g, named_a, named_n,
-                     moves, conf_ptr, conf_idx, inc_ptr, inc_idx, seed_order,
+                     moves, conf_ptr, conf_idx, inc_ptr, inc_idx, seed_rank,
                      n_seeds, work_cap, max_states):
     """:func:`explore` restricted to stubborn sets, for nets without reset arcs.
 
     Only the rows that change the marking (``moves``) take part: ``enabled_count`` is
-    the number of them enabled (0: no marking but itself is reachable from this one).
-    Per state, up to ``n_seeds`` enabled rows (in ``seed_order``) are tried as seeds of
-    a D1/D2 closure (``conf_*``: the rows that can disable a row or be disabled by it;
-    ``inc_*``: per place, the rows that raise its count), each within ``work_cap``
-    relations; the smallest is fired, every member of it. With no closure smaller than
-    all enabled rows, every enabled row is stubborn and only one per orbit of the
-    marking's stabiliser is fired, as in :func:`explore`. ``seen_enabled`` marks every
-    row enabled in some explored marking (moving or not)."""
-    n_cols = rows.shape[1]
+    the number of them enabled (0: no marking but itself is reachable from this one),
+    counted by orbits of the stabiliser as in :func:`explore`. Per state, up to
+    ``n_seeds`` enabled representatives (lowest ``seed_rank`` first) are tried as seeds
+    of a D1/D2 closure
+    (``conf_*``: the rows that can disable a row or be disabled by it; ``inc_*``: per
+    place, the rows that raise its count), all of them within ``work_cap`` relations
+    followed; the smallest is fired, every member of it. With no closure smaller than
+    all enabled rows, every enabled row is stubborn and only the representatives are
+    fired, as in :func:`explore`. ``seen_enabled`` marks a row of every orbit of rows
+    enabled in some explored marking (moving or not)."""
     n_rows = pre_n.shape[0]
-    row = np.empty(n_cols, dtype=np.uint8)
+    row = np.empty(rows.shape[1], dtype=np.uint8)
     scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
+    no_resets = np.zeros((n_rows, 1), dtype=np.int64)
+    no_reset_n = np.zeros(n_rows, dtype=np.int64)
     n_groups = group_k.shape[0]
     max_k = 1
     for g in range(n_groups):
         max_k = max(max_k, group_k[g])
     run = np.zeros((max(1, n_groups), max_k), dtype=np.int64)
-    en_mask = np.full(n_rows, -1, dtype=np.int64)
-    en_list = np.empty(n_rows, dtype=np.int64)
+    run_len = np.ones((max(1, n_groups), max_k), dtype=np.int64)
+    reps = np.empty(n_rows + 1, dtype=np.int64)
     inside = np.full(n_rows, -1, dtype=np.int64)
     stack = np.empty(n_rows + 1, dtype=np.int64)
     members = np.empty(n_rows + 1, dtype=np.int64)
@@ -336,105 +381,69 @@ def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_r
             return LIMIT
         offsets[head] = ne
         state = rows[head]
+        _runs(state, run, run_len, group_k, group_b, group_off, blocks)
         n_en = 0
+        n_reps = 0
         for t in range(n_rows):
-            enabled = True
-            for k in range(pre_n[t]):
-                if state[pre_p[t, k]] < pre_w[t, k]:
-                    enabled = False
-                    break
-            if enabled:
-                seen_enabled[t] = True
-                if moves[t]:
-                    en_mask[t] = head
-                    en_list[n_en] = t
-                    n_en += 1
+            if not _enabled(state, t, pre_p, pre_w, pre_n):
+                continue
+            size = _multiplicity(t, run, run_len, named_g, named_a, named_n)
+            if size == 0:
+                continue
+            seen_enabled[t] = True
+            if moves[t]:
+                reps[n_reps] = t
+                n_reps += 1
+                n_en += size
         enabled_count[head] = n_en
         if n_en == 0:
             head += 1
             offsets[head] = ne
             continue
+        # seeds: the representatives (a closure from another row of the orbit is its
+        # image), fewest relations first
+        for j in range(1, n_reps):
+            t = reps[j]
+            i = j
+            while i > 0 and seed_rank[reps[i - 1]] > seed_rank[t]:
+                reps[i] = reps[i - 1]
+                i -= 1
+            reps[i] = t
         n_chosen = 0
         tries = 0
-        for i in range(seed_order.shape[0]):
-            t = seed_order[i]
-            if en_mask[t] != head:
-                continue
+        budget = work_cap
+        for i in range(n_reps):
+            t = reps[i]
             tries += 1
             mark += 1
             limit = n_en if n_chosen == 0 else n_chosen
-            got = _closure(state, t, pre_p, pre_w, pre_n, en_mask, head, inside, mark, stack,
-                           conf_ptr, conf_idx, inc_ptr, inc_idx, limit, work_cap, members)
+            got, work = _closure(state, t, pre_p, pre_w, pre_n, inside, mark, stack,
+                                 conf_ptr, conf_idx, inc_ptr, inc_idx, limit, budget, members)
+            budget -= work
             if got > 0:
                 n_chosen = got
                 for j in range(got):
                     chosen[j] = members[j]
                 if got == 1:
                     break
-            if tries >= n_seeds:
+            if tries >= n_seeds or budget <= 0:
                 break
-        full = n_chosen == 0
-        if full:
-            # all enabled rows, one per orbit of the stabiliser
-            for g in range(n_groups):
-                b = group_b[g]
-                off = group_off[g]
-                run[g, 0] = 0
-                for a in range(1, group_k[g]):
-                    same = True
-                    for j in range(b):
-                        if state[blocks[off + a * b + j]] != state[blocks[off + (a - 1) * b + j]]:
-                            same = False
-                            break
-                    run[g, a] = run[g, a - 1] if same else a
-            for j in range(n_en):
-                t = en_list[j]
-                representative = True
-                for k in range(named_n[t]):
-                    g = named_g[t, k]
-                    a = named_a[t, k]
-                    start = run[g, a]
-                    expected = start
-                    for q in range(k):
-                        if named_g[t, q] == g and run[g, named_a[t, q]] == start:
-                            expected += 1
-                    if a != expected:
-                        representative = False
-                        break
-                if representative:
-                    chosen[n_chosen] = t
-                    n_chosen += 1
+        if n_chosen == 0:
+            # every enabled row is stubborn: the representatives
+            for j in range(n_reps):
+                chosen[j] = reps[j]
+            n_chosen = n_reps
         for j in range(n_chosen):
             t = chosen[j]
             fired[t] = True
-            for c in range(n_cols):
-                row[c] = state[c]
-            for k in range(pre_n[t]):
-                row[pre_p[t, k]] -= pre_w[t, k]
-            for k in range(post_n[t]):
-                value = np.int64(row[post_p[t, k]]) + post_w[t, k]
-                if value > 255:
-                    counters[0], counters[1], counters[2] = n, head, ne
-                    return OVERFLOW
-                row[post_p[t, k]] = value
-            canonicalise(row, group_k, group_b, group_off, blocks, scratch)
-            h = row_hash(row)
-            found, slot = _find(rows, hashes, table, row, h, n_cols)
-            if found < 0:
-                found = n
-                for c in range(n_cols):
-                    rows[n, c] = row[c]
-                hashes[n] = h
-                table[slot] = n + 1
-                parent[n] = head
-                parent_row[n] = t
-                seen_by[n] = -1
-                n += 1
-            if seen_by[found] != head:
-                seen_by[found] = head
-                edge_target[ne] = found
-                edge_row[ne] = t
-                ne += 1
+            n, ne, overflow = _successor(rows, hashes, table, parent, parent_row, seen_by,
+                                         edge_target, edge_row, row, scratch, head, t, n, ne,
+                                         pre_p, pre_w, pre_n, post_p, post_w, post_n,
+                                         no_resets, no_reset_n, group_k, group_b, group_off,
+                                         blocks)
+            if overflow:
+                counters[0], counters[1], counters[2] = n, head, ne
+                return OVERFLOW
         head += 1
         offsets[head] = ne
     counters[0], counters[1], counters[2] = n, head, ne

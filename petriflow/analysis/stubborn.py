@@ -57,8 +57,8 @@ from petriflow.net import Net
 __all__ = ["Relations", "StubbornResult", "reaches_marking", "relations", "stubborn_deadlocks"]
 
 #: Seeds tried per marking by the compiled search (:func:`relations`), and the most
-#: relations one closure may follow before it is given up (then every enabled row is
-#: taken: always stubborn).
+#: relations its closures may follow in all before the search stops trying (then the
+#: smallest closure found so far is fired, or every enabled row: always stubborn).
 COMPILED_SEEDS = 4
 COMPILED_WORK_CAP = 4096
 
@@ -78,7 +78,8 @@ class Relations:
             enabled member of a stubborn set brings them all in (D1).
         inc_ptr, inc_idx: per place, the moving rows that raise its count: a disabled
             member brings in those of one input place short of tokens (D2).
-        seed_order: the moving rows, fewest D1 relations first (the seeds tried first).
+        seed_rank: per row, its place among the moving rows ordered by fewest D1
+            relations (seeds are tried lowest first).
         seeds, work_cap: :data:`COMPILED_SEEDS`, :data:`COMPILED_WORK_CAP`.
     """
 
@@ -87,7 +88,7 @@ class Relations:
     conf_idx: np.ndarray
     inc_ptr: np.ndarray
     inc_idx: np.ndarray
-    seed_order: np.ndarray
+    seed_rank: np.ndarray
     seeds: int = COMPILED_SEEDS
     work_cap: int = COMPILED_WORK_CAP
 
@@ -122,8 +123,9 @@ def relations(compiled: CompiledNet) -> Relations:
     conf_ptr, conf_idx = _csr(conf)
     inc_ptr, inc_idx = _csr(raisers)
     order = sorted(np.flatnonzero(moves).tolist(), key=lambda t: (len(conf[t]), t))
-    return Relations(moves.astype(np.bool_), conf_ptr, conf_idx, inc_ptr, inc_idx,
-                     np.asarray(order, dtype=np.int64))
+    rank = np.full(n_rows, n_rows, dtype=np.int64)
+    rank[order] = np.arange(len(order), dtype=np.int64)
+    return Relations(moves.astype(np.bool_), conf_ptr, conf_idx, inc_ptr, inc_idx, rank)
 
 
 def _csr(lists: list[list[int]]) -> tuple[np.ndarray, np.ndarray]:

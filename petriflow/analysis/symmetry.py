@@ -556,7 +556,7 @@ def symmetric_graph(net: Net, start: Mapping[str, int] | None = None, *,
                     parent_row, enabled_count, seen_by, fired, seen_enabled,
                     pre_p, pre_w, pre_n, post_p, post_w, post_n, group_k, group_b,
                     group_off, blocks, named_g, named_a, named_n, rel.moves, rel.conf_ptr,
-                    rel.conf_idx, rel.inc_ptr, rel.inc_idx, rel.seed_order, rel.seeds,
+                    rel.conf_idx, rel.inc_ptr, rel.inc_idx, rel.seed_rank, rel.seeds,
                     rel.work_cap, max_states)
             else:
                 status = kernel.explore(rows, hashes, table, counters, offsets, edge_target,
