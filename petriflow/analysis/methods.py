@@ -120,8 +120,10 @@ def check_with_method(net: Net, method: str, **budgets) -> dict[str, Any]:
     if reduced and (method == "stubborn" or (method == "auto" and not result["complete"]
                                              and result.get("sound") is None)):
         _reduced(net, result, methods, notes, budgets)
-    elif method == "stubborn" or (method == "auto" and not result["complete"]
-                                  and result.get("deadlock_free") is None):
+    # deadlocks by the Python search where nothing above decided them
+    if (method == "stubborn" or (method == "auto" and not result["complete"])) and \
+            result.get("deadlock_free") is None and not (structure.is_wf_net
+                                                         and result.get("sound") is not None):
         _stubborn(net, structure, start, result, methods, notes, budgets)
     if notes:
         result["method_notes"] = notes
