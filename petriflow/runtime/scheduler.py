@@ -65,7 +65,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from petriflow import limits
-from petriflow.collector import paused
+from petriflow.collector import paused, relaxed
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 from petriflow.net import Net
@@ -315,6 +315,7 @@ class Scheduler:
         except Unrouted as exc:
             raise exc.failure from None
 
+    @relaxed()  # long-lived agent data: fewer full collector passes (petriflow.collector)
     def run(self, until: float | None = None, *, max_firings: int | None = None) -> RunResult:
         """Run until the net finishes, deadlocks, or a limit is reached.
 
