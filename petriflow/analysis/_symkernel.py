@@ -117,6 +117,29 @@ def rehash(hashes, n, table):
 
 
 @_jit
+def _room(n, ne, n_rows, rows, edge_target, table, max_states):
+    """What sends the loop back to Python before the next state (buffers that one more
+    state's successors could overflow, a half-full table, the limit), else ``OK``."""
+    if n + n_rows > rows.shape[0] or ne + n_rows > edge_target.shape[0]:
+        return GROW
+    if 2 * (n + n_rows) > table.shape[0]:
+        return REHASH
+    if n > max_states:
+        return LIMIT
+    return OK
+
+
+@_jit
+def _run_arrays(group_k):
+    """The arrays :func:`_runs` fills (a row per group, a column per agent)."""
+    max_k = 1
+    for g in range(group_k.shape[0]):
+        max_k = max(max_k, group_k[g])
+    rows = max(1, group_k.shape[0])
+    return np.zeros((rows, max_k), dtype=np.int64), np.ones((rows, max_k), dtype=np.int64)
+
+
+@_jit
 def _runs(state, run, run_len, group_k, group_b, group_off, blocks):
     """Runs of equal blocks of a canonical marking: ``run[g, a]`` the first agent of
     agent ``a``'s run in group ``g``, ``run_len[g, a]`` the run's length."""
@@ -224,25 +247,15 @@ def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, paren
     n_rows = pre_n.shape[0]
     row = np.empty(rows.shape[1], dtype=np.uint8)
     scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
-    n_groups = group_k.shape[0]
-    max_k = 1
-    for g in range(n_groups):
-        max_k = max(max_k, group_k[g])
-    run = np.zeros((max(1, n_groups), max_k), dtype=np.int64)
-    run_len = np.ones((max(1, n_groups), max_k), dtype=np.int64)
+    run, run_len = _run_arrays(group_k)
     n = counters[0]
     head = counters[1]
     ne = counters[2]
     while head < n:
-        if n + n_rows > rows.shape[0] or ne + n_rows > edge_target.shape[0]:
+        status = _room(n, ne, n_rows, rows, edge_target, table, max_states)
+        if status != OK:
             counters[0], counters[1], counters[2] = n, head, ne
-            return GROW
-        if 2 * (n + n_rows) > table.shape[0]:
-            counters[0], counters[1], counters[2] = n, head, ne
-            return REHASH
-        if n > max_states:
-            counters[0], counters[1], counters[2] = n, head, ne
-            return LIMIT
+            return status
         offsets[head] = ne
         state = rows[head]
         _runs(state, run, run_len, group_k, group_b, group_off, blocks)
@@ -354,12 +367,7 @@ def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_r
     scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
     no_resets = np.zeros((n_rows, 1), dtype=np.int64)
     no_reset_n = np.zeros(n_rows, dtype=np.int64)
-    n_groups = group_k.shape[0]
-    max_k = 1
-    for g in range(n_groups):
-        max_k = max(max_k, group_k[g])
-    run = np.zeros((max(1, n_groups), max_k), dtype=np.int64)
-    run_len = np.ones((max(1, n_groups), max_k), dtype=np.int64)
+    run, run_len = _run_arrays(group_k)
     reps = np.empty(n_rows + 1, dtype=np.int64)
     inside = np.full(n_rows, -1, dtype=np.int64)
     stack = np.empty(n_rows + 1, dtype=np.int64)
@@ -370,15 +378,10 @@ def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_r
     head = counters[1]
     ne = counters[2]
     while head < n:
-        if n + n_rows > rows.shape[0] or ne + n_rows > edge_target.shape[0]:
+        status = _room(n, ne, n_rows, rows, edge_target, table, max_states)
+        if status != OK:
             counters[0], counters[1], counters[2] = n, head, ne
-            return GROW
-        if 2 * (n + n_rows) > table.shape[0]:
-            counters[0], counters[1], counters[2] = n, head, ne
-            return REHASH
-        if n > max_states:
-            counters[0], counters[1], counters[2] = n, head, ne
-            return LIMIT
+            return status
         offsets[head] = ne
         state = rows[head]
         _runs(state, run, run_len, group_k, group_b, group_off, blocks)
