@@ -192,6 +192,28 @@ def _enabled(state, t, pre_p, pre_w, pre_n):
 
 
 @_jit
+def _representatives(state, pre_p, pre_w, pre_n, run, run_len, named_g, named_a, named_n,
+                     moves, reps, seen_enabled):
+    """The enabled rows of ``state`` that represent their orbit under its stabiliser:
+    those with ``moves`` go to ``reps``, every one is marked in ``seen_enabled``.
+    Returns how many went to ``reps`` and how many rows their orbits hold."""
+    n_reps = 0
+    count = 0
+    for t in range(pre_n.shape[0]):
+        if not _enabled(state, t, pre_p, pre_w, pre_n):
+            continue
+        size = _multiplicity(t, run, run_len, named_g, named_a, named_n)
+        if size == 0:
+            continue
+        seen_enabled[t] = True
+        if moves[t]:
+            reps[n_reps] = t
+            n_reps += 1
+            count += size
+    return n_reps, count
+
+
+@_jit
 def _successor(rows, hashes, table, parent, parent_row, seen_by, edge_target, edge_row,
                row, scratch, head, t, n, ne, pre_p, pre_w, pre_n, post_p, post_w, post_n,
                reset_p, reset_n, group_k, group_b, group_off, blocks):
@@ -248,6 +270,9 @@ def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, paren
     row = np.empty(rows.shape[1], dtype=np.uint8)
     scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
     run, run_len = _run_arrays(group_k)
+    reps = np.empty(n_rows + 1, dtype=np.int64)
+    everything = np.ones(n_rows, dtype=np.bool_)
+    seen = np.zeros(n_rows, dtype=np.bool_)
     n = counters[0]
     head = counters[1]
     ne = counters[2]
@@ -259,14 +284,10 @@ def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, paren
         offsets[head] = ne
         state = rows[head]
         _runs(state, run, run_len, group_k, group_b, group_off, blocks)
-        count = 0
-        for t in range(n_rows):
-            if not _enabled(state, t, pre_p, pre_w, pre_n):
-                continue
-            size = _multiplicity(t, run, run_len, named_g, named_a, named_n)
-            if size == 0:
-                continue
-            count += size
+        n_reps, count = _representatives(state, pre_p, pre_w, pre_n, run, run_len, named_g,
+                                         named_a, named_n, everything, reps, seen)
+        for j in range(n_reps):
+            t = reps[j]
             fired[t] = True
             n, ne, overflow = _successor(rows, hashes, table, parent, parent_row, seen_by,
                                          edge_target, edge_row, row, scratch, head, t, n, ne,
@@ -385,19 +406,8 @@ def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_r
         offsets[head] = ne
         state = rows[head]
         _runs(state, run, run_len, group_k, group_b, group_off, blocks)
-        n_en = 0
-        n_reps = 0
-        for t in range(n_rows):
-            if not _enabled(state, t, pre_p, pre_w, pre_n):
-                continue
-            size = _multiplicity(t, run, run_len, named_g, named_a, named_n)
-            if size == 0:
-                continue
-            seen_enabled[t] = True
-            if moves[t]:
-                reps[n_reps] = t
-                n_reps += 1
-                n_en += size
+        n_reps, n_en = _representatives(state, pre_p, pre_w, pre_n, run, run_len, named_g,
+                                        named_a, named_n, moves, reps, seen_enabled)
         enabled_count[head] = n_en
         if n_en == 0:
             head += 1
