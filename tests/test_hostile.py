@@ -180,7 +180,7 @@ def test_invalid_utf8_is_one_line(tmp_path, capsys):
 
 def test_a_large_chain_gets_a_note_not_gigabytes(tmp_path, capsys):
     """Invariants of a net whose Farkas matrix is too large are skipped with a note."""
-    n = 1500
+    n = 3000    # places x (places + transitions) = 18 million > INVARIANT_CELLS
     net = tmp_path / "chain.yaml"
     net.write_text("petriflow: 1\nplaces: [{id: p0, tokens: 1}, " + ", ".join(f"p{i}" for i in range(1, n + 1))
                    + "]\ntransitions:\n" + "".join(f"  - {{id: t{i}, in: [p{i}], out: [p{i + 1}]}}\n"
