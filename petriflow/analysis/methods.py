@@ -273,10 +273,16 @@ def _reduced(net: Net, result: dict, methods: dict, notes: list[str], budgets: d
         result["dead_transitions"] = []
         methods["dead_transitions"] = found.method
     if found.option_to_complete:
-        result["stuck_markings"] = 0
-        result["deadlock_free"] = False      # the final marking is reachable and enables nothing
+        # the final marking is reachable and enables nothing: a dead marking, where no
+        # transition can fire again and from which [i] is not reached
+        result["deadlock_markings"] = 1         # every dead marking is the final one
+        result["stuck_markings"] = 0 if net.final_marking is not None else 1
+        result["deadlock_free"] = False
         methods["deadlock_free"] = found.method
-    for key in ("sound", "bounded", "dead_transitions", "deadlock_free"):
+        if result.get("initial_marking") != (found.final or {}):
+            result["live"] = result["reversible"] = False
+            methods["live"] = methods["reversible"] = found.method
+    for key in ("sound", "bounded", "dead_transitions", "deadlock_free", "live", "reversible"):
         if result.get(key) is not None and key in (result.get("undecided") or []):
             result["undecided"].remove(key)
     notes.append(f"soundness: {'sound' if found.sound else 'not sound'} on the reduced graph"

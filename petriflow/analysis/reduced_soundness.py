@@ -82,6 +82,7 @@ class ReducedSoundness:
         unseen: transitions never seen enabled (their deadness is undecided).
         complete: ``False`` when ``max_states`` stopped the search.
         reason: why something is undecided (empty when all is decided).
+        final: the final marking soundness is decided for (as a dict).
     """
 
     sound: bool | None
@@ -95,6 +96,7 @@ class ReducedSoundness:
     unseen: list[str] = field(default_factory=list)
     complete: bool = True
     reason: str = ""
+    final: dict[str, int] = field(default_factory=dict)
 
     @property
     def method(self) -> str:
@@ -142,7 +144,7 @@ def reduced_soundness(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
         section, _ = _invariants(compiled, start, DEFAULT_BUDGET)
         covered = bool(section.get("covered_by_p_semiflows"))
     groups = find_symmetries(net, compiled=compiled, start=start, final=final)
-    found = ReducedSoundness(None, groups=[g.agents for g in groups])
+    found = ReducedSoundness(None, groups=[g.agents for g in groups], final=final.to_dict())
     reasons = [] if covered else ["no P-semiflow covers every place (boundedness and proper"
                                   " completion not proved)"]
     try:

@@ -242,6 +242,11 @@ def test_check_stubborn_and_auto_report_the_reduced_answer(tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     assert result["sound"] is True and result["methods"]["sound"] == "stubborn+symmetry"
     assert result["states_visited"]["stubborn+symmetry"] == result["reduced"]["states"]
+    full = check_net(_team(9, loop=False), method="explicit")
+    for key in ("bounded", "deadlock_free", "deadlock_markings", "dead_transitions", "live", "reversible",
+                "stuck_markings"):
+        assert result[key] == full[key], key
+    assert result["methods"]["live"] == "stubborn+symmetry"
     # auto: the symmetric exploration stops at the limit, the reduced graph answers
     net = _parallel(9, 4)
     assert check_net(net, method="symmetry")["symmetry"]["canonical_states"] > 300
