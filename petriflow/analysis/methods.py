@@ -78,8 +78,9 @@ def check_with_method(net: Net, method: str, **budgets) -> dict[str, Any]:
             notes.append(f"symmetry reduction not used ({why}): explicit state space")
     if result is None and method == "stubborn":
         result = report.check_net(net, method=None, **dict(budgets, max_states=1))
-        result["error"] = ("--method stubborn explores no full state space: deadlocks (and a WF-net's soundness) by stubborn sets,"
-                           " the properties they do not preserve undecided")
+        result["error"] = ("--method stubborn explores no full state space: deadlocks (and a"
+                           " WF-net's soundness) by stubborn sets, the properties they do not"
+                           " preserve undecided")
         result["partial"] = None
         result["undecided"] = [k for k in ("states", "edges", "live", "reversible", "dead_transitions",
                                            "max_tokens_place", "max_tokens_marking", "k_bound",
@@ -249,7 +250,7 @@ def _reduced(net: Net, result: dict, methods: dict, notes: list[str], budgets: d
 
     covered = (result.get("invariants") or {}).get("covered_by_p_semiflows")
     found = reduced_soundness(net, max_states=budgets.get("max_states") or 2_000_000,
-                              covered=covered if covered is not None else None)
+                              covered=covered)
     result["reduced"] = {"states": found.states, "edges": found.edges, "groups": found.groups,
                          "complete": found.complete, "sound": found.sound,
                          "option_to_complete": found.option_to_complete,
