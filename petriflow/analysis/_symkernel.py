@@ -20,7 +20,7 @@ from petriflow.analysis._numba import njit
 
 _jit = njit(__name__)
 
-__all__ = ["canonicalise", "explore", "explore_stubborn", "rehash", "row_hash"]
+__all__ = ["canonicalise", "explore", "rehash", "row_hash"]
 
 OK, GROW, LIMIT, REHASH, OVERFLOW = 0, 1, 2, 3, 4
 
@@ -253,59 +253,6 @@ def _successor(rows, hashes, table, parent, parent_row, seen_by, edge_target, ed
 
 
 @_jit
-def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, parent, parent_row,
-            enabled_count, seen_by, fired,
-            pre_p, pre_w, pre_n, post_p, post_w, post_n, reset_p, reset_n,
-            group_k, group_b, group_off, blocks, named_g, named_a, named_n, max_states):
-    """Expand states ``counters[1]`` .. while any are left; ``counters`` = ``[states,
-    next state to expand, edges]`` is updated in place. Returns a status code.
-
-    In a canonical marking agents with equal blocks are interchangeable (its
-    stabiliser), so of each orbit of rows under it only the representative
-    (:func:`_multiplicity`) is tested and fired, and counted as many times as its orbit
-    has rows (``enabled_count``: the out-degree of each marking of the orbit). Each
-    distinct successor is one edge (``seen_by`` deduplicates); ``fired`` marks the rows
-    fired."""
-    n_rows = pre_n.shape[0]
-    row = np.empty(rows.shape[1], dtype=np.uint8)
-    scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
-    run, run_len = _run_arrays(group_k)
-    reps = np.empty(n_rows + 1, dtype=np.int64)
-    everything = np.ones(n_rows, dtype=np.bool_)
-    seen = np.zeros(n_rows, dtype=np.bool_)
-    n = counters[0]
-    head = counters[1]
-    ne = counters[2]
-    while head < n:
-        status = _room(n, ne, n_rows, rows, edge_target, table, max_states)
-        if status != OK:
-            counters[0], counters[1], counters[2] = n, head, ne
-            return status
-        offsets[head] = ne
-        state = rows[head]
-        _runs(state, run, run_len, group_k, group_b, group_off, blocks)
-        n_reps, count = _representatives(state, pre_p, pre_w, pre_n, run, run_len, named_g,
-                                         named_a, named_n, everything, reps, seen)
-        for j in range(n_reps):
-            t = reps[j]
-            fired[t] = True
-            n, ne, overflow = _successor(rows, hashes, table, parent, parent_row, seen_by,
-                                         edge_target, edge_row, row, scratch, head, t, n, ne,
-                                         pre_p, pre_w, pre_n, post_p, post_w, post_n,
-                                         reset_p, reset_n, group_k, group_b, group_off, blocks)
-            if overflow:
-                counters[0], counters[1], counters[2] = n, head, ne
-                return OVERFLOW
-        enabled_count[head] = count
-        head += 1
-        offsets[head] = ne
-    counters[0], counters[1], counters[2] = n, head, ne
-    if n > max_states:
-        return LIMIT
-    return OK
-
-
-@_jit
 def _closure(state, seed, pre_p, pre_w, pre_n, inside, mark, stack,
              conf_ptr, conf_idx, inc_ptr, inc_idx, limit, work_cap, members):
     """The D1/D2 closure of ``seed`` in the marking ``state``: its enabled members go to
@@ -364,30 +311,32 @@ def _closure(state, seed, pre_p, pre_w, pre_n, inside, mark, stack,
 
 
 @_jit
-def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_row, parent,
-                     parent_row, enabled_count, seen_by, fired, seen_enabled,
-                     pre_p, pre_w, pre_n, post_p, post_w, post_n,
-                     group_k, group_b, group_off, blocks, named_g, named_a, named_n,
-                     moves, conf_ptr, conf_idx, inc_ptr, inc_idx, seed_rank,
-                     n_seeds, work_cap, max_states):
-    """:func:`explore` restricted to stubborn sets, for nets without reset arcs.
+def explore(rows, hashes, table, counters, offsets, edge_target, edge_row, parent, parent_row,
+            enabled_count, seen_by, fired, seen_enabled,
+            pre_p, pre_w, pre_n, post_p, post_w, post_n, reset_p, reset_n,
+            group_k, group_b, group_off, blocks, named_g, named_a, named_n,
+            moves, conf_ptr, conf_idx, inc_ptr, inc_idx, seed_rank, n_seeds, work_cap,
+            max_states):
+    """Expand states ``counters[1]`` .. while any are left; ``counters`` = ``[states,
+    next state to expand, edges]`` is updated in place. Returns a status code.
 
-    Only the rows that change the marking (``moves``) take part: ``enabled_count`` is
-    the number of them enabled (0: no marking but itself is reachable from this one),
-    counted by orbits of the stabiliser as in :func:`explore`. Per state, up to
-    ``n_seeds`` enabled representatives (lowest ``seed_rank`` first) are tried as seeds
-    of a D1/D2 closure
-    (``conf_*``: the rows that can disable a row or be disabled by it; ``inc_*``: per
-    place, the rows that raise its count), all of them within ``work_cap`` relations
-    followed; the smallest is fired, every member of it. With no closure smaller than
-    all enabled rows, every enabled row is stubborn and only the representatives are
-    fired, as in :func:`explore`. ``seen_enabled`` marks a row of every orbit of rows
-    enabled in some explored marking (moving or not)."""
+    In a canonical marking agents with equal blocks are interchangeable (its
+    stabiliser), so of each orbit of rows under it only the representative
+    (:func:`_multiplicity`) is tested and fired, and counted as many times as its orbit
+    has rows. Only rows with ``moves`` count (``enabled_count``: how many of them each
+    marking of the orbit enables) and are fired; ``seen_enabled`` marks a row of every
+    orbit of rows enabled in some explored marking. Each distinct successor is one edge
+    (``seen_by`` deduplicates); ``fired`` marks the rows fired.
+
+    With ``n_seeds`` > 0 (stubborn sets, nets without reset arcs), up to ``n_seeds``
+    enabled representatives (lowest ``seed_rank`` first) are tried as seeds of a D1/D2
+    closure (``conf_*``: the rows that can disable a row or be disabled by it;
+    ``inc_*``: per place, the rows that raise its count), all of them within
+    ``work_cap`` relations followed; the smallest is fired, every member of it. With no
+    closure smaller than all enabled rows (or no seeds), the representatives are fired."""
     n_rows = pre_n.shape[0]
     row = np.empty(rows.shape[1], dtype=np.uint8)
     scratch = np.empty(max(1, blocks.shape[0]), dtype=np.uint8)
-    no_resets = np.zeros((n_rows, 1), dtype=np.int64)
-    no_reset_n = np.zeros(n_rows, dtype=np.int64)
     run, run_len = _run_arrays(group_k)
     reps = np.empty(n_rows + 1, dtype=np.int64)
     inside = np.full(n_rows, -1, dtype=np.int64)
@@ -409,38 +358,33 @@ def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_r
         n_reps, n_en = _representatives(state, pre_p, pre_w, pre_n, run, run_len, named_g,
                                         named_a, named_n, moves, reps, seen_enabled)
         enabled_count[head] = n_en
-        if n_en == 0:
-            head += 1
-            offsets[head] = ne
-            continue
-        # seeds: the representatives (a closure from another row of the orbit is its
-        # image), fewest relations first
-        for j in range(1, n_reps):
-            t = reps[j]
-            i = j
-            while i > 0 and seed_rank[reps[i - 1]] > seed_rank[t]:
-                reps[i] = reps[i - 1]
-                i -= 1
-            reps[i] = t
         n_chosen = 0
-        tries = 0
-        budget = work_cap
-        for i in range(n_reps):
-            t = reps[i]
-            tries += 1
-            mark += 1
-            limit = n_en if n_chosen == 0 else n_chosen
-            got, work = _closure(state, t, pre_p, pre_w, pre_n, inside, mark, stack,
-                                 conf_ptr, conf_idx, inc_ptr, inc_idx, limit, budget, members)
-            budget -= work
-            if got > 0:
-                n_chosen = got
-                for j in range(got):
-                    chosen[j] = members[j]
-                if got == 1:
+        if n_seeds > 0 and n_en > 0:
+            # seeds: the representatives (a closure from another row of the orbit is its
+            # image), fewest relations first
+            for j in range(1, n_reps):
+                t = reps[j]
+                i = j
+                while i > 0 and seed_rank[reps[i - 1]] > seed_rank[t]:
+                    reps[i] = reps[i - 1]
+                    i -= 1
+                reps[i] = t
+            budget = work_cap
+            for i in range(min(n_reps, n_seeds)):
+                mark += 1
+                limit = n_en if n_chosen == 0 else n_chosen
+                got, work = _closure(state, reps[i], pre_p, pre_w, pre_n, inside, mark, stack,
+                                     conf_ptr, conf_idx, inc_ptr, inc_idx, limit, budget,
+                                     members)
+                budget -= work
+                if got > 0:
+                    n_chosen = got
+                    for j in range(got):
+                        chosen[j] = members[j]
+                    if got == 1:
+                        break
+                if budget <= 0:
                     break
-            if tries >= n_seeds or budget <= 0:
-                break
         if n_chosen == 0:
             # every enabled row is stubborn: the representatives
             for j in range(n_reps):
@@ -452,8 +396,7 @@ def explore_stubborn(rows, hashes, table, counters, offsets, edge_target, edge_r
             n, ne, overflow = _successor(rows, hashes, table, parent, parent_row, seen_by,
                                          edge_target, edge_row, row, scratch, head, t, n, ne,
                                          pre_p, pre_w, pre_n, post_p, post_w, post_n,
-                                         no_resets, no_reset_n, group_k, group_b, group_off,
-                                         blocks)
+                                         reset_p, reset_n, group_k, group_b, group_off, blocks)
             if overflow:
                 counters[0], counters[1], counters[2] = n, head, ne
                 return OVERFLOW

@@ -92,6 +92,16 @@ class Relations:
     seeds: int = COMPILED_SEEDS
     work_cap: int = COMPILED_WORK_CAP
 
+    @classmethod
+    def everything(cls, compiled: CompiledNet) -> "Relations":
+        """No reduction: every row takes part and no seed is tried, so every enabled row
+        is stubborn (the full search, reset arcs allowed)."""
+        n_rows, n_places = len(compiled.transitions), len(compiled.places)
+        empty = np.zeros(0, dtype=np.int64)
+        return cls(np.ones(n_rows, dtype=np.bool_), np.zeros(n_rows + 1, dtype=np.int64), empty,
+                   np.zeros(n_places + 1, dtype=np.int64), empty, np.zeros(n_rows, dtype=np.int64),
+                   seeds=0)
+
 
 def relations(compiled: CompiledNet) -> Relations:
     """The :class:`Relations` of a net without reset arcs (arc weights taken into

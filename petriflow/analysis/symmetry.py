@@ -543,27 +543,19 @@ def symmetric_graph(net: Net, start: Mapping[str, int] | None = None, *,
     named_g, named_a, named_n = _named(compiled, groups)
     counters = np.asarray([1, 0, 0], dtype=np.int64)
     seen_enabled = np.zeros(len(compiled.transitions), dtype=np.bool_)
-    if stubborn:
-        if compiled.has_resets:
-            raise SymmetryUnsupported("stubborn sets need a net without reset arcs")
-        from petriflow.analysis.stubborn import relations
-        rel = relations(compiled)
+    from petriflow.analysis.stubborn import Relations, relations
+    if stubborn and compiled.has_resets:
+        raise SymmetryUnsupported("stubborn sets need a net without reset arcs")
+    rel = relations(compiled) if stubborn else Relations.everything(compiled)
     while True:
         with np.errstate(over="ignore"):     # the hash wraps on purpose (plain Python)
-            if stubborn:
-                status = kernel.explore_stubborn(
-                    rows, hashes, table, counters, offsets, edge_target, edge_row, parent,
-                    parent_row, enabled_count, seen_by, fired, seen_enabled,
-                    pre_p, pre_w, pre_n, post_p, post_w, post_n, group_k, group_b,
-                    group_off, blocks, named_g, named_a, named_n, rel.moves, rel.conf_ptr,
-                    rel.conf_idx, rel.inc_ptr, rel.inc_idx, rel.seed_rank, rel.seeds,
-                    rel.work_cap, max_states)
-            else:
-                status = kernel.explore(rows, hashes, table, counters, offsets, edge_target,
-                                        edge_row, parent, parent_row, enabled_count, seen_by,
-                                        fired, pre_p, pre_w, pre_n, post_p, post_w, post_n,
-                                        reset_p, reset_n, group_k, group_b, group_off, blocks,
-                                        named_g, named_a, named_n, max_states)
+            status = kernel.explore(rows, hashes, table, counters, offsets, edge_target, edge_row,
+                                    parent, parent_row, enabled_count, seen_by, fired,
+                                    seen_enabled, pre_p, pre_w, pre_n, post_p, post_w, post_n,
+                                    reset_p, reset_n, group_k, group_b, group_off, blocks,
+                                    named_g, named_a, named_n, rel.moves, rel.conf_ptr,
+                                    rel.conf_idx, rel.inc_ptr, rel.inc_idx, rel.seed_rank,
+                                    rel.seeds, rel.work_cap, max_states)
         if status == kernel.OK or status == kernel.LIMIT:
             break
         if status == kernel.OVERFLOW:
