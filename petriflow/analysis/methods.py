@@ -29,7 +29,7 @@ import numpy as np
 
 from petriflow.analysis._graph import components, reaching
 from petriflow.analysis.reachability import StateSpaceLimit
-from petriflow.analysis.soundness import Violation
+from petriflow.analysis.soundness import Violation, _format as _fmt
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
@@ -51,9 +51,6 @@ AUTO_STUBBORN_WORK = 100_000_000
 PROPERTIES = ("sound", "bounded", "deadlock_free", "dead_transitions", "live", "reversible",
               "states")
 
-
-def _fmt(marking) -> str:
-    return ", ".join(f"{p}={c}" for p, c in dict(marking).items()) or "(empty)"
 
 
 def check_with_method(net: Net, method: str, **budgets) -> dict[str, Any]:

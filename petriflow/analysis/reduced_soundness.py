@@ -60,7 +60,7 @@ import numpy as np
 
 from petriflow.analysis._graph import reaching
 from petriflow.analysis.reachability import DEFAULT_MAX_STATES, StateSpaceLimit
-from petriflow.analysis.soundness import Violation, workflow_structure
+from petriflow.analysis.soundness import Violation, workflow_structure, _format as _fmt
 from petriflow.engine import CompiledNet
 from petriflow.marking import Marking
 from petriflow.net import Net
@@ -103,9 +103,6 @@ class ReducedSoundness:
         """How it was decided, as ``check``'s ``methods`` names it."""
         return "stubborn+symmetry" if self.groups else "stubborn"
 
-
-def _fmt(marking) -> str:
-    return ", ".join(f"{p}={c}" for p, c in dict(marking).items()) or "(empty)"
 
 
 def reduced_soundness(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
