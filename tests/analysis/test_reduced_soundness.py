@@ -20,6 +20,7 @@ from petriflow.analysis.soundness import check_soundness
 from petriflow.engine import CompiledNet
 from petriflow.marking import Marking
 from petriflow.net import Net
+from petriflow.netbuild import NetBuilder
 
 from tests.analysis.test_reductions import free_choice_workflows, replay
 
@@ -50,70 +51,58 @@ def _can_finish(net: Net, start: Marking, final: Marking, limit: int = 50_000) -
 LOCAL = ["start", "busy", "wait", "done"]
 
 
+def _team_net(k: int, steps, *, local, start: str, done: str, lock: bool = True,
+              mail: bool = False, sends: bool = False) -> Net:
+    """``k`` agents ``a1..ak`` (one template: ``steps`` are ``(name, inputs, outputs)``
+    over the ``local`` places and the shared ``lock``) in the WF envelope of
+    :class:`~petriflow.netbuild.NetBuilder`: ``begin`` marks each agent's ``start`` (and
+    the lock, a resource, with ``lock``), ``end`` takes each ``done`` back. With ``mail``
+    each agent has a mailbox (``box``) and a ``receive``; with ``sends`` a busy agent can
+    send into every other agent's mailbox."""
+    b = NetBuilder("team")
+    if lock or any("lock" in ins + outs for _, ins, outs in steps):
+        b.place("lock")
+    if lock:
+        b.resource("lock")
+    agents = [b.agent(f"a{a}", state="agent") for a in range(1, k + 1)]
+    boxes = {}
+    for agent in agents:
+        for place in local:
+            agent.place(place)
+        if mail:
+            boxes[agent.name] = b.mailbox(agent, channel=None)
+        agent.start(start)
+        agent.done(done)
+    for agent in agents:
+        for name, ins, outs in steps:
+            agent.transition(name, inputs=ins, outputs=outs)
+        if mail:
+            for other in agents:
+                if sends and other is not agent:
+                    b.send(agent.transition(f"send_{other.name}", inputs=["busy"], outputs=["busy"]),
+                           boxes[other.name])
+            b.receive(agent.transition("receive"), boxes[agent.name])
+    b.envelope()
+    return b.build()
+
+
 @st.composite
 def team_workflows(draw) -> Net:
-    """A WF-net: ``begin`` starts 2-3 agents from one random template (local places,
-    a shared lock and a mailbox per agent, sends to every other agent), ``end`` takes
-    every agent's ``done``, the lock and the free mailbox slots back."""
+    """A WF-net of 2-3 agents from one random template: a chain ``start -> busy -> wait
+    -> done`` and 1-3 random steps over those places, a shared lock (a resource, or
+    only passed between steps) and, sometimes, a mailbox per agent that every other
+    busy agent sends into; ``begin`` starts the agents, ``end`` takes every ``done``,
+    the lock and the free mailbox slots back."""
     k = draw(st.integers(2, 3))
-    steps = []
-    for s in range(draw(st.integers(1, 4))):
-        ins = draw(st.lists(st.sampled_from(LOCAL + ["lock", "box"]), min_size=1, max_size=2,
-                            unique=True))
+    mail = draw(st.booleans())
+    steps = [("go", ["start"], ["busy"]), ("pause", ["busy"], ["wait"]), ("finish", ["wait"], ["done"])]
+    for s in range(draw(st.integers(1, 3))):
+        ins = draw(st.lists(st.sampled_from(LOCAL + ["lock"] + (["box"] if mail else [])), min_size=1,
+                            max_size=2, unique=True))
         outs = draw(st.lists(st.sampled_from(LOCAL + ["lock"]), min_size=0, max_size=2, unique=True))
         steps.append((f"s{s}", ins, outs))
-    steps.append(("finish", [draw(st.sampled_from(LOCAL[:3]))], ["done"]))
-    sends = draw(st.booleans())
-    lock = draw(st.integers(0, 1))
-    net = Net("team")
-    for p in ("i", "o", "lock"):
-        net.add_place(p)
-    agents = [f"a{a}" for a in range(1, k + 1)]
-    for a in agents:
-        net.add_subnet(a, state="agent")
-        for p in LOCAL + ["box", "slot"]:
-            net.add_place(f"{a}_{p}", subnet=a)
-
-    def arc(place, a):
-        return place if place == "lock" else f"{a}_{place}"
-
-    for a in agents:
-        for name, ins, outs in steps:
-            t = f"{a}_{name}"
-            net.add_transition(t, subnet=a)
-            for p in ins:
-                net.add_arc(arc(p, a), t)
-            for p in outs:
-                net.add_arc(t, arc(p, a))
-        if sends:
-            for b in agents:
-                if b != a:
-                    t = f"{a}_send_{b}"
-                    net.add_transition(t, subnet=a)
-                    net.add_arc(f"{a}_busy", t)
-                    net.add_arc(f"{b}_slot", t)
-                    net.add_arc(t, f"{a}_busy")
-                    net.add_arc(t, f"{b}_box")
-        t = f"{a}_receive"
-        net.add_transition(t, subnet=a)
-        net.add_arc(f"{a}_box", t)
-        net.add_arc(t, f"{a}_slot")
-    net.add_transition("begin")
-    net.add_arc("i", "begin")
-    for a in agents:
-        net.add_arc("begin", f"{a}_start")
-        net.add_arc("begin", f"{a}_slot")
-    if lock:
-        net.add_arc("begin", "lock")
-    net.add_transition("end")
-    for a in agents:
-        net.add_arc(f"{a}_done", "end")
-        net.add_arc(f"{a}_slot", "end")
-    if lock:
-        net.add_arc("lock", "end")
-    net.add_arc("end", "o")
-    net.set_initial_marking(Marking({"i": 1}))
-    return net
+    return _team_net(k, steps, local=LOCAL, start="start", done="done", lock=draw(st.booleans()),
+                     mail=mail, sends=mail)
 
 
 def _agrees(net: Net) -> bool:
@@ -154,35 +143,14 @@ def _team(k: int, loop: bool) -> Net:
     """``k`` agents take a shared lock in turn; with ``loop`` one of them may instead
     enter, lock in hand, a two-step cycle whose exit needs the lock: it never leaves
     (a livelock, not a deadlock)."""
-    net = Net("lockers")
-    for p in ("i", "o", "lock"):
-        net.add_place(p)
-    net.add_transition("begin")
-    net.add_arc("i", "begin")
-    net.add_arc("begin", "lock")
-    net.add_transition("end")
-    net.add_arc("lock", "end")
-    net.add_arc("end", "o")
-    for a in range(1, k + 1):
-        net.add_subnet(f"a{a}", state="agent")
-        for p in ("idle", "busy", "done") + (("spin", "spun") if loop else ()):
-            net.add_place(f"a{a}_{p}", subnet=f"a{a}")
-        net.add_arc("begin", f"a{a}_idle")
-        net.add_arc(f"a{a}_done", "end")
-        steps = [("take", ["idle", "lock"], ["busy"]), ("give", ["busy"], ["done", "lock"])]
-        if loop:
-            # the way out of the cycle needs the lock the stray agent still holds
-            steps += [("stray", ["busy"], ["spin"]), ("go_round", ["spin"], ["spun"]),
-                      ("come_back", ["spun"], ["spin"]), ("leave", ["spun", "lock"], ["done", "lock"])]
-        for name, ins, outs in steps:
-            t = f"a{a}_{name}"
-            net.add_transition(t, subnet=f"a{a}")
-            for p in ins:
-                net.add_arc(p if p == "lock" else f"a{a}_{p}", t)
-            for p in outs:
-                net.add_arc(t, p if p == "lock" else f"a{a}_{p}")
-    net.set_initial_marking(Marking({"i": 1}))
-    return net
+    steps = [("take", ["idle", "lock"], ["busy"]), ("give", ["busy"], ["done", "lock"])]
+    local = ["idle", "busy", "done"]
+    if loop:
+        # the way out of the cycle needs the lock the stray agent still holds
+        steps += [("stray", ["busy"], ["spin"]), ("go_round", ["spin"], ["spun"]),
+                  ("come_back", ["spun"], ["spin"]), ("leave", ["spun", "lock"], ["done", "lock"])]
+        local += ["spin", "spun"]
+    return _team_net(k, steps, local=local, start="idle", done="done")
 
 
 def test_a_team_of_twelve_is_sound_on_a_small_reduced_graph():
@@ -261,30 +229,11 @@ def test_check_stubborn_and_auto_report_the_reduced_answer(tmp_path, capsys):
 
 def _parallel(k: int, steps: int) -> Net:
     """``k`` agents that each take ``steps`` steps (2 or more), between a fork and a join."""
-    net = Net("parallel")
-    net.add_place("i")
-    net.add_place("o")
-    net.add_place("lock")
-    net.add_transition("begin")
-    net.add_transition("end")
-    net.add_arc("i", "begin")
-    net.add_arc("end", "o")
-    for a in range(1, k + 1):
-        net.add_subnet(f"a{a}", state="agent")
-        for s in range(steps + 1):
-            net.add_place(f"a{a}_s{s}", subnet=f"a{a}")
-        for s in range(steps):
-            net.add_transition(f"a{a}_t{s}", subnet=f"a{a}")
-            net.add_arc(f"a{a}_s{s}", f"a{a}_t{s}")
-            net.add_arc(f"a{a}_t{s}", f"a{a}_s{s + 1}")
-        net.add_arc("begin", f"a{a}_s0")
-        net.add_arc(f"a{a}_s{steps}", "end")
-        net.add_arc("lock", f"a{a}_t0")         # the first step holds a shared lock:
-        net.add_arc(f"a{a}_t1", "lock")         # not free-choice (no Rank Theorem)
-    net.add_arc("begin", "lock")
-    net.add_arc("lock", "end")
-    net.set_initial_marking(Marking({"i": 1}))
-    return net
+    chain = [(f"t{s}", [f"s{s}"], [f"s{s + 1}"]) for s in range(steps)]
+    chain[0] = ("t0", ["s0", "lock"], ["s1"])        # the first step holds a shared lock:
+    chain[1] = ("t1", ["s1"], ["s2", "lock"])        # not free-choice (no Rank Theorem)
+    return _team_net(k, chain, local=[f"s{s}" for s in range(steps + 1)], start="s0",
+                     done=f"s{steps}")
 
 
 @pytest.mark.parametrize("path", ["nets/bus/bus-algorithm2-3.yaml", "nets/comm/comm-centralised-3.yaml",
