@@ -3,12 +3,14 @@
 In a marking ``M`` a set ``S`` of transitions is *stubborn* (Valmari 1988, 1991) when
 
 * **D0**: ``S`` holds an enabled transition, if ``M`` enables any;
-* **D1**: for every enabled ``t`` in ``S``: every transition sharing an input place
-  with ``t`` is in ``S`` (firing transitions outside ``S`` never disables ``t`` nor is
-  disabled by it, so ``t`` commutes with every sequence outside ``S``);
+* **D1**: for every enabled ``t`` in ``S``: every transition that lowers the count of
+  an input place of ``t``, and every transition with an input place whose count ``t``
+  lowers, is in ``S`` (net effects: a transition that puts back what it takes lowers
+  nothing), so firing transitions outside ``S`` never disables ``t`` nor is disabled
+  by it, and ``t`` commutes with every sequence outside ``S``;
 * **D2**: for every disabled ``t`` in ``S``: for one input place ``p`` with
-  ``M(p) < W(p, t)`` (its *scapegoat*), every transition that puts tokens into ``p`` is
-  in ``S`` (no sequence outside ``S`` can enable ``t``).
+  ``M(p) < W(p, t)`` (its *scapegoat*), every transition that raises the count of
+  ``p`` is in ``S`` (no sequence outside ``S`` can enable ``t``).
 
 Exploring only the enabled transitions of a stubborn set in each marking reaches every
 reachable deadlock (Valmari's theorem: a sequence to a deadlock can be permuted to start
@@ -103,18 +105,20 @@ class Relations:
                    seeds=0)
 
 
-def relations(compiled: CompiledNet) -> Relations:
+def relations(compiled: CompiledNet, *, moving_only: bool = True) -> Relations:
     """The :class:`Relations` of a net without reset arcs (arc weights taken into
     account: a row that puts back what it takes from a place neither lowers nor raises
-    it)."""
+    it). With ``moving_only=False`` every row takes part (rows that never change the
+    marking still count as enabled: a search for dead markings needs them)."""
     n_rows = len(compiled.transitions)
     n_places = len(compiled.places)
     net_effect = compiled.post_matrix - compiled.pre_matrix
     moves = (net_effect != 0).any(axis=1) if n_rows else np.zeros(0, dtype=bool)
+    taking_part = moves if moving_only else np.ones(n_rows, dtype=bool)
     needers: list[list[int]] = [[] for _ in range(n_places)]
     lowerers: list[list[int]] = [[] for _ in range(n_places)]
     raisers: list[list[int]] = [[] for _ in range(n_places)]
-    for t in np.flatnonzero(moves).tolist():
+    for t in np.flatnonzero(taking_part).tolist():
         for p, _ in compiled.pre[t]:
             needers[p].append(t)
         for p in np.flatnonzero(net_effect[t] < 0).tolist():
@@ -122,7 +126,7 @@ def relations(compiled: CompiledNet) -> Relations:
         for p in np.flatnonzero(net_effect[t] > 0).tolist():
             raisers[p].append(t)
     conf: list[list[int]] = [[] for _ in range(n_rows)]
-    for t in np.flatnonzero(moves).tolist():
+    for t in np.flatnonzero(taking_part).tolist():
         found: set[int] = set()
         for p, _ in compiled.pre[t]:
             found.update(lowerers[p])
@@ -132,10 +136,10 @@ def relations(compiled: CompiledNet) -> Relations:
         conf[t] = sorted(found)
     conf_ptr, conf_idx = _csr(conf)
     inc_ptr, inc_idx = _csr(raisers)
-    order = sorted(np.flatnonzero(moves).tolist(), key=lambda t: (len(conf[t]), t))
+    order = sorted(np.flatnonzero(taking_part).tolist(), key=lambda t: (len(conf[t]), t))
     rank = np.full(n_rows, n_rows, dtype=np.int64)
     rank[order] = np.arange(len(order), dtype=np.int64)
-    return Relations(moves.astype(np.bool_), conf_ptr, conf_idx, inc_ptr, inc_idx, rank)
+    return Relations(taking_part.astype(np.bool_), conf_ptr, conf_idx, inc_ptr, inc_idx, rank)
 
 
 def _csr(lists: list[list[int]]) -> tuple[np.ndarray, np.ndarray]:
@@ -174,16 +178,13 @@ class _Stubborn:
 
     def __init__(self, compiled: CompiledNet) -> None:
         self.compiled = compiled
-        n_places = len(compiled.places)
-        self.producers: list[list[int]] = [[] for _ in range(n_places)]
-        for t, post in enumerate(compiled.post):
-            for p, _ in post:
-                self.producers[p].append(t)
         self.consumers = compiled.consumers
-        # transitions sharing an input place with t (t itself included)
-        self.conflicts = [sorted({u for p, _ in compiled.pre[t] for u in self.consumers[p]})
-                          for t in range(len(compiled.transitions))]
         self.reduced = not compiled.has_resets
+        # D1 and D2 as the compiled search has them (:func:`relations`), every row taking
+        # part: per row the rows it conflicts with, per place the rows that raise it
+        rel = relations(compiled, moving_only=False)
+        self.conflicts = [rel.conf_idx[a:b].tolist() for a, b in zip(rel.conf_ptr[:-1], rel.conf_ptr[1:])]
+        self.producers = [rel.inc_idx[a:b].tolist() for a, b in zip(rel.inc_ptr[:-1], rel.inc_ptr[1:])]
 
     def enabled(self, m: tuple[int, ...]) -> list[int]:
         return [t for t, pre in enumerate(self.compiled.pre) if all(m[p] >= w for p, w in pre)]
