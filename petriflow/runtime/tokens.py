@@ -108,9 +108,15 @@ class TokenStore:
         initial: token counts to start with (tokens without data).
         final: the final marking, if the net has one (tracked in ``O(1)`` per change).
 
+    A place whose tokens all carry no data (black tokens, most places of most nets)
+    keeps only its count: its data is ``None`` until a token with data arrives, and
+    becomes ``None`` again when the place empties. A run over plain control flow then
+    allocates nothing per place and touches only the count vector.
+
     Attributes:
         counts: per place index, the token count (what the firing rule reads).
-        data: per place index, a deque of the tokens' data.
+        data: per place index, a deque of the tokens' data, or ``None`` when every
+            token there is black (its count says how many).
     """
 
     def __init__(self, compiled: CompiledNet, initial: Mapping[str, int],
@@ -119,7 +125,7 @@ class TokenStore:
         self.places = compiled.places
         self.index = compiled.place_index
         self.counts = [0] * len(self.places)
-        self.data: list[deque] = [deque() for _ in self.places]
+        self.data: list[deque | None] = [None] * len(self.places)
         self._final = None if final is None else compiled.vector(final)
         self.mismatch = 0
         self.replace({p: [None] * n for p, n in initial.items()})
@@ -127,12 +133,13 @@ class TokenStore:
     def replace(self, tokens: Mapping[str, Iterable[Any]]) -> None:
         """Set every place's tokens (places not named hold none)."""
         for i in range(len(self.places)):
-            self.data[i] = deque()
+            self.data[i] = None
             self.counts[i] = 0
         for place, items in tokens.items():
             i = self.index[place]
-            self.data[i] = deque(items)
-            self.counts[i] = len(self.data[i])
+            items = list(items)
+            self.data[i] = deque(items) if any(item is not None for item in items) else None
+            self.counts[i] = len(items)
         final = self._final
         self.mismatch = 0 if final is None else sum(c != f for c, f in zip(self.counts, final))
 
@@ -160,7 +167,12 @@ class TokenStore:
         taken = {}
         for p, w in compiled.pre[row]:  # the compiled rule's consume, with the tokens' data
             queue = data[p]
-            taken[places[p]] = [queue.popleft()] if w == 1 else [queue.popleft() for _ in range(w)]
+            if queue is None:  # black tokens only
+                taken[places[p]] = [None] * w
+            else:
+                taken[places[p]] = [queue.popleft()] if w == 1 else [queue.popleft() for _ in range(w)]
+                if not queue:
+                    data[p] = None
             count = counts[p]
             counts[p] = count - w
             if final is not None:
@@ -175,12 +187,15 @@ class TokenStore:
         taken = {}
         for p, w in compiled.pre[row]:
             queue = data[p]
-            taken[places[p]] = [queue.popleft() for _ in range(w)]
+            taken[places[p]] = [None] * w if queue is None else [queue.popleft() for _ in range(w)]
+            if queue is not None and not queue:
+                data[p] = None
         withdrawn = {}
         for p in compiled.reset[row]:
-            if data[p]:
-                withdrawn[places[p]] = len(data[p])
-                data[p].clear()
+            count = counts[p] - sum(w for q, w in compiled.pre[row] if q == p)
+            if count:
+                withdrawn[places[p]] = count
+            data[p] = None
         compiled.consume(counts, row)
         for p, count in before.items():
             self._track(p, count)
@@ -202,12 +217,16 @@ class TokenStore:
             if skip[p]:
                 continue
             item = outputs.get(places[p], result) if outputs else result
-            if w == 1:
-                data[p].append(item)
-            else:
-                data[p].extend([item] * w)
-            produced[places[p]] = w
+            queue = data[p]
             count = counts[p]
+            if queue is None:
+                if item is not None:  # the first token with data: keep the black ones before it
+                    data[p] = deque([None] * count + [item] * w)
+            elif w == 1:
+                queue.append(item)
+            else:
+                queue.extend([item] * w)
+            produced[places[p]] = w
             counts[p] = count + w
             if final is not None:
                 wanted = final[p]
@@ -218,17 +237,24 @@ class TokenStore:
         """One token with data ``item`` arrives in place index ``i`` (a delivery)."""
         before = self.counts[i]
         self.counts[i] += 1
-        self.data[i].append(item)
+        queue = self.data[i]
+        if queue is not None:
+            queue.append(item)
+        elif item is not None:
+            self.data[i] = deque([None] * before + [item])
         self._track(i, before)
 
     def offered(self, row: int) -> dict[str, list[Any]]:
         """``{place: [data, ...]}`` of the tokens firing ``row`` would take now."""
         data, places = self.data, self.places
-        return {places[p]: [data[p][k] for k in range(w)] for p, w in self.compiled.pre[row]}
+        return {places[p]: [None] * w if data[p] is None else [data[p][k] for k in range(w)]
+                for p, w in self.compiled.pre[row]}
 
     def read(self, place: str) -> list[Any]:
         """The data of the tokens in ``place`` (oldest first), not taken."""
-        return list(self.data[self.index[place]])
+        i = self.index[place]
+        queue = self.data[i]
+        return [None] * self.counts[i] if queue is None else list(queue)
 
     def marking(self) -> Marking:
         """Token counts now."""
@@ -236,4 +262,5 @@ class TokenStore:
 
     def tokens(self) -> dict[str, list[Any]]:
         """``{place: [data, ...]}`` of the marked places."""
-        return {self.places[i]: list(q) for i, q in enumerate(self.data) if q}
+        return {self.places[i]: [None] * c if q is None else list(q)
+                for i, (c, q) in enumerate(zip(self.counts, self.data)) if c}
