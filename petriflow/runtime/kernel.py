@@ -34,9 +34,8 @@ Examples:
     >>> clock.schedule(2, Note("second")); clock.schedule(1, Note("first"))
     >>> clock.peek()
     1
-    >>> clock.tick = 1; [event.apply(tick) for tick, event in clock.pop_due()]
+    >>> clock.tick = 1; clock.run_due()
     first 0.5
-    [None]
 """
 
 from __future__ import annotations
@@ -205,10 +204,10 @@ class Kernel:
         bucket = self._buckets.get(self.tick)
         return bucket is not None and bool(bucket[0] or bucket[1] or bucket[2])
 
-    def pop_due(self) -> Iterator[tuple[int, Scheduled]]:
-        """Take the live events due at the current tick, in order (timed events by
-        time, polls by key, then applies), as ``(tick, event)``. Timed events and
-        applies scheduled for the current tick while iterating are taken too."""
+    def run_due(self) -> None:
+        """Apply the live events due at the current tick, in order (timed events by
+        time, polls by key, then applies). Timed events, polls and applies scheduled
+        for the current tick while they run are applied too."""
         tick = self.tick
         bucket = self._buckets.get(tick)
         if bucket is None:
@@ -218,12 +217,12 @@ class Kernel:
             event = heapq.heappop(timed)[3]
             if event.live(tick):  # a cancelled one was counted off by its canceller
                 self.pending -= 1
-                yield tick, event
+                event.apply(tick)
         if polls:
             polls.sort()
             for _, _, event in polls:
                 if event.live(tick):
-                    yield tick, event
+                    event.apply(tick)
             polls.clear()
         index = 0
         while index < len(applies):
@@ -231,7 +230,7 @@ class Kernel:
             index += 1
             self.pending -= 1
             if event.live(tick):
-                yield tick, event
+                event.apply(tick)
         applies.clear()
 
     def __len__(self) -> int:

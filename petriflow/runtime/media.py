@@ -152,8 +152,7 @@ class ProcessClock:
             if tick is None or tick > limit:
                 break
             kernel.tick = tick
-            for _, event in kernel.pop_due():
-                event.apply(tick)
+            kernel.run_due()
         kernel.tick = max(kernel.tick, limit)
 
 

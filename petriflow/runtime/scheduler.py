@@ -288,8 +288,7 @@ class Scheduler:
         kernel = self.kernel
         self._opened = True
         while True:
-            for tick, event in kernel.pop_due():
-                event.apply(tick)
+            kernel.run_due()
             if fire:
                 self.firer.fire_instant()
             if not kernel.due():

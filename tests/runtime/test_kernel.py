@@ -15,8 +15,7 @@ class Note(Scheduled):
 
 
 def drain(kernel):
-    for tick, event in kernel.pop_due():
-        event.apply(tick)
+    kernel.run_due()
 
 
 def test_polls_come_first_in_key_order_then_applies_in_schedule_order():
