@@ -132,32 +132,32 @@ class Firer:
 
     def fire(self, t: int) -> None:
         """Fire transition index ``t`` now: consume, cancel its region, start its action."""
-        index, recorder = self.index, self.recorder
-        tid, agent = index.ids[t], index.agent[t]
-        self.count += 1
-        number = self.count
+        index = self.index
+        self.count = number = self.count + 1
         kernel = self.kernel
-        self.progress = kernel.tick
+        tick = self.progress = kernel.tick
         inputs, withdrawn = self.tokens.consume(index.row[t])
         dirty = self.enabled.dirty
         for group in self._touched[t]:
             dirty.update(group)
+        agent = index.agent[t]
         if self._acts[t]:
             self.agents.acted(agent)
+        recorder = self.recorder
         if recorder.handlers:
             details: dict[str, Any] = {"firing": number, "consumed": {p: len(v) for p, v in inputs.items()}}
             carried = {p: [summarize(d) for d in v] for p, v in inputs.items() if any(d is not None for d in v)}
             if carried:
                 details["inputs"] = carried
-            recorder.emit(_START, tid, agent, **details)
+            recorder.emit(_START, index.ids[t], agent, **details)
         else:
             recorder.count += 1
-        if index.cancels[t] or withdrawn:
+        if withdrawn or index.cancels[t]:
             self._cancel_region(t, number, withdrawn)
-        now = kernel.tick * kernel.dt
-        ctx = ActionContext(tid, agent, index.params[t], inputs, self.world, self._seed_prefix + str(number),
-                            now, now, None, False, None, "", None, None, self, self._declared[t])
-        self.runner.start(t, number, ctx)
+        now = tick * kernel.dt
+        self.runner.start(t, number, ActionContext(index.ids[t], agent, index.params[t], inputs, self.world,
+                                                   self._seed_prefix + str(number), now, now, None, False, None,
+                                                   "", None, None, self, self._declared[t]))
         if t in self._running:  # running: it cannot fire again before its action ends (which marks it)
             self._agenda.discard(t)
         else:  # ended at once: check it again
@@ -192,8 +192,20 @@ class Firer:
             ctx.emitted.clear()
         produced: dict[str, int] = {}
         sent: list[tuple[str, Any]] = []
-        if row is not None:
-            produced, sent = self._produce(row, ctx)
+        if row is not None:  # the outputs: tokens here, messages once the end is recorded
+            result, outputs = ctx.result, ctx.outputs
+            if ctx.per_place and isinstance(result, dict):
+                result, outputs = None, result
+            channel = self.index.channel
+            produced = self.tokens.produce(row, result, outputs, channel)
+            dirty = self.enabled.dirty
+            for group in self._fed[row]:
+                dirty.update(group)
+            if self._sends[row]:
+                places = self.index.compiled.places
+                for p, w in self.index.compiled.post[row]:
+                    if channel[p]:
+                        sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
         if recorder.handlers:
             details: dict[str, Any] = {"firing": number, "outcome": outcome.value, "produced": produced}
             if ctx.result is not None:
@@ -205,22 +217,3 @@ class Firer:
             recorder.count += 1
         for place, data in sent:
             self.channels.send(place, data, ctx.agent)
-
-    def _produce(self, row: int, ctx: ActionContext) -> tuple[dict[str, int], list[tuple[str, Any]]]:
-        """Put a firing's outputs into the places of ``row``; returns the counts produced
-        and the messages for channel places (sent once the end is recorded)."""
-        result, outputs = ctx.result, ctx.outputs
-        if ctx.per_place and isinstance(result, dict):
-            result, outputs = None, result
-        channel = self.index.channel
-        produced = self.tokens.produce(row, result, outputs, channel)
-        dirty = self.enabled.dirty
-        for group in self._fed[row]:
-            dirty.update(group)
-        sent: list[tuple[str, Any]] = []
-        if self._sends[row]:
-            places = self.index.compiled.places
-            for p, w in self.index.compiled.post[row]:
-                if channel[p]:
-                    sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
-        return produced, sent

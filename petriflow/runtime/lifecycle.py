@@ -15,6 +15,7 @@ transition fail with it.
 
 from __future__ import annotations
 
+from math import ceil
 from typing import Any, Callable, Protocol
 
 from petriflow.outcome import Outcome
@@ -57,7 +58,7 @@ class Firing(Scheduled):
         return self.running and self.wake == tick
 
     def apply(self, tick: int) -> None:
-        if self.polled != self.runner.kernel.tick:  # once per tick, whichever entry comes first
+        if self.polled != tick:  # once per tick, whichever entry comes first
             self.runner.poll(self)
 
 
@@ -125,8 +126,10 @@ class ActionRunner:
             tick = max(kernel.tick + 1, kernel.ticks_at(firing.deadline))
             kernel.schedule(tick, Deadline(firing, number), key=number)
         wake = action.wake_at
-        if wake is not None and not action.needs_world and wake > now + 1e-12:
-            self._wake(firing, max(kernel.tick + 1, kernel.ticks_at(wake)))  # first poll when it asked
+        if wake is not None and not action.needs_world and wake > now + 1e-12:  # first poll when it asked
+            tick = kernel.tick + 1
+            firing.wake = tick = max(tick, ceil(wake / kernel.dt - 1e-9))  # kernel.ticks_at, inline
+            kernel.schedule_poll(tick, firing, number)
         else:
             self.poll(firing)
 
@@ -162,11 +165,10 @@ class ActionRunner:
         if status is Status.OK:
             outcome = Outcome.OK
         elif status is Status.RUNNING:
-            if action.needs_world:
-                self._wake(firing, tick + 1)
-            else:
-                wake = action.wake_at
-                self._wake(firing, tick + 1 if wake is None else max(tick + 1, kernel.ticks_at(wake)))
+            wake = action.wake_at
+            firing.wake = tick = tick + 1 if wake is None or action.needs_world else \
+                max(tick + 1, ceil(wake / kernel.dt - 1e-9))  # kernel.ticks_at, inline
+            kernel.schedule_poll(tick, firing, firing.number)
             return
         else:
             if status is not Status.FAILED:
