@@ -105,7 +105,7 @@ class Firer:
                 refresh()
             if not agenda:
                 return
-            t = agenda.pick(draw)
+            t = agenda.take(draw)
             fire(t)
             self.now_count += 1
             if self.now_count > watch:
@@ -159,7 +159,8 @@ class Firer:
                                                    self._seed_prefix + str(number), now, now, None, False, None,
                                                    "", None, None, self, self._declared[t]))
         if t in self._running:  # running: it cannot fire again before its action ends (which marks it)
-            self._agenda.discard(t)
+            if self._agenda.on[t]:  # fired from outside the agenda's take (fire_one)
+                self._agenda.discard(t)
         else:  # ended at once: check it again
             dirty.add(t)
 
@@ -191,7 +192,7 @@ class Firer:
                 recorder.emit(_CUSTOM, tid, ctx.agent, firing=number, name=kind, data=summarize(data))
             ctx.emitted.clear()
         produced: dict[str, int] = {}
-        sent: list[tuple[str, Any]] = []
+        sent: list[tuple[str, Any]] | None = None
         if row is not None:  # the outputs: tokens here, messages once the end is recorded
             result, outputs = ctx.result, ctx.outputs
             if ctx.per_place and isinstance(result, dict):
@@ -202,7 +203,7 @@ class Firer:
             for group in self._fed[row]:
                 dirty.update(group)
             if self._sends[row]:
-                places = self.index.compiled.places
+                sent, places = [], self.index.compiled.places
                 for p, w in self.index.compiled.post[row]:
                     if channel[p]:
                         sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
@@ -215,5 +216,6 @@ class Firer:
             recorder.emit(_END, tid, ctx.agent, **details)
         else:
             recorder.count += 1
-        for place, data in sent:
-            self.channels.send(place, data, ctx.agent)
+        if sent:
+            for place, data in sent:
+                self.channels.send(place, data, ctx.agent)

@@ -19,6 +19,8 @@ Examples:
     (3, 3)
     >>> agenda.add(2); agenda.pick(lambda: 0.0)
     2
+    >>> agenda.take(lambda: 0.99), agenda.pick(lambda: 0.99), len(agenda)
+    (3, 1, 3)
 """
 
 from __future__ import annotations
@@ -93,6 +95,16 @@ class Agenda:
                 if len(level) == 1:
                     return level[0]
                 return level[int(draw() * len(level))]
+        raise LookupError("no transition is enabled")
+
+    def take(self, draw: Callable[[], float]) -> int:
+        """:meth:`pick` and :meth:`discard` the transition picked (what a firing does)."""
+        for level in self._levels:
+            if level:
+                t = level.pop() if len(level) == 1 else level.pop(int(draw() * len(level)))
+                self.on[t] = False
+                self._count -= 1
+                return t
         raise LookupError("no transition is enabled")
 
     def members(self) -> list[int]:
