@@ -174,8 +174,11 @@ class ActionRunner:
             if status is not Status.FAILED:
                 ctx.reason = f"poll() returned {status!r}, not a Status"
             outcome = Outcome.FAILED
-        self._stop(firing)
-        self.finish(firing.number, firing.index, ctx, outcome)
+        t = firing.index  # stopped (as _stop does, inline on the commonest path)
+        firing.running = False
+        del self.running[t]
+        self.enabled.dirty.add(t)
+        self.finish(firing.number, t, ctx, outcome)
 
     def _drive_cancel(self, firing: Firing, ctx: ActionContext, action: Action, tick: int) -> None:
         outcome = firing.cancelling
