@@ -119,7 +119,7 @@ class EnabledSet:
 
     def refresh(self) -> None:
         """Check the dirty transitions again (:meth:`can_fire`, with its common cases,
-        a running transition, a state guard whose kept answer is no, or one short of
+        a running transition, a state guard whose answer is kept, or one short of
         tokens, decided inline)."""
         dirty = self.dirty
         if dirty:
@@ -128,7 +128,8 @@ class EnabledSet:
             agent, alive = self.index.agent, self.alive
             add, discard, on = agenda.add, agenda.discard, agenda.on
             for t in dirty:
-                if t in running or answer[t] is False:  # running, or a state guard's kept "no"
+                kept = answer[t]
+                if kept is False or t in running:  # a state guard's kept "no", or running
                     if on[t]:
                         discard(t)
                     continue
@@ -138,15 +139,17 @@ class EnabledSet:
                             discard(t)
                         break
                 else:
-                    if guard[t] is None:  # no guard: its agent's liveness decides
+                    if guard[t] is None or kept:  # no guard, or a state guard's kept "yes": the agent decides
                         a = agent[t]
                         if a is None or alive.get(a, True):
-                            add(t)
-                        else:
+                            if not on[t]:
+                                add(t)
+                        elif on[t]:
                             discard(t)
                     elif can_fire(t):
-                        add(t)
-                    else:
+                        if not on[t]:
+                            add(t)
+                    elif on[t]:
                         discard(t)
             dirty.clear()
 
