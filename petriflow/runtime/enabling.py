@@ -6,11 +6,17 @@ action is not already running (a transition runs one firing at a time).
 
 :class:`EnabledSet` keeps the transitions that may fire in an
 :class:`~petriflow.runtime.tokens.Agenda`. Whatever changes something a transition's
-enabling reads marks it *dirty* (:meth:`EnabledSet.mark`): a firing marks the
-consumers of the places it took from or put into, a delivery the consumers of its
-channel place, a fault the transitions of its agent. Only dirty transitions are
-checked again, at the next :meth:`~EnabledSet.refresh`, so a firing's cost does not
-grow with the size of the net.
+enabling reads marks it *dirty* (:meth:`EnabledSet.mark`): a fault the transitions of
+its agent, a transition starting or ending its action itself. Tokens are marked by
+place (:meth:`EnabledSet.mark_place`): a firing marks the places it took from or put
+into, a delivery its channel place. At the next :meth:`~EnabledSet.refresh` a marked
+place makes its consumers dirty only where their answer may have changed: a consumer
+that reads only the place's count, when the count crossed its arc weight since the
+last refresh (a place an instant firing takes a token from and gives one back, an
+agent's control place, re-checks nobody); a guard over the tokens it would take, at
+any change. Only dirty transitions are checked again, so a firing's cost does not
+grow with the size of the net, nor with the number of transitions sharing a place
+whose tokens did not change.
 
 Examples:
     >>> from petriflow.io.yaml import loads_net
@@ -69,6 +75,19 @@ class EnabledSet:
         self.states: Mapping[str, Any] = {} if states is None else states
         self.agenda = Agenda(index.priority)
         self.dirty: set[int] = set(range(len(index.ids)))
+        #: Places whose tokens changed since the last refresh.
+        self.changed: set[int] = set()
+        self._seen = list(tokens.counts)  # per place, its count when its consumers were last checked
+        pre = index.compiled.pre
+        weights: list[dict[int, int]] = [{} for _ in index.consumers]  # place -> {consumer: arc weight}
+        for t, r in enumerate(index.row):
+            for p, w in pre[r]:
+                weights[p][t] = w
+        token_guard = [index.guard[t] is not None and index.reads[t] is None for t in range(len(index.ids))]
+        #: per place: its consumers that read its tokens' data (a guard over them), and
+        #: the largest arc weight of the others (below it, a count change can matter)
+        self._reading = [tuple(t for t in ws if token_guard[t]) for ws in weights]
+        self._need = [max((w for t, w in ws.items() if not token_guard[t]), default=0) for ws in weights]
         self.answer: list[bool | None] = [None] * len(index.ids)  # kept answers of state guards
         #: How many times a guard was called (what "cost by what changed" saves).
         self.evaluations = 0
@@ -83,8 +102,30 @@ class EnabledSet:
         self.dirty.update(transitions)
 
     def mark_place(self, place: int) -> None:
-        """Check again the transitions that consume from place index ``place``."""
-        self.dirty.update(self.index.consumers[place])
+        """The tokens of place index ``place`` changed: at the next refresh, check again
+        the consumers whose answer that may change (see the module)."""
+        self.changed.add(place)
+
+    def resync(self) -> None:
+        """Every place's tokens were replaced: check every transition again."""
+        self._seen = list(self.tokens.counts)
+        self.changed.clear()
+        self.dirty.update(range(len(self.index.ids)))
+
+    def _places(self) -> None:
+        """Make dirty the consumers of the changed places whose answer may have changed."""
+        dirty, counts, seen, need, reading = self.dirty, self.tokens.counts, self._seen, self._need, self._reading
+        consumers = self.index.consumers
+        for p in self.changed:
+            now, before = counts[p], seen[p]
+            if now != before and (now < need[p] or before < need[p]):
+                dirty.update(consumers[p])
+                seen[p] = now
+            else:
+                seen[p] = now
+                if reading[p]:
+                    dirty.update(reading[p])
+        self.changed.clear()
 
     def can_fire(self, t: int) -> bool:
         """Whether transition index ``t`` may fire now (checked afresh).
@@ -121,41 +162,39 @@ class EnabledSet:
         """Check the dirty transitions again (:meth:`can_fire`, with its common cases,
         a running transition, a state guard whose answer is kept, or one short of
         tokens, decided inline)."""
+        if self.changed:
+            self._places()
         dirty = self.dirty
         if dirty:
-            agenda, can_fire, running, answer = self.agenda, self.can_fire, self.running, self.answer
+            can_fire, running, answer, on = self.can_fire, self.running, self.answer, self.agenda.on
             counts, row, pre, guard = self.tokens.counts, self.index.row, self.index.compiled.pre, self.index.guard
             agent, alive = self.index.agent, self.alive
-            add, discard, on = agenda.add, agenda.discard, agenda.on
+            up: list[int] = []
+            down: list[int] = []
             for t in dirty:
                 kept = answer[t]
                 if kept is False or t in running:  # a state guard's kept "no", or running
-                    if on[t]:
-                        discard(t)
-                    continue
-                for p, w in pre[row[t]]:
-                    if counts[p] < w:
-                        if on[t]:
-                            discard(t)
-                        break
+                    ok = False
                 else:
-                    if guard[t] is None or kept:  # no guard, or a state guard's kept "yes": the agent decides
-                        a = agent[t]
-                        if a is None or alive.get(a, True):
-                            if not on[t]:
-                                add(t)
-                        elif on[t]:
-                            discard(t)
-                    elif can_fire(t):
-                        if not on[t]:
-                            add(t)
-                    elif on[t]:
-                        discard(t)
+                    for p, w in pre[row[t]]:
+                        if counts[p] < w:
+                            ok = False
+                            break
+                    else:
+                        if guard[t] is None or kept:  # no guard, or a state guard's kept "yes": the agent decides
+                            a = agent[t]
+                            ok = a is None or alive.get(a, True)
+                        else:
+                            ok = can_fire(t)
+                if ok != on[t]:
+                    (up if ok else down).append(t)
             dirty.clear()
+            if up or down:
+                self.agenda.change(up, down)
 
     def pick(self, draw: Callable[[], float]) -> int | None:
         """The transition to fire next (see :meth:`Agenda.pick`), or ``None`` when none may."""
-        if self.dirty:
+        if self.dirty or self.changed:
             self.refresh()
         if not self.agenda:
             return None

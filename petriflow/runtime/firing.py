@@ -73,17 +73,14 @@ class Firer:
         self.resources: Any = None  # set by the run (petriflow.runtime.resources.Resources)
         self._declared = [getattr(cls, "resources", None) or None for cls in index.action_class]
         compiled, consumers = index.compiled, index.consumers
-        # per transition, what a firing marks for re-checking: the consumers of the places
-        # it takes from or empties (the tuples are shared, not copied), less a place only
-        # it consumes from (the transition itself is settled once its action starts)
-        self._touched = [tuple(group for group in dict.fromkeys(
-            consumers[p] for p in (*(p for p, _ in compiled.pre[index.row[t]]), *compiled.reset[index.row[t]]))
-            if group != (t,)) for t in range(len(index.ids))]
+        # per transition, the places a firing takes from or empties
+        self._touched = [tuple(dict.fromkeys((*(p for p, _ in compiled.pre[r]), *compiled.reset[r])))
+                         for r in index.row]
         self._running = self.runner.running
         self._agenda = enabled.agenda
         self._acts = [self.agents.any_readers(index.agent[t]) for t in range(len(index.ids))]
-        # per compiled row, the consumers of its non-channel output places
-        self._fed = [tuple(consumers[p] for p, _ in compiled.post[r] if not index.channel[p])
+        # per compiled row, its non-channel output places
+        self._fed = [tuple(p for p, _ in compiled.post[r] if not index.channel[p] and consumers[p])
                      for r in range(len(compiled.transitions))]
         # per compiled row, whether it puts tokens into channel places (messages)
         self._sends = [any(index.channel[p] for p, _ in compiled.post[r]) for r in range(len(compiled.transitions))]
@@ -98,10 +95,11 @@ class Firer:
     def fire_instant(self) -> None:
         """Fire until nothing more can fire at this instant (or the firing limit)."""
         limit, draw, enabled = self.limit, self._rng.random, self.enabled
-        agenda, dirty, refresh, fire = enabled.agenda, enabled.dirty, enabled.refresh, self.fire
+        agenda, dirty, changed, refresh, fire = enabled.agenda, enabled.dirty, enabled.changed, enabled.refresh, \
+            self.fire
         watch = limits.FIRINGS_PER_INSTANT - 64
         while limit is None or self.count < limit:
-            if dirty:
+            if dirty or changed:
                 refresh()
             if not agenda:
                 return
@@ -137,9 +135,8 @@ class Firer:
         kernel = self.kernel
         tick = self.progress = kernel.tick
         inputs, withdrawn = self.tokens.consume(index.row[t])
-        dirty = self.enabled.dirty
-        for group in self._touched[t]:
-            dirty.update(group)
+        enabled = self.enabled
+        enabled.changed.update(self._touched[t])
         agent = index.agent[t]
         if self._acts[t]:
             self.agents.acted(agent)
@@ -162,7 +159,7 @@ class Firer:
             if self._agenda.on[t]:  # fired from outside the agenda's take (fire_one)
                 self._agenda.discard(t)
         else:  # ended at once: check it again
-            dirty.add(t)
+            enabled.dirty.add(t)
 
     def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:
         cancelled = self.runner.cancel(list(self.index.cancels[t]))
@@ -199,9 +196,7 @@ class Firer:
                 result, outputs = None, result
             channel = self.index.channel
             produced = self.tokens.produce(row, result, outputs, channel)
-            dirty = self.enabled.dirty
-            for group in self._fed[row]:
-                dirty.update(group)
+            self.enabled.changed.update(self._fed[row])
             if self._sends[row]:
                 sent, places = [], self.index.compiled.places
                 for p, w in self.index.compiled.post[row]:

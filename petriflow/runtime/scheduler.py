@@ -263,7 +263,7 @@ class Scheduler:
         for place in tokens:
             self.net.place(place)
         self.tokens.replace(tokens)
-        self.enabled_set.mark(range(len(self.index.ids)))
+        self.enabled_set.resync()
 
     # Running ------------------------------------------------------------------------
     def start(self) -> None:
