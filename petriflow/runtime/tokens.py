@@ -20,7 +20,9 @@ Examples:
     >>> agenda.add(2); agenda.pick(lambda: 0.0)
     2
     >>> agenda.take(lambda: 0.99), agenda.pick(lambda: 0.99), len(agenda)
-    (3, 1, 3)
+    (2, 3, 3)
+    >>> agenda.change(up=[2], down=[0, 3]); agenda.members(), len(agenda)
+    ([1, 2], 2)
 """
 
 from __future__ import annotations
@@ -86,6 +88,28 @@ class Agenda:
                 level.pop()
             else:
                 del level[bisect_left(level, t)]
+
+    def change(self, up: Iterable[int], down: Iterable[int]) -> None:
+        """Mark the transitions ``up`` enabled and those ``down`` not (each must be off,
+        respectively on, now): :meth:`add` and :meth:`discard` for many at once."""
+        on, level_of, count = self.on, self._level, self._count
+        for t in down:
+            on[t] = False
+            count -= 1
+            level = level_of[t]
+            if level[-1] == t:
+                level.pop()
+            else:
+                del level[bisect_left(level, t)]
+        for t in up:
+            on[t] = True
+            count += 1
+            level = level_of[t]
+            if not level or level[-1] < t:
+                level.append(t)
+            else:
+                insort(level, t)
+        self._count = count
 
     def pick(self, draw: Callable[[], float]) -> int:
         """The transition to fire: of the highest priority enabled, the only one, or
