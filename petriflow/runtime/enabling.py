@@ -85,9 +85,12 @@ class EnabledSet:
                 weights[p][t] = w
         token_guard = [index.guard[t] is not None and index.reads[t] is None for t in range(len(index.ids))]
         #: per place: its consumers that read its tokens' data (a guard over them), and
-        #: the largest arc weight of the others (below it, a count change can matter)
+        #: the largest arc weight of the others (below it, a count change can matter);
+        #: -1 for a place with one consumer, woken at every change (a firing does not
+        #: mark a place only it consumes from: it checks itself again when it ends)
         self._reading = [tuple(t for t in ws if token_guard[t]) for ws in weights]
-        self._need = [max((w for t, w in ws.items() if not token_guard[t]), default=0) for ws in weights]
+        self._need = [-1 if len(ws) == 1 else max((w for t, w in ws.items() if not token_guard[t]), default=0)
+                      for ws in weights]
         self.answer: list[bool | None] = [None] * len(index.ids)  # kept answers of state guards
         #: How many times a guard was called (what "cost by what changed" saves).
         self.evaluations = 0
@@ -117,14 +120,12 @@ class EnabledSet:
         dirty, counts, seen, need, reading = self.dirty, self.tokens.counts, self._seen, self._need, self._reading
         consumers = self.index.consumers
         for p in self.changed:
-            now, before = counts[p], seen[p]
-            if now != before and (now < need[p] or before < need[p]):
+            now, before, n = counts[p], seen[p], need[p]
+            seen[p] = now
+            if n < 0 or (now != before and (now < n or before < n)):
                 dirty.update(consumers[p])
-                seen[p] = now
-            else:
-                seen[p] = now
-                if reading[p]:
-                    dirty.update(reading[p])
+            elif reading[p]:
+                dirty.update(reading[p])
         self.changed.clear()
 
     def can_fire(self, t: int) -> bool:

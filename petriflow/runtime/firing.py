@@ -73,9 +73,10 @@ class Firer:
         self.resources: Any = None  # set by the run (petriflow.runtime.resources.Resources)
         self._declared = [getattr(cls, "resources", None) or None for cls in index.action_class]
         compiled, consumers = index.compiled, index.consumers
-        # per transition, the places a firing takes from or empties
-        self._touched = [tuple(dict.fromkeys((*(p for p, _ in compiled.pre[r]), *compiled.reset[r])))
-                         for r in index.row]
+        # per transition, the places a firing takes from or empties, less a place only it
+        # consumes from (the transition itself is settled once its action starts)
+        self._touched = [tuple(p for p in dict.fromkeys((*(p for p, _ in compiled.pre[r]), *compiled.reset[r]))
+                               if consumers[p] != (t,)) for t, r in enumerate(index.row)]
         self._running = self.runner.running
         self._agenda = enabled.agenda
         self._acts = [self.agents.any_readers(index.agent[t]) for t in range(len(index.ids))]
