@@ -142,7 +142,7 @@ class Firer:
         if self._acts[t]:
             self.agents.acted(agent)
         recorder = self.recorder
-        if recorder.handlers:
+        if recorder.by_kind[_START]:
             details: dict[str, Any] = {"firing": number, "consumed": {p: len(v) for p, v in inputs.items()}}
             carried = {p: [summarize(d) for d in v] for p, v in inputs.items() if any(d is not None for d in v)}
             if carried:
@@ -187,7 +187,10 @@ class Firer:
                                          action=self.net.transitions[tid].action))
         if ctx.emitted:
             for kind, data in ctx.emitted:
-                recorder.emit(_CUSTOM, tid, ctx.agent, firing=number, name=kind, data=summarize(data))
+                if recorder.by_kind[_CUSTOM]:
+                    recorder.emit(_CUSTOM, tid, ctx.agent, firing=number, name=kind, data=summarize(data))
+                else:
+                    recorder.count += 1
             ctx.emitted.clear()
         produced: dict[str, int] = {}
         sent: list[tuple[str, Any]] | None = None
@@ -203,7 +206,7 @@ class Firer:
                 for p, w in self.index.compiled.post[row]:
                     if channel[p]:
                         sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
-        if recorder.handlers:
+        if recorder.by_kind[_END]:
             details: dict[str, Any] = {"firing": number, "outcome": outcome.value, "produced": produced}
             if ctx.result is not None:
                 details["result"] = summarize(ctx.result)

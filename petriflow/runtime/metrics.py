@@ -10,11 +10,12 @@ wall clock, unless it is registered ``wall_clock=True`` (``core.wall_s``,
 the same value on every machine and backend.
 
 Register one with :func:`petriflow.metric` (or ``registry.metric``) in an action
-module or a plugin; ``events=True`` makes the run keep its events in memory for it::
+module or a plugin; ``events=True`` makes the run keep its events in memory for it,
+``events=("message",)`` only the events of those kinds (the others are not even built)::
 
     from petriflow import metric
 
-    @metric("bidding.messages", events=True)
+    @metric("bidding.messages", events=("message",))
     def messages(record):
         return sum(1 for e in record.events if e.kind == "message")
 
@@ -55,11 +56,11 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Iterable
 
 from petriflow.errors import PetriflowError
 
-__all__ = ["RunRecord", "MetricRef", "register", "parse_refs", "measure", "plain_value", "messages",
+__all__ = ["RunRecord", "MetricRef", "register", "parse_refs", "measure", "plain_value", "event_kinds", "messages",
            "messages_per_agent", "messages_per_channel", "cpu_s_per_sim_s"]
 
 
@@ -99,6 +100,19 @@ class RunRecord:
     def tokens(self) -> dict[str, list[Any]]:
         """``{place: [data, ...]}`` at the end."""
         return getattr(self.result, "tokens", {}) or {}
+
+
+def event_kinds(specs: Iterable[Any]) -> list[str] | None:
+    """The event kinds a run must keep for these metric specs: ``None`` for every kind
+    (one of them reads them all), else the kinds they name, in a fixed order (empty:
+    none reads events)."""
+    kinds: set[str] = set()
+    for spec in specs:
+        if spec.events is True:
+            return None
+        if spec.events:
+            kinds.update(spec.events)
+    return sorted(kinds)
 
 
 def end_time(record: RunRecord) -> float:

@@ -32,11 +32,12 @@ import importlib
 import logging
 from dataclasses import dataclass
 from importlib.metadata import entry_points
-from typing import Any, Callable
+from typing import Any, Callable, Iterable
 
 from petriflow.errors import PetriflowError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, Param, generator_action
+from petriflow.runtime.trace import EventKind
 
 __all__ = ["Registry", "ActionSpec", "MetricSpec", "UnknownActionError", "default_registry", "ENTRY_POINT_GROUP",
            "action", "guard", "metric"]
@@ -88,7 +89,9 @@ class MetricSpec:
     Attributes:
         name: the name sweep files use (``core.firings``, ``bidding.time_s``).
         target: ``f(record, **params)``, or a lazy ``"module:function"`` string.
-        events: whether it reads the run's events (the run then keeps them in memory).
+        events: whether it reads the run's events (the run then keeps them in memory):
+            ``True`` for every kind, or the kinds it reads (``("custom",)``,
+            :class:`~petriflow.runtime.trace.EventKind` values: only those are kept).
         doc: one line of documentation.
         wall_clock: it measures wall-clock time (or anything else outside the simulation),
             so it differs between runs of the same trial; reports mark it.
@@ -96,7 +99,7 @@ class MetricSpec:
 
     name: str
     target: Callable[..., Any] | str
-    events: bool = False
+    events: bool | tuple[str, ...] = False
     doc: str = ""
     wall_clock: bool = False
 
@@ -198,12 +201,19 @@ class Registry:
 
         return decorate
 
-    def register_metric(self, name: str, target: Callable[..., Any] | str, *, events: bool = False,
-                        doc: str = "", replace: bool = False, wall_clock: bool = False) -> None:
+    def register_metric(self, name: str, target: Callable[..., Any] | str, *,
+                        events: bool | Iterable[str] = False, doc: str = "", replace: bool = False,
+                        wall_clock: bool = False) -> None:
         """Register a metric ``f(record, **params)`` (or a lazy ``"module:function"``);
+        ``events``: it reads the run's events, all (``True``) or of these kinds;
         ``wall_clock``: it is not reproducible between runs (see :class:`MetricSpec`)."""
         if name in self._metrics and not replace:
             raise PetriflowError(f"metric {name!r} is already registered")
+        if not isinstance(events, bool):
+            events = tuple(events)
+            unknown = sorted(set(events) - {kind.value for kind in EventKind})
+            if unknown or not events:
+                raise PetriflowError(f"metric {name!r}: events names no event kind: {unknown or events}")
         if not doc and not isinstance(target, str) and target.__doc__:
             doc = target.__doc__.strip().splitlines()[0]
         self._metrics[name] = MetricSpec(name, target, events, doc, wall_clock)
@@ -234,8 +244,9 @@ class Registry:
         self._load_plugins()
         return sorted(self._channels)
 
-    def metric(self, name: str, *, events: bool = False, replace: bool = False) -> Callable:
-        """Decorator registering a metric; ``events``: it reads the run's events."""
+    def metric(self, name: str, *, events: bool | Iterable[str] = False, replace: bool = False) -> Callable:
+        """Decorator registering a metric; ``events``: it reads the run's events (all, or
+        of these kinds)."""
 
         def decorate(function: Callable[..., Any]) -> Callable[..., Any]:
             self.register_metric(name, function, events=events, replace=replace)
@@ -425,7 +436,8 @@ def guard(name: str, *, replace: bool = False, registry: Registry | None = None,
     return (registry or default_registry).predicate(name, replace=replace, reads=reads)
 
 
-def metric(name: str, *, events: bool = False, replace: bool = False, registry: Registry | None = None) -> Callable:
+def metric(name: str, *, events: bool | Iterable[str] = False, replace: bool = False,
+           registry: Registry | None = None) -> Callable:
     """Decorator registering a metric ``f(record, **params)`` under ``name`` (in the run
     registry by default); see :mod:`petriflow.runtime.metrics`."""
     return (registry or default_registry).metric(name, events=events, replace=replace)

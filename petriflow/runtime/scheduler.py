@@ -62,7 +62,7 @@ Examples:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Iterable
 
 from petriflow import limits
 from petriflow.collector import paused, relaxed
@@ -177,9 +177,11 @@ class Scheduler:
         self._finished: RunResult | None = None
 
     # Observers ----------------------------------------------------------------------
-    def on_event(self, handler: EventHandler) -> None:
-        """Call ``handler(event)`` for every event, in order."""
-        self.recorder.on_event(handler)
+    def on_event(self, handler: EventHandler, kinds: Iterable[str] | None = None) -> None:
+        """Call ``handler(event)`` for every event, in order (only for the events of
+        ``kinds``, :class:`~petriflow.runtime.trace.EventKind` values, when given: the
+        others are then not built for it)."""
+        self.recorder.on_event(handler, kinds)
 
     def on_instant(self, watcher: Any) -> None:
         """Call ``watcher(scheduler)`` after each instant: for displays that need no

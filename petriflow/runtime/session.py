@@ -297,12 +297,17 @@ def _can_create_in(folder: Path) -> bool:
 
 
 def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: Path | None,
-             xes: Path | None, progress: bool | float, keep_events: bool) -> dict[str, Any]:
-    """Subscribe the requested observers; returns them by name."""
+             xes: Path | None, progress: bool | float, keep_events: bool,
+             kinds: list[str] | None = None) -> dict[str, Any]:
+    """Subscribe the requested observers (the events kept: of ``kinds``, or all);
+    returns them by name."""
     observers: dict[str, Any] = {}
     if keep_events:
         observers["events"] = events = []
-        scheduler.on_event(events.append)
+        if kinds is None:
+            scheduler.on_event(events.append)
+        else:
+            scheduler.on_event(events.append, kinds)
     if journal is not None:
         def journal_event(event: Event) -> None:
             journal.record(event)
@@ -327,13 +332,14 @@ def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: 
 
 
 def _observed_run(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: Path | None,
-                  xes: Path | None, progress: bool | float, keep_events: bool, **limits: Any) -> RunOutcome:
+                  xes: Path | None, progress: bool | float, keep_events: bool, kinds: list[str] | None = None,
+                  **limits: Any) -> RunOutcome:
     """Run ``scheduler`` with the requested observers; the trace and XES files are
     renamed into place if the run ends, dropped if it raises."""
     observers: dict[str, Any] = {}
     try:
         observers = _observe(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
-                             keep_events=keep_events)
+                             keep_events=keep_events, kinds=kinds)
         started = wallclock.perf_counter()
         with scheduler:
             result = scheduler.run(**limits)
@@ -370,7 +376,8 @@ def _execute(net: Net, binding: Binding, config: RunConfig, inputs: dict[str, An
         extras.watch(scheduler)
         cpu = wallclock.process_time()
         outcome = _observed_run(scheduler, net, journal=journal, trace=trace, xes=xes, progress=progress,
-                                keep_events=keep, until=inputs["until"], max_firings=max_firings)
+                                keep_events=keep, kinds=None if keep_events else extras.event_kinds(),
+                                until=inputs["until"], max_firings=max_firings)
         outcome.cpu = wallclock.process_time() - cpu
         extras.finish(scheduler, outcome, config)
     if not keep_events:

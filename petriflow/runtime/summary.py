@@ -41,6 +41,12 @@ class RunExtras:
         """Whether a metric reads the run's events (then the run keeps them)."""
         return any(spec.events for _, spec in self.metrics)
 
+    def event_kinds(self) -> list[str] | None:
+        """The kinds of events the metrics read (``None``: every kind)."""
+        from petriflow.runtime.metrics import event_kinds
+
+        return event_kinds(spec for _, spec in self.metrics)
+
     def watch(self, scheduler: Any) -> None:
         """Start sampling the robots' positions, if a picture is wanted and there is a world."""
         if self.picture is not None and scheduler.world is not None:

@@ -207,7 +207,7 @@ def build(spec: dict[str, Any], params: dict[str, Any], seed: int) -> Built:
 
 
 def _measure(spec: dict[str, Any], params: dict[str, Any], seed: int) -> tuple[dict[str, Any], str, str | None]:
-    from petriflow.runtime.metrics import RunRecord
+    from petriflow.runtime.metrics import RunRecord, event_kinds
     from petriflow.runtime.scheduler import Scheduler
 
     built = build(spec, params, seed)
@@ -220,8 +220,8 @@ def _measure(spec: dict[str, Any], params: dict[str, Any], seed: int) -> tuple[d
     try:
         scheduler = Scheduler(built.net, world=world, config=built.config, seed=seed, binding=built.binding)
         events: list[Any] = []
-        if any(m.events for _, m, _ in built.metrics):
-            scheduler.on_event(events.append)
+        if any(m.events for _, m, _ in built.metrics):  # only the kinds they read
+            scheduler.on_event(events.append, event_kinds(m for _, m, _ in built.metrics))
         # wall and CPU time of the run itself (RunRecord.cpu says what that includes)
         started, cpu_started = wallclock.perf_counter(), wallclock.process_time()
         with scheduler:
