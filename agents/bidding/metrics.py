@@ -131,4 +131,4 @@ def register(registry: Any) -> None:
                            ("bidding.zones_of", zones_of),
                            ("bidding.reauctioned", reauctioned), ("bidding.zones_mapped", zones_mapped),
                            ("bidding.zones_reached", zones_reached)):
-        registry.register_metric(name, function, events=True)
+        registry.register_metric(name, function, events=("custom",))

@@ -154,4 +154,4 @@ def register(registry: Any) -> None:
                            ("bus.phase_error_rad", phase_error_rad), ("bus.speed_mps", speed_mps),
                            ("bus.lost_by_reason", lost_by_reason), ("bus.sniffer_lost_pct", sniffer_lost_pct),
                            ("bus.sniffer_lost_pct_module", sniffer_lost_pct_module)):
-        registry.register_metric(name, function, events=True)
+        registry.register_metric(name, function, events=("custom",))

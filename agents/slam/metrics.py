@@ -263,4 +263,4 @@ METRICS = {
 def register(registry: Any) -> None:
     """Register the metrics (the plugin calls this)."""
     for name, function in METRICS.items():
-        registry.register_metric(name, function, events=True)
+        registry.register_metric(name, function, events=("custom",))

@@ -69,4 +69,4 @@ def register(registry: Any) -> None:
     """Register the metrics (the ``petriflow.actions`` plugin calls this)."""
     for name, function in (("swarm.coverage", coverage), ("swarm.bytes_total", bytes_total),
                            ("swarm.time_s", time_s), ("swarm.home", home)):
-        registry.register_metric(name, function, events=True)
+        registry.register_metric(name, function, events=("custom", "message", "start"))
