@@ -171,16 +171,13 @@ class Scheduler:
                                                         self.seed)
         self.resources = self.firer.resources = Resources(
             self.registry, ResourceContext(world, Liveness(self.faults.alive, index.agents), self.config))
-        self._started = self._closed = False
-        self._opened = False  # whether the instant at tick 0 was processed
+        self._started = self._closed = self._opened = False  # _opened: the instant at tick 0 was processed
         self._watchers: list[Any] = []
         self._finished: RunResult | None = None
 
     # Observers ----------------------------------------------------------------------
     def on_event(self, handler: EventHandler, kinds: Iterable[str] | None = None) -> None:
-        """Call ``handler(event)`` for every event, in order (only for the events of
-        ``kinds``, :class:`~petriflow.runtime.trace.EventKind` values, when given: the
-        others are then not built for it)."""
+        """Call ``handler(event)`` for every event, in order (or for those of ``kinds``)."""
         self.recorder.on_event(handler, kinds)
 
     def on_instant(self, watcher: Any) -> None:
@@ -255,11 +252,8 @@ class Scheduler:
         self.enabled_set.mark(self.index.of_agent.get(agent, ()))
 
     def set_tokens(self, tokens: dict[str, list[Any]]) -> None:
-        """Replace the tokens (with their data) before the run starts.
-
-        Args:
-            tokens: ``{place: [data, ...]}``; places not named keep no token.
-        """
+        """Replace the tokens (with their data) before the run starts: ``{place: [data,
+        ...]}``; places not named keep no token."""
         if self._started:
             raise PetriflowError("tokens can only be set before the run starts")
         for place in tokens:
