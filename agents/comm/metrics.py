@@ -122,4 +122,4 @@ def register(registry: Any) -> None:
                            ("comm.time_s", time_s), ("comm.distance_m", distance_m),
                            ("comm.maps_complete", maps_complete), ("comm.complete_per_agent", complete_per_agent),
                            ("comm.vertices", vertices)):
-        registry.register_metric(name, function, events=name != "comm.vertices")
+        registry.register_metric(name, function, events=("custom", "fault") if name != "comm.vertices" else False)
