@@ -15,7 +15,6 @@ transition fail with it.
 
 from __future__ import annotations
 
-from math import ceil
 from typing import Any, Callable, Protocol
 
 from petriflow.outcome import Outcome
@@ -126,10 +125,8 @@ class ActionRunner:
             tick = max(kernel.tick + 1, kernel.ticks_at(firing.deadline))
             kernel.schedule(tick, Deadline(firing, number), key=number)
         wake = action.wake_at
-        if wake is not None and not action.needs_world and wake > now + 1e-12:  # first poll when it asked
-            tick = kernel.tick + 1
-            firing.wake = tick = max(tick, ceil(wake / kernel.dt - 1e-9))  # kernel.ticks_at, inline
-            kernel.schedule_poll(tick, firing, number)
+        if wake is not None and not action.needs_world and wake > now + 1e-12:
+            self._wake(firing, max(kernel.tick + 1, kernel.ticks_at(wake)))  # first poll when it asked
         else:
             self.poll(firing)
 
@@ -165,20 +162,18 @@ class ActionRunner:
         if status is Status.OK:
             outcome = Outcome.OK
         elif status is Status.RUNNING:
-            wake = action.wake_at
-            firing.wake = tick = tick + 1 if wake is None or action.needs_world else \
-                max(tick + 1, ceil(wake / kernel.dt - 1e-9))  # kernel.ticks_at, inline
-            kernel.schedule_poll(tick, firing, firing.number)
+            if action.needs_world:
+                self._wake(firing, tick + 1)
+            else:
+                wake = action.wake_at
+                self._wake(firing, tick + 1 if wake is None else max(tick + 1, kernel.ticks_at(wake)))
             return
         else:
             if status is not Status.FAILED:
                 ctx.reason = f"poll() returned {status!r}, not a Status"
             outcome = Outcome.FAILED
-        t = firing.index  # stopped (as _stop does, inline on the commonest path)
-        firing.running = False
-        del self.running[t]
-        self.enabled.dirty.add(t)
-        self.finish(firing.number, t, ctx, outcome)
+        self._stop(firing)
+        self.finish(firing.number, firing.index, ctx, outcome)
 
     def _drive_cancel(self, firing: Firing, ctx: ActionContext, action: Action, tick: int) -> None:
         outcome = firing.cancelling
