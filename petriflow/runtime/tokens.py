@@ -70,24 +70,12 @@ class Agenda:
     def add(self, t: int) -> None:
         """Mark transition ``t`` enabled (no-op if it is)."""
         if not self.on[t]:
-            self.on[t] = True
-            self._count += 1
-            level = self._level[t]
-            if not level or level[-1] < t:
-                level.append(t)
-            else:
-                insort(level, t)
+            self.change((t,), ())
 
     def discard(self, t: int) -> None:
         """Mark transition ``t`` not enabled (no-op if it is not)."""
         if self.on[t]:
-            self.on[t] = False
-            self._count -= 1
-            level = self._level[t]
-            if level[-1] == t:
-                level.pop()
-            else:
-                del level[bisect_left(level, t)]
+            self.change((), (t,))
 
     def change(self, up: Iterable[int], down: Iterable[int]) -> None:
         """Mark the transitions ``up`` enabled and those ``down`` not (each must be off,
@@ -111,25 +99,25 @@ class Agenda:
                 insort(level, t)
         self._count = count
 
+    def _choice(self, draw: Callable[[], float]) -> tuple[list[int], int]:
+        for level in self._levels:
+            if level:
+                return level, 0 if len(level) == 1 else int(draw() * len(level))
+        raise LookupError("no transition is enabled")
+
     def pick(self, draw: Callable[[], float]) -> int:
         """The transition to fire: of the highest priority enabled, the only one, or
         the ``int(draw() * n)``-th of the ``n`` in net order (one draw, only on a tie)."""
-        for level in self._levels:
-            if level:
-                if len(level) == 1:
-                    return level[0]
-                return level[int(draw() * len(level))]
-        raise LookupError("no transition is enabled")
+        level, i = self._choice(draw)
+        return level[i]
 
     def take(self, draw: Callable[[], float]) -> int:
         """:meth:`pick` and :meth:`discard` the transition picked (what a firing does)."""
-        for level in self._levels:
-            if level:
-                t = level.pop() if len(level) == 1 else level.pop(int(draw() * len(level)))
-                self.on[t] = False
-                self._count -= 1
-                return t
-        raise LookupError("no transition is enabled")
+        level, i = self._choice(draw)
+        t = level.pop(i)
+        self.on[t] = False
+        self._count -= 1
+        return t
 
     def members(self) -> list[int]:
         """The enabled transitions, in net order."""
@@ -288,7 +276,9 @@ class TokenStore:
 
     def read(self, place: str) -> list[Any]:
         """The data of the tokens in ``place`` (oldest first), not taken."""
-        i = self.index[place]
+        return self._items(self.index[place])
+
+    def _items(self, i: int) -> list[Any]:
         queue = self.data[i]
         return [None] * self.counts[i] if queue is None else list(queue)
 
@@ -298,5 +288,4 @@ class TokenStore:
 
     def tokens(self) -> dict[str, list[Any]]:
         """``{place: [data, ...]}`` of the marked places."""
-        return {self.places[i]: [None] * c if q is None else list(q)
-                for i, (c, q) in enumerate(zip(self.counts, self.data)) if c}
+        return {self.places[i]: self._items(i) for i, c in enumerate(self.counts) if c}
