@@ -74,11 +74,12 @@ class EnabledSet:
         self.running = running
         self.states: Mapping[str, Any] = {} if states is None else states
         self.agenda = Agenda(index.priority)
-        self.dirty: set[int] = set(range(len(index.ids)))
+        self.dirty: set[int] = set()
         #: Places whose tokens changed since the last refresh.
         self.changed: set[int] = set()
-        self._seen = list(tokens.counts)  # per place, its count when its consumers were last checked
-        pre = index.compiled.pre
+        self._seen: list[int] = []  # per place, its count when its consumers were last checked
+        self.resync()
+        pre, reset = index.compiled.pre, index.compiled.reset
         weights: list[dict[int, int]] = [{} for _ in index.consumers]  # place -> {consumer: arc weight}
         for t, r in enumerate(index.row):
             for p, w in pre[r]:
@@ -91,6 +92,10 @@ class EnabledSet:
         self._reading = [tuple(t for t in ws if token_guard[t]) for ws in weights]
         self._need = [-1 if len(ws) == 1 else max((w for t, w in ws.items() if not token_guard[t]), default=0)
                       for ws in weights]
+        #: per transition, the places a firing marks when it takes its tokens (its preset
+        #: and cancellation region), less a place only it consumes from
+        self.taking = [tuple(p for p in dict.fromkeys((*(p for p, _ in pre[r]), *reset[r])) if weights[p].keys() != {t})
+                       for t, r in enumerate(index.row)]
         self.answer: list[bool | None] = [None] * len(index.ids)  # kept answers of state guards
         #: How many times a guard was called (what "cost by what changed" saves).
         self.evaluations = 0

@@ -73,12 +73,7 @@ class Firer:
         self.resources: Any = None  # set by the run (petriflow.runtime.resources.Resources)
         self._declared = [getattr(cls, "resources", None) or None for cls in index.action_class]
         compiled, consumers = index.compiled, index.consumers
-        # per transition, the places a firing takes from or empties, less a place only it
-        # consumes from (the transition itself is settled once its action starts)
-        self._touched = [tuple(p for p in dict.fromkeys((*(p for p, _ in compiled.pre[r]), *compiled.reset[r]))
-                               if consumers[p] != (t,)) for t, r in enumerate(index.row)]
         self._running = self.runner.running
-        self._agenda = enabled.agenda
         self._acts = [self.agents.any_readers(index.agent[t]) for t in range(len(index.ids))]
         # per compiled row, its non-channel output places
         self._fed = [tuple(p for p, _ in compiled.post[r] if not index.channel[p] and consumers[p])
@@ -130,14 +125,15 @@ class Firer:
                             " action that takes time, or stop the run with --max-firings)")
 
     def fire(self, t: int) -> None:
-        """Fire transition index ``t`` now: consume, cancel its region, start its action."""
+        """Fire transition index ``t`` now: consume, cancel its region, start its action.
+        ``t`` is off the agenda (:meth:`fire_instant` takes it from there)."""
         index = self.index
         self.count = number = self.count + 1
         kernel = self.kernel
         tick = self.progress = kernel.tick
         inputs, withdrawn = self.tokens.consume(index.row[t])
         enabled = self.enabled
-        enabled.changed.update(self._touched[t])
+        enabled.changed.update(enabled.taking[t])
         agent = index.agent[t]
         if self._acts[t]:
             self.agents.acted(agent)
@@ -156,10 +152,7 @@ class Firer:
         self.runner.start(t, number, ActionContext(index.ids[t], agent, index.params[t], inputs, self.world,
                                                    self._seed_prefix + str(number), now, now, None, False, None,
                                                    "", None, None, self, self._declared[t]))
-        if t in self._running:  # running: it cannot fire again before its action ends (which marks it)
-            if self._agenda.on[t]:  # fired from outside the agenda's take (fire_one)
-                self._agenda.discard(t)
-        else:  # ended at once: check it again
+        if t not in self._running:  # ended at once: check it again (a running one is when it ends)
             enabled.dirty.add(t)
 
     def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:

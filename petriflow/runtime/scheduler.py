@@ -377,6 +377,7 @@ class Scheduler:
             fire_counts(self.net, self.marking(), transition)  # raises naming short places
             raise PetriflowError(f"transition {transition!r} cannot fire now (guard false or agent down)")
         kernel = self.kernel
+        self.enabled_set.agenda.discard(t)  # as the firing loop's take does
         try:
             self.firer.fire(t)
             limit = kernel.ticks_at(self.now + timeout)
