@@ -179,11 +179,11 @@ class Firer:
             raise Unrouted(ActionFailure(reason, net=self.net.id, transition=tid,
                                          action=self.net.transitions[tid].action))
         if ctx.emitted:
-            for kind, data in ctx.emitted:
-                if recorder.by_kind[_CUSTOM]:
+            for kind, data in ctx.emitted:  # summarized only for someone listening
+                if recorder.wants(_CUSTOM):
                     recorder.emit(_CUSTOM, tid, ctx.agent, firing=number, name=kind, data=summarize(data))
                 else:
-                    recorder.count += 1
+                    recorder.skip()
             ctx.emitted.clear()
         produced: dict[str, int] = {}
         sent: list[tuple[str, Any]] | None = None

@@ -41,8 +41,7 @@ class Recorder:
 
     def __init__(self, kernel: Kernel) -> None:
         self.kernel = kernel
-        self.handlers: list[EventHandler] = []  # every subscriber, whatever kinds it asked for
-        self._every: list[EventHandler] = []    # those that asked for every kind
+        self._every: list[EventHandler] = []  # the handlers of every kind
         #: ``{kind: [handler, ...]}``: who receives an event of each kind (a kind not in it
         #: goes to the handlers of every kind).
         self.by_kind: dict[str, list[EventHandler]] = {kind.value: [] for kind in EventKind}
@@ -51,7 +50,7 @@ class Recorder:
     @property
     def active(self) -> bool:
         """Whether anyone listens (event data need only be built then)."""
-        return bool(self.handlers)
+        return any(self.by_kind.values())
 
     def wants(self, kind: str) -> bool:
         """Whether anyone listens to events of ``kind``."""
@@ -61,7 +60,6 @@ class Recorder:
         """Call ``handler(event)`` for every event from now on, in order; only for the
         events of ``kinds`` (:class:`~petriflow.runtime.trace.EventKind` values) when
         given."""
-        self.handlers.append(handler)
         if kinds is None:
             self._every.append(handler)
             for handlers in self.by_kind.values():

@@ -304,10 +304,7 @@ def _observe(scheduler: Scheduler, net: Net, *, journal: Journal | None, trace: 
     observers: dict[str, Any] = {}
     if keep_events:
         observers["events"] = events = []
-        if kinds is None:
-            scheduler.on_event(events.append)
-        else:
-            scheduler.on_event(events.append, kinds)
+        scheduler.on_event(events.append, kinds)
     if journal is not None:
         def journal_event(event: Event) -> None:
             journal.record(event)

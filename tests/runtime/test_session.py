@@ -79,8 +79,8 @@ def test_crash_mid_run_then_resume_gives_the_uninterrupted_trace(tmp_path, monke
 
     original = session.Scheduler.on_event
 
-    def crash_after(self, handler):
-        original(self, handler)
+    def crash_after(self, handler, kinds=None):
+        original(self, handler, kinds)
         if not getattr(self, "_crash_installed", False):
             self._crash_installed = True
 
@@ -199,8 +199,8 @@ def test_resume_writes_the_outputs_the_run_was_started_with(tmp_path, ticker, mo
 
     original = session.Scheduler.on_event
 
-    def crash_after(self, handler):
-        original(self, handler)
+    def crash_after(self, handler, kinds=None):
+        original(self, handler, kinds)
         if not getattr(self, "_crash_installed", False):
             self._crash_installed = True
             original(self, lambda event: (_ for _ in ()).throw(Crash()) if event.seq == 9 else None)
