@@ -4,9 +4,10 @@
 :class:`~petriflow.netbuild.NetBuilder`): an operator, the interface agent (HMIA) and
 ``robots`` robot agents (RAs), each an agent subnet whose state the run keeps
 (``bidding.operator``, ``bidding.interface``, ``bidding.robot``). Every agent but the
-operator has a mailbox, a channel place every other agent sends into, bounded by one
-slot token (a sender takes it, the receiver gives it back), so the net is bounded and
-its state space small enough to check. The protocol is the net's structure:
+operator has a mailbox, a channel place every other agent sends into, bounded by slot
+tokens (a sender takes one, the receiver gives it back): one by default, so the net is
+bounded and its state space small enough to check, or one per sender (``mailbox=
+"senders"``). The protocol is the net's structure:
 
 * operator: ``request`` (REQUEST, INFORM), ``send_hmia``, ``finish``;
 * HMIA: ``create``, then a work loop of ``team`` (INITIALIZE), ``inform`` (random
@@ -51,8 +52,9 @@ RECEIVE, FINISH, SEND, STEP, WAIT = 6, 5, 4, 3, 0
 
 
 def _agent(b: NetBuilder, name: str, label: str, state: str, *,
-           listens: bool = True) -> tuple[AgentBuilder, Mailbox | None]:
-    """An agent's places (start, work, listen, done) and its mailbox ``box_<name>``."""
+           listens: bool = True, capacity: int = 1) -> tuple[AgentBuilder, Mailbox | None]:
+    """An agent's places (start, work, listen, done) and its mailbox ``box_<name>`` of
+    ``capacity`` slots."""
     agent = b.agent(name, label=label, state=state)
     for local in ("start", "work", "listen", "done") if listens else ("start", "work", "done"):
         agent.place(local)
@@ -61,8 +63,9 @@ def _agent(b: NetBuilder, name: str, label: str, state: str, *,
         agent.done("done")
         return agent, None
     agent.done("done", "listen")
-    return agent, b.mailbox(agent, channel="lan", id=f"box_{name}", label=f"{name}'s mailbox",
-                            slot=f"slot_{name}", slot_label=f"{name}'s mailbox is free")
+    return agent, b.mailbox(agent, channel="lan", capacity=capacity, id=f"box_{name}",
+                            label=f"{name}'s mailbox", slot=f"slot_{name}",
+                            slot_label=f"{name}'s mailbox is free")
 
 
 def _loop(b: NetBuilder, agent: AgentBuilder, create: tuple[str, str, dict[str, Any]],
@@ -117,7 +120,7 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
           zones: list[list[float]] | None = None, speed: float = SPEED_M_S, scan_period: float = 1.0,
           filter_teammates: bool = False, spin: bool = False, visit: str = "centre", wait: float = 1.0,
           localization: str = "odom", odom_error: list[float] | None = None, until: str = "mapped",
-          idle: str = "scan", **ignored: Any) -> Net:
+          idle: str = "scan", mailbox: int | str = 1, **ignored: Any) -> Net:
     """The mission's net (see the module).
 
     Args:
@@ -143,6 +146,11 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
             sight, or reached) or only when every zone is ``reached``.
         idle: an RA whose zones are done goes on mapping until END (``scan``) or
             stops (``stop``).
+        mailbox: slots per mailbox: a whole number (default 1: a sender waits until the
+            receiver took the message before, which keeps the net's state space small
+            enough to check), or ``senders``: one per agent that sends into it, so no
+            sender waits for a receiver while it has a message for it (the paper assumes
+            communication unlimited, §4).
         ignored: other sweep parameters (they go elsewhere).
     """
     if isinstance(lists, str):  # "2 8 1 6 5 / 7 3 4": a sweep report prints text, not nested lists
@@ -166,8 +174,13 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
     b = NetBuilder(f"bidding-{deployment}-{robots}", label=f"seed 004 collaborative mapping: {robots}"
                    f" robot{'s' if robots > 1 else ''}, {deployment} deployment")
     operator, _ = _agent(b, "operator", "the human operator", "bidding.operator", listens=False)
-    hmia, hmia_box = _agent(b, "hmia", "human/machine interface agent", "bidding.interface")
-    ras = [_agent(b, name, f"robot agent {name}", "bidding.robot") for name in team]
+    if mailbox != "senders" and (isinstance(mailbox, bool) or not isinstance(mailbox, int) or mailbox < 1):
+        raise ValueError(f"mailbox is a whole number of slots >= 1 or 'senders', got {mailbox!r}")
+    senders = mailbox == "senders"  # the HMIA hears the operator and the RAs, an RA the HMIA and the others
+    hmia, hmia_box = _agent(b, "hmia", "human/machine interface agent", "bidding.interface",
+                            capacity=robots + 1 if senders else mailbox)
+    ras = [_agent(b, name, f"robot agent {name}", "bidding.robot", capacity=robots if senders else mailbox)
+           for name in team]
     boxes = {box.owner: box for box in [hmia_box] + [box for _, box in ras]}
     operator.transition("request", label="REQUEST and INFORM", action="bidding.operator", params=mission,
                         inputs=["start"], outputs=["work"])

@@ -29,6 +29,22 @@ def test_nets_are_sound_workflow_nets(robots):
         assert result["workflow_net"] and result["sound"], result["violations"]
 
 
+def test_a_mailbox_can_hold_one_message_from_every_sender():
+    net = build(3, "autonomous", mailbox="senders")
+    result = check_net(net)
+    assert result["workflow_net"] and result["sound"], result["violations"]
+    for place in (p for p in net.places.values() if p.channel):
+        senders = {net.transitions[t].subnet for t in net.place_preset(place.id)}
+        assert net.postset("begin")[f"slot_{place.subnet}"] == len(senders)  # HMIA: operator + 3 RAs; RA: 3
+    assert net.postset("begin")["slot_hmia"] == 4
+    one = build(3, "autonomous")
+    assert {p: w for p, w in one.postset("begin").items() if p.startswith("slot_")} == dict.fromkeys(
+        ["slot_hmia", "slot_robot1", "slot_robot2", "slot_robot3"], 1)
+    for bad in (0, -1, 1.5, True, "all"):
+        with pytest.raises(ValueError, match="mailbox"):
+            build(3, "autonomous", mailbox=bad)
+
+
 @pytest.mark.parametrize("robots, deployment, run", [(3, "autonomous", "run.yaml"), (5, "random", "run.yaml"),
                                                      (20, "autonomous", "run-20.yaml")])
 def test_shipped_nets_are_the_builders(robots, deployment, run):
