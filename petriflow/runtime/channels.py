@@ -100,6 +100,9 @@ class ChannelModel:
     """
 
     on_loss = "drop"
+    #: Whether :meth:`deliver` reads ``message.distance`` (the sender-receiver distance,
+    #: from the world's poses); a model that does not spares the run those lookups.
+    needs_distance = True
 
     def deliver(self, message: Message, rng: Any) -> float | None:
         raise NotImplementedError
@@ -110,6 +113,7 @@ class IdealChannel(ChannelModel):
     """Lossless channel with a fixed latency (seconds)."""
 
     latency: float = field(default=0.0, metadata={"range": (0.0, 3600.0)})
+    needs_distance = False
 
     def deliver(self, message: Message, rng: Any) -> float | None:
         return self.latency
@@ -169,6 +173,7 @@ class BusChannel(ChannelModel):
     overhead_bits: int = field(default=20, metadata={"range": (0, 1_000_000)})
     arbitration: bool = True
     loss: float = field(default=0.0, metadata={"range": (0.0, 1.0)})
+    needs_distance = False
 
     def __post_init__(self) -> None:
         self._busy_until = -math.inf
@@ -367,9 +372,10 @@ class Channels:
         channel = self.channel[place]
         receiver = self.receiver[place]
         model, _ = self.model_for(place)
+        recorded = run.recorder.wants("message")  # the event's data is built only for a listener
         distance = None
         world = run.world
-        if sender and receiver and hasattr(world, "distance"):
+        if sender and receiver and (recorded or getattr(model, "needs_distance", True)) and hasattr(world, "distance"):
             distance = world.distance(sender, receiver)
         now = run.kernel.now
         message = Message(place, sender, receiver, data, now, _size(data), distance)
@@ -387,21 +393,30 @@ class Channels:
                                       or not 0 <= delay < math.inf):
                 raise PetriflowError(f"channel {channel!r}: model {type(model).__name__} gave a delay of {delay!r}"
                                      " (a finite number of seconds >= 0, or None for lost)")
-        info: dict[str, Any] = {"place": place, "channel": channel, "receiver": receiver, "size": message.size}
-        if distance is not None:
-            info["distance"] = round(distance, 6)
+        info: dict[str, Any] = {}
+        if recorded:
+            info = {"place": place, "channel": channel, "receiver": receiver, "size": message.size}
+            if distance is not None:
+                info["distance"] = round(distance, 6)
         if delay is None:
-            run.emit("message", None, sender, fate=Fate.LOST.value, why=why, **info)
+            self._record(recorded, sender, fate=Fate.LOST.value, why=why, **info)
             self._notice(model, place, data, sender, receiver, why, now)
             return
         if delay is _PROCESS:  # a medium decides the fate when it happens
-            run.emit("message", None, sender, fate=Fate.SENT.value, **info)
+            self._record(recorded, sender, fate=Fate.SENT.value, **info)
             model.send(message)
             return
         kernel = run.kernel
         arrival = kernel.ticks_at(now + delay)
-        run.emit("message", None, sender, fate=Fate.SENT.value, arrival=round(arrival * kernel.dt, 9), **info)
+        self._record(recorded, sender, fate=Fate.SENT.value, arrival=round(arrival * kernel.dt, 9), **info)
         kernel.schedule(arrival, Delivery(self, place, data, sender, message=message))
+
+    def _record(self, recorded: bool, sender: str | None, **data: Any) -> None:
+        """A ``message`` event, or only its number when nobody listens to them."""
+        if recorded:
+            self.run.emit("message", None, sender, **data)
+        else:
+            self.run.recorder.skip()
 
     def _notice(self, model: ChannelModel, place: str, data: Any, sender: str | None, receiver: str | None,
                 why: str, now: float) -> None:
@@ -413,8 +428,8 @@ class Channels:
     def _delivered(self, message: Message) -> None:
         """A medium delivers ``message`` now: its token appears in its channel place."""
         self.run.deliver(message.place, message.data)
-        self.run.emit("message", None, message.sender, fate=Fate.DELIVERED.value, place=message.place,
-                      channel=self.channel[message.place])
+        self._record(self.run.recorder.wants("message"), message.sender, fate=Fate.DELIVERED.value,
+                     place=message.place, channel=self.channel[message.place])
 
     def _lost(self, message: Message, why: str) -> None:
         """A medium lost ``message`` now (``why``: the reason it gives). The event says
@@ -444,5 +459,5 @@ class Channels:
         """A message reaches its place: the token appears there."""
         self.run.deliver(delivery.place, delivery.data)
         fate = Fate.NOTICED if delivery.notice else Fate.DELIVERED
-        self.run.emit("message", None, delivery.sender, fate=fate.value, place=delivery.place,
-                      channel=self.channel[delivery.place])
+        self._record(self.run.recorder.wants("message"), delivery.sender, fate=fate.value, place=delivery.place,
+                     channel=self.channel[delivery.place])

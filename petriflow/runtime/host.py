@@ -15,6 +15,7 @@ from petriflow.runtime.kernel import Kernel
 
 if TYPE_CHECKING:
     from petriflow.runtime.faults import Faults
+    from petriflow.runtime.recorder import Recorder
 
 __all__ = ["RunHost"]
 
@@ -26,6 +27,9 @@ class RunHost(Protocol):
     kernel: Kernel
     world: Any
     faults: "Faults"  # which agents run and which links work (channels read it)
+    #: The run's events: a component asks ``recorder.wants(kind)`` before it builds an
+    #: event's data, and takes only its number (``recorder.skip()``) when nobody listens.
+    recorder: "Recorder"
 
     def emit(self, kind: str, transition: str | None = None, agent: str | None = None, **data: Any) -> None:
         """Record an event (observers receive it)."""

@@ -201,3 +201,52 @@ def test_a_medium_that_loses_a_message_in_flight_counts_it_once_as_sent():
     assert [e.data.get("in_flight") for e in events if e.kind == "message"] == [None, True, None]
     assert result.marking == {"a_done": 1, "b_done": 1}
     assert count(RunRecord(result, events)) == {"sent": 1, "delivered": 0, "lost": 1, "bytes": 4}
+
+
+class _CountingWorld(StubWorld):
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.asked = 0
+
+    def distance(self, a, b):
+        self.asked += 1
+        return super().distance(a, b)
+
+
+_TWO_AGENTS = """
+petriflow: 1
+subnets:
+  - id: a
+    places: [{id: a_ready, tokens: 3}, {id: outbox, channel: CHANNEL}]
+    transitions: [{id: send, action: core.wait, params: {seconds: 1}, in: [a_ready], out: [outbox]}]
+  - id: b
+    places: [b_done]
+    transitions: [{id: receive, in: [outbox], out: [b_done]}]
+"""
+
+
+@pytest.mark.parametrize("channel, model, needs", [("lan", {"model": "ideal"}, False),
+                                                    ("radio", {"model": "range", "latency": 0.0}, True)])
+def test_message_events_and_distances_only_for_whom_needs_them(channel, model, needs):
+    """A message event's data is built only when someone listens to message events, and
+    the sender-receiver distance is asked of the world only for such a listener or a
+    model that reads it (range: yes; ideal: no). Either way the same tokens arrive."""
+    net = loads_net(_TWO_AGENTS.replace("CHANNEL", channel))
+    config = RunConfig.from_dict({"channels": {channel: model}})
+    quiet_world = _CountingWorld(positions={"a": (0, 0), "b": (3, 4)})
+    quiet = Scheduler(net, world=quiet_world, config=config)
+    firings = []
+    quiet.on_event(firings.append, ["end"])
+    quiet.run()
+    assert quiet_world.asked == (3 if needs else 0)
+    listened_world = _CountingWorld(positions={"a": (0, 0), "b": (3, 4)})
+    listened = Scheduler(net, world=listened_world, config=config)
+    events = []
+    listened.on_event(events.append)
+    listened.run()
+    assert listened_world.asked == 3
+    messages = [e.data for e in events if e.kind == "message"]
+    assert [m["fate"] for m in messages] == ["sent", "delivered"] * 3
+    assert all(m["distance"] == 5.0 for m in messages if m["fate"] == "sent")
+    assert [e.seq for e in firings] == [e.seq for e in events if e.kind == "end"]  # the same numbering
+    assert quiet.tokens.counts == listened.tokens.counts
