@@ -14,7 +14,9 @@ place makes its consumers dirty only where their answer may have changed: a cons
 that reads only the place's count, when the count crossed its arc weight since the
 last refresh (a place an instant firing takes a token from and gives one back, an
 agent's control place, re-checks nobody); a guard over the tokens it would take, at
-any change. Only dirty transitions are checked again, so a firing's cost does not
+any change. A consumer whose state guard's kept answer is no sleeps: no change of its
+places wakes it, only a change of its guard's keys (:meth:`EnabledSet.forget`). Only
+dirty transitions are checked again, so a firing's cost does not
 grow with the size of the net, nor with the number of transitions sharing a place
 whose tokens did not change.
 
@@ -92,6 +94,11 @@ class EnabledSet:
         self._reading = [tuple(t for t in ws if token_guard[t]) for ws in weights]
         self._need = [-1 if len(ws) == 1 else max((w for t, w in ws.items() if not token_guard[t]), default=0)
                       for ws in weights]
+        #: per place, its consumers a change of its count may enable or disable: all of
+        #: them but those whose state guard's kept answer is "no" (they wait for their
+        #: guard's keys to change, :meth:`forget`, whatever the tokens do)
+        self._awake = [set(c) for c in index.consumers]
+        self._inputs = [tuple(p for p, _ in pre[r]) for r in index.row]
         #: per transition, the places a firing marks when it takes its tokens (its preset
         #: and cancellation region), less a place only it consumes from
         self.taking = [tuple(p for p in dict.fromkeys((*(p for p, _ in pre[r]), *reset[r])) if weights[p].keys() != {t})
@@ -102,6 +109,10 @@ class EnabledSet:
 
     def forget(self, t: int) -> None:
         """The kept guard answer of ``t`` is out of date: ask again at the next check."""
+        if self.answer[t] is False:  # its places wake it again
+            awake = self._awake
+            for p in self._inputs[t]:
+                awake[p].add(t)
         self.answer[t] = None
         self.dirty.add(t)
 
@@ -123,12 +134,12 @@ class EnabledSet:
     def _places(self) -> None:
         """Make dirty the consumers of the changed places whose answer may have changed."""
         dirty, counts, seen, need, reading = self.dirty, self.tokens.counts, self._seen, self._need, self._reading
-        consumers = self.index.consumers
+        awake = self._awake
         for p in self.changed:
             now, before, n = counts[p], seen[p], need[p]
             seen[p] = now
             if n < 0 or (now != before and (now < n or before < n)):
-                dirty.update(consumers[p])
+                dirty.update(awake[p])
             elif reading[p]:
                 dirty.update(reading[p])
         self.changed.clear()
@@ -159,6 +170,9 @@ class EnabledSet:
             if answer is None:  # a guard over its agent's state, asked again only when its keys changed
                 self.evaluations += 1
                 answer = self.answer[t] = bool(guard(self.states.get(agent), index.params[t]))
+                if not answer:  # no token change can enable it until its keys change
+                    for p in self._inputs[t]:
+                        self._awake[p].discard(t)
             return answer
         except Exception as exc:
             raise GuardError(f"transition {index.ids[t]!r}: guard {index.guard_name[t]!r} raised"
