@@ -375,7 +375,8 @@ class Channels:
         recorded = run.recorder.wants("message")  # the event's data is built only for a listener
         distance = None
         world = run.world
-        if sender and receiver and (recorded or getattr(model, "needs_distance", True)) and hasattr(world, "distance"):
+        wanted = recorded or getattr(model, "needs_distance", True)
+        if wanted and sender and receiver and hasattr(world, "distance"):
             distance = world.distance(sender, receiver)
         now = run.kernel.now
         message = Message(place, sender, receiver, data, now, _size(data), distance)

@@ -222,8 +222,8 @@ def busy_net(peers: int, slots: int) -> str:
     lines = [f"      - {{id: work_{p}, action: test.work, params: {{peer: {p}}}, guard: test.has_work,"
              f" in: [loop, pool], out: [loop, back]}}" for p in names]
     for k, seconds in ((1, 0.7), (2, 1.3)):
-        lines.append(f"      - {{id: pace{k}, action: core.wait, params: {{seconds: {seconds}}}, in: [gate{k}],"
-                     f" out: [fed{k}]}}")
+        lines.append(f"      - {{id: pace{k}, action: core.wait, params: {{seconds: {seconds}}},"
+                     f" in: [gate{k}], out: [fed{k}]}}")
         lines += [f"      - {{id: feed{k}_{p}, action: test.produce, params: {{peer: {p}}}, in: [fed{k}],"
                   f" out: [gate{k}]}}" for p in names]
     work = "\n".join(lines)
@@ -233,7 +233,8 @@ subnets:
     state: test.inbox
     places: [{{id: start, tokens: 1}}, loop, gate1, gate2, fed1, fed2, back, {{id: pool, tokens: {slots}}}]
     transitions:
-      - {{id: create, action: test.create, params: {{peers: {names}}}, in: [start], out: [loop, gate1, gate2]}}
+      - {{id: create, action: test.create, params: {{peers: {names}}}, in: [start],
+         out: [loop, gate1, gate2]}}
       - {{id: give_back, action: core.wait, params: {{seconds: 1.0}}, in: [back], out: [pool]}}
 {work}
 """
