@@ -120,19 +120,25 @@ def test_range_model_rssi_falls_with_distance():
     assert radio.rssi(1.0) - radio.rssi(10.0) == pytest.approx(20.0)
 
 
-def test_the_receiver_is_the_agent_that_takes_from_the_channel_place():
-    """A channel place declared in the sender's subnet is still received by the agent
-    whose transitions consume from it: killing that agent loses the message."""
-    net = loads_net("""
+def two_agents(channel: str, tokens: int, seconds: float) -> str:
+    """Agent ``a`` sends ``tokens`` messages over ``channel``, one every ``seconds``, into
+    a channel place in its own subnet; agent ``b`` takes them."""
+    return f"""
 petriflow: 1
 subnets:
   - id: a
-    places: [{id: a_ready, tokens: 1}, {id: outbox, channel: radio}]
-    transitions: [{id: send, action: core.wait, params: {seconds: 2}, in: [a_ready], out: [outbox]}]
+    places: [{{id: a_ready, tokens: {tokens}}}, {{id: outbox, channel: {channel}}}]
+    transitions: [{{id: send, action: core.wait, params: {{seconds: {seconds}}}, in: [a_ready], out: [outbox]}}]
   - id: b
     places: [b_done]
-    transitions: [{id: receive, in: [outbox], out: [b_done]}]
-""")
+    transitions: [{{id: receive, in: [outbox], out: [b_done]}}]
+"""
+
+
+def test_the_receiver_is_the_agent_that_takes_from_the_channel_place():
+    """A channel place declared in the sender's subnet is still received by the agent
+    whose transitions consume from it: killing that agent loses the message."""
+    net = loads_net(two_agents("radio", tokens=1, seconds=2))
     config = RunConfig.from_dict({"faults": [{"kill": "b", "at": 1}]})
     scheduler = Scheduler(net, config=config)
     events = []
@@ -213,17 +219,6 @@ class _CountingWorld(StubWorld):
         return super().distance(a, b)
 
 
-_TWO_AGENTS = """
-petriflow: 1
-subnets:
-  - id: a
-    places: [{id: a_ready, tokens: 3}, {id: outbox, channel: CHANNEL}]
-    transitions: [{id: send, action: core.wait, params: {seconds: 1}, in: [a_ready], out: [outbox]}]
-  - id: b
-    places: [b_done]
-    transitions: [{id: receive, in: [outbox], out: [b_done]}]
-"""
-
 
 @pytest.mark.parametrize("channel, model, needs", [("lan", {"model": "ideal"}, False),
                                                     ("radio", {"model": "range", "latency": 0.0}, True)])
@@ -231,7 +226,7 @@ def test_message_events_and_distances_only_for_whom_needs_them(channel, model, n
     """A message event's data is built only when someone listens to message events, and
     the sender-receiver distance is asked of the world only for such a listener or a
     model that reads it (range: yes; ideal: no). Either way the same tokens arrive."""
-    net = loads_net(_TWO_AGENTS.replace("CHANNEL", channel))
+    net = loads_net(two_agents(channel, tokens=3, seconds=1))
     config = RunConfig.from_dict({"channels": {channel: model}})
     quiet_world = _CountingWorld(positions={"a": (0, 0), "b": (3, 4)})
     quiet = Scheduler(net, world=quiet_world, config=config)
