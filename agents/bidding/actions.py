@@ -157,11 +157,15 @@ class MakeInterface(InstantAction):
     params = {"resolution": Param(float, 0.1, "global map cell (m)", low=1e-9),
               "until": Param(str, "mapped", "END when every zone is mapped: in a laser's sight or reached"
                              " (mapped; the paper maps \"until mapping the entire world\") or only when every"
-                             " zone is reached (reached)", choices=("mapped", "reached"))}
+                             " zone is reached (reached)", choices=("mapped", "reached")),
+              "casts": Param(bool, False, "follow broadcasts so each may leave in one firing (the agent's net has a"
+                             " cast transition)")}
 
     def run(self, ctx: ActionContext) -> None:
         hmia = ctx.state = Interface(ctx.agent or ctx.transition)
         hmia.until = self.params["until"]
+        if self.params["casts"]:
+            hmia.track_casts()
         office = _office(ctx)
         if office is not None:
             from petriflow.agents.bidding.grid import GlobalMap
@@ -176,10 +180,14 @@ class MakeRobot(InstantAction):
 
     agent_state = RobotAgent
     params = {"rank": Param(int, 0, "the robot's rank in the team (ties go to the smallest)"),
-              "hmia": Param(str, "hmia", "the interface agent")}
+              "hmia": Param(str, "hmia", "the interface agent"),
+              "casts": Param(bool, False, "follow broadcasts so each may leave in one firing (the agent's net has a"
+                             " cast transition)")}
 
     def run(self, ctx: ActionContext) -> None:
-        ctx.state = RobotAgent(ctx.agent or ctx.transition, self.params["rank"], self.params["hmia"])
+        ra = ctx.state = RobotAgent(ctx.agent or ctx.transition, self.params["rank"], self.params["hmia"])
+        if self.params["casts"]:
+            ra.track_casts()
 
 
 # Receiving -------------------------------------------------------------------------------
@@ -850,6 +858,26 @@ class Send(InstantAction):
                  broadcast=message.cast)
 
 
+class Cast(InstantAction):
+    """Any agent: a broadcast to exactly the agents of ``boxes`` into all their
+    mailboxes in one firing, once every copy of it is first in its receiver's queue
+    (``bidding.has_cast``). Each copy is recorded as :class:`Send` records it."""
+
+    agent_state = Mailbox
+    params = {"boxes": Param(dict, doc="receiving agent -> its mailbox (channel place)", places="*")}
+
+    def run(self, ctx: ActionContext) -> None:
+        boxes = self.params["boxes"]
+        messages = ctx.state.take_cast(frozenset(boxes))
+        if not messages:
+            raise ActionFailure(f"bidding.cast: no broadcast to {', '.join(sorted(boxes))} is ready")
+        for message in messages:
+            token = message.token()
+            ctx.put(boxes[message.receiver], token)
+            ctx.emit("bidding.sent", message=message.kind, to=message.receiver, bytes=token["size"],
+                     broadcast=message.cast)
+
+
 class Wait(Action):
     """An agent with nothing to do: wait until something is (at most ``period`` s)."""
 
@@ -890,6 +918,12 @@ def has_message(state: Any, params: dict[str, Any]) -> bool:
     return state is not None and state.has_for(params["peer"])
 
 
+def has_cast(state: Any, params: dict[str, Any]) -> bool:
+    """Guard: a broadcast to exactly the agents of ``params['boxes']`` can leave in one
+    firing (every copy first in its receiver's queue)."""
+    return state is not None and state.ready_cast(frozenset(params["boxes"])) is not None
+
+
 def finished(state: Any, params: dict[str, Any]) -> bool:
     """Guard: the agent's part is over (operator: sent everything; HMIA: END sent;
     RA: END received) and nothing waits to be sent."""
@@ -911,6 +945,7 @@ def idle(state: Any, params: dict[str, Any]) -> bool:
 #: state calls for; whether anything waits to be sent.
 GUARDS = {
     "bidding.has_message": (has_message, ("outbox/{peer}",)),
+    "bidding.has_cast": (has_cast, ("cast",)),
     "bidding.finished": (finished, ("step", "pending")),
     "bidding.idle": (idle, ("step", "pending")),
     **{f"bidding.next_{step}": (_guard(step), ("step",)) for step in

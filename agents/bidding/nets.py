@@ -47,8 +47,11 @@ from petriflow.netbuild import AgentBuilder, Mailbox, NetBuilder
 __all__ = ["build", "main"]
 
 #: Priorities of an agent's transitions: taking mail first, then ending, sending, the
-#: protocol's steps, and waiting last.
+#: protocol's steps, and waiting last. A broadcast in one firing (``casts=True``) goes
+#: before the sends to one peer (it is never enabled with ``finish``, which needs an
+#: empty outbox).
 RECEIVE, FINISH, SEND, STEP, WAIT = 6, 5, 4, 3, 0
+CAST = FINISH
 
 
 def _agent(b: NetBuilder, name: str, label: str, state: str, *,
@@ -69,16 +72,25 @@ def _agent(b: NetBuilder, name: str, label: str, state: str, *,
 
 
 def _loop(b: NetBuilder, agent: AgentBuilder, create: tuple[str, str, dict[str, Any]],
-          steps: list[tuple[str, str, str, dict[str, Any]]], peers: list[Mailbox], wait: float) -> None:
+          steps: list[tuple[str, str, str, dict[str, Any]]], peers: list[Mailbox], wait: float,
+          team: list[Mailbox] | None = None) -> None:
     """An agent's transitions: ``create`` (its state), the work loop's protocol steps,
-    a send per peer, ``wait``, ``finish``, and ``receive`` on the listening place."""
+    a send per peer, a broadcast to the mailboxes of ``team`` in one firing (``cast``,
+    when given), ``wait``, ``finish``, and ``receive`` on the listening place."""
     action, label, params = create
+    if team:
+        params = {**params, "casts": True}
     agent.transition("create", label=label, action=action, params=params or None, inputs=["start"],
                      outputs=["work", "listen"])
     for step, action, label, params in steps:
         agent.transition(step, label=label, action=action, params=params or None,
                          guard=f"bidding.next_{step}", priority=STEP, inputs=["work"], outputs=["work"])
     _sends(b, agent, peers)
+    if team:
+        b.broadcast(agent.transition("cast", label="broadcast to the team", action="bidding.cast",
+                                     params={"boxes": {box.owner: box.id for box in team}},
+                                     guard="bidding.has_cast", priority=CAST, inputs=["work"], outputs=["work"]),
+                    team)
     agent.transition("wait", label="wait for news", action="bidding.wait", params={"period": wait},
                      guard="bidding.idle", priority=WAIT, inputs=["work"], outputs=["work"])
     agent.transition("finish", label="mission over", guard="bidding.finished", priority=FINISH,
@@ -120,7 +132,7 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
           zones: list[list[float]] | None = None, speed: float = SPEED_M_S, scan_period: float = 1.0,
           filter_teammates: bool = False, spin: bool = False, visit: str = "centre", wait: float = 1.0,
           localization: str = "odom", odom_error: list[float] | None = None, until: str = "mapped",
-          idle: str = "scan", mailbox: int | str = 1, **ignored: Any) -> Net:
+          idle: str = "scan", mailbox: int | str = 1, casts: bool = False, **ignored: Any) -> Net:
     """The mission's net (see the module).
 
     Args:
@@ -151,6 +163,11 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
             enough to check), or ``senders``: one per agent that sends into it, so no
             sender waits for a receiver while it has a message for it (the paper assumes
             communication unlimited, §4).
+        casts: a broadcast to the whole team (the HMIA's CFP, MAP and END to every RA,
+            an RA's PROPOSE to the others) leaves in one firing (``cast``) into every
+            receiver's mailbox, as one message does on a network (§3.2.2: the RA
+            "broadcasts this cost"), instead of a send firing per receiver. One to part
+            of the team (after a breakdown) still goes one copy at a time.
         ignored: other sweep parameters (they go elsewhere).
     """
     if isinstance(lists, str):  # "2 8 1 6 5 / 7 3 4": a sweep report prints text, not nested lists
@@ -193,7 +210,7 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
         ("cfp", "bidding.cfp", "CFP: offer the next zone", {}),
         ("map", "bidding.map", "MAP: start mapping", {}),
         ("end", "bidding.end", "END: the world mapped", {}),
-    ], [boxes[name] for name in team], wait)
+    ], [boxes[name] for name in team], wait, [boxes[name] for name in team] if casts and robots > 1 else None)
     explore = {"speed": speed, "scan_period": scan_period, "filter_teammates": filter_teammates, "spin": spin,
                "visit": visit}
     if idle != "scan":
@@ -207,7 +224,8 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
             ("bid", "bidding.bid", "PROPOSE: eq. 6 cost", {"speed": speed}),
             ("decide", "bidding.decide", "best proposal; ALLOCATED if won", {}),
             ("explore", "bidding.explore", "map the zones: MAPPED", explore),
-        ], [boxes[name] for name in ["hmia"] + team if name != ra.name], wait)
+        ], [boxes[name] for name in ["hmia"] + team if name != ra.name], wait,
+            [boxes[name] for name in team if name != ra.name] if casts and robots > 2 else None)
     b.envelope(begin_label="REQUEST from the operator", end_label="mission over")
     return b.build()
 

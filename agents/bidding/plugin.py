@@ -24,6 +24,7 @@ ACTIONS = {
     "bidding.decide": (f"{_A}:Decide", "RA: lowest cost wins, ties to the smallest rank (ALLOCATED)"),
     "bidding.explore": (f"{_A}:Explore", "RA: map its zones nearest first, laser scans (MAPPED)"),
     "bidding.send": (f"{_A}:Send", "the next message for one peer into its mailbox"),
+    "bidding.cast": (f"{_A}:Cast", "a broadcast into every receiver's mailbox in one firing"),
     "bidding.wait": (f"{_A}:Wait", "an agent with nothing to do waits for news"),
 }
 

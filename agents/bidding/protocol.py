@@ -102,7 +102,10 @@ class Mailbox(AgentState):
     * ``step``: the step the agent's state calls for, or whether its part is over,
       changed (:meth:`changed`, which the agents' actions call when they end, compares
       :meth:`signature` with what it was: a message that changes neither, a proposal
-      among many, asks no guard again).
+      among many, asks no guard again);
+    * ``cast`` (once :meth:`track_casts` was called): a broadcast became ready to leave
+      in one firing, or stopped being ready (:meth:`ready_cast`: every copy of it is
+      first in its receiver's queue).
     """
 
     def __init__(self) -> None:
@@ -113,6 +116,12 @@ class Mailbox(AgentState):
         self.sent: dict[str, int] = {}
         self.received: dict[str, int] = {}
         self._signature: Any = None
+        # per broadcast whose copies are all still queued: its receivers and how many of
+        # the copies are first in their queue (all of them: it may leave in one firing)
+        self._track = False  # see track_casts
+        self._cast_to: dict[int, frozenset[str]] = {}
+        self._heads: dict[int, int] = {}
+        self._ready: set[int] = set()
 
     def to_token(self) -> dict[str, Any]:
         """What a trace records of an agent's state: who it is and its message counts."""
@@ -125,6 +134,8 @@ class Mailbox(AgentState):
             box = self.outbox[message.receiver] = deque()
         box.append(message)
         self.queued += 1
+        if len(box) == 1:
+            self._head(message.cast, 1)
         if self.queued == 1:
             self.touch("outbox/" + message.receiver, "pending")
         else:
@@ -134,8 +145,68 @@ class Mailbox(AgentState):
                   body: dict[str, Any] | None = None) -> None:
         """Queue one broadcast: a copy for each receiver, all with the same ``cast``."""
         self.casts += 1
+        if self._track and len(set(receivers)) == len(receivers) > 0:
+            self._cast_to[self.casts] = frozenset(receivers)
+            self._heads[self.casts] = 0
         for receiver in receivers:
             self.queue(Message(kind, sender, receiver, zone, dict(body or {}), self.casts))
+
+    def track_casts(self) -> None:
+        """Follow each broadcast queued from now on, so that it may leave in one firing
+        (:meth:`ready_cast`, :meth:`take_cast`; the ``cast`` key): for an agent whose
+        net has a ``cast`` transition."""
+        self._track = True
+
+    def _head(self, cast: int | None, change: int) -> None:
+        """A copy of broadcast ``cast`` became first in its queue (+1) or left that place (-1)."""
+        if cast is None or cast not in self._heads:
+            return
+        self._heads[cast] += change
+        ready = self._heads[cast] == len(self._cast_to[cast])
+        if ready != (cast in self._ready):
+            (self._ready.add if ready else self._ready.discard)(cast)
+            self.touch("cast")
+
+    def _alone(self, cast: int | None) -> None:
+        """Broadcast ``cast`` no longer leaves in one firing (a copy of it left alone, or
+        was dropped, or all left together): its copies go one by one."""
+        if cast is None or cast not in self._cast_to:
+            return
+        del self._cast_to[cast], self._heads[cast]
+        if cast in self._ready:
+            self._ready.discard(cast)
+            self.touch("cast")
+
+    def ready_cast(self, receivers: Any) -> int | None:
+        """The broadcast to exactly ``receivers`` (a set of agent names) that can leave in
+        one firing now (:meth:`take_cast`): every copy first in its receiver's queue; or
+        ``None``."""
+        for cast in self._ready:
+            if self._cast_to[cast] == receivers:
+                return cast
+        return None
+
+    def take_cast(self, receivers: Any) -> list[Message]:
+        """Take the copies of the broadcast :meth:`ready_cast` names, one per receiver in
+        name order (``[]`` when none is ready)."""
+        cast = self.ready_cast(receivers)
+        if cast is None:
+            return []
+        peers = sorted(self._cast_to[cast])
+        self._alone(cast)
+        taken = []
+        for peer in peers:
+            box = self.outbox[peer]
+            message = box.popleft()
+            if box:
+                self._head(box[0].cast, 1)
+            self.queued -= 1
+            self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
+            self.touch("outbox/" + peer)
+            taken.append(message)
+        if self.queued == 0:
+            self.touch("pending")
+        return taken
 
     def has_for(self, peer: str) -> bool:
         box = self.outbox.get(peer)
@@ -149,6 +220,9 @@ class Mailbox(AgentState):
         if not box:
             return None
         message = box.popleft()
+        self._alone(message.cast)
+        if box:
+            self._head(box[0].cast, 1)
         self.queued -= 1
         self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
         if self.queued == 0:
@@ -162,6 +236,8 @@ class Mailbox(AgentState):
         box = self.outbox.pop(peer, None)
         if not box:
             return 0
+        for message in box:
+            self._alone(message.cast)
         self.queued -= len(box)
         if self.queued == 0:
             self.touch("outbox/" + peer, "pending")

@@ -318,3 +318,23 @@ def test_guards_are_asked_again_only_when_what_they_read_changed():
     small, large = _auction(2), _auction(5)
     per_firing = [run.enabled_set.evaluations / run.firer.count for run in (small, large)]
     assert per_firing[1] < 1.3 * per_firing[0] and per_firing[1] < 6, per_firing
+
+
+def test_broadcasts_in_one_firing_give_the_same_mission(tmp_path):
+    """With ``casts`` (and a slot per sender) a broadcast leaves in one firing: the
+    auction, the messages and the zones are those of the mission that sends each copy
+    alone, with fewer firings."""
+    (tmp_path / "one").mkdir()
+    (tmp_path / "cast").mkdir()
+    one = _run(tmp_path / "one", 3, mailbox="senders", localization="gps")
+    cast = _run(tmp_path / "cast", 3, mailbox="senders", casts=True, localization="gps")
+    fired = [e.transition for e in cast.events if e.kind == "start"]
+    assert fired.count("robot1_cast") >= 8 and fired.count("hmia_cast") >= 10  # 8 PROPOSE; CFPs, MAP, END
+
+    def allocated(outcome):
+        return {e.data["data"]["zone"]: e.data["data"]["robot"] for e in _custom(outcome, "bidding.allocated")}
+
+    assert allocated(cast) == allocated(one) and len(allocated(one)) == 8
+    assert _metric(cast, "messages_by_kind") == _metric(one, "messages_by_kind")
+    assert _metric(cast, "deliveries") == _metric(one, "deliveries")
+    assert cast.result.firings < one.result.firings

@@ -140,3 +140,34 @@ def test_near_reads_the_positions_once_per_step_and_misses_nobody_within_the_rad
         for radius in (0.5, 1.3, 2.5):
             inside = {a for a, (px, py) in world.positions.items() if (px - x) ** 2 + py ** 2 <= radius ** 2}
             assert plan.near(world, 0.2, x, 0.0, radius) >= inside
+
+
+def test_a_broadcast_leaves_in_one_firing_once_every_copy_is_first_in_its_queue():
+    box = Mailbox()
+    box.track_casts()
+    touched = watched(box)
+    team = frozenset({"robot1", "robot2", "robot3"})
+    box.queue(Message("ALLOCATED", "robot4", "robot2", zone=1))  # robot2's queue is not free yet
+    box.broadcast("PROPOSE", "robot4", ["robot3", "robot1", "robot2"], zone=2, body={"cost": 1.0})
+    assert box.ready_cast(team) is None and "cast" not in touched
+    assert box.take("robot2").kind == "ALLOCATED"
+    assert box.ready_cast(team) == box.casts and "cast" in touched
+    assert box.ready_cast(frozenset({"robot1", "robot2"})) is None  # exactly its receivers
+    box.broadcast("PROPOSE", "robot4", ["robot1", "robot2", "robot3"], zone=3)
+    copies = box.take_cast(team)
+    assert [(m.receiver, m.zone) for m in copies] == [("robot1", 2), ("robot2", 2), ("robot3", 2)]
+    assert box.ready_cast(team) == box.casts  # the next broadcast is first everywhere now
+    assert box.queued == 3 and box.sent == {"ALLOCATED": 1, "PROPOSE": 3}
+    touched.clear()
+    assert box.take("robot1").zone == 3  # a copy sent alone: the rest go one by one
+    assert box.ready_cast(team) is None and "cast" in touched and box.take_cast(team) == []
+    assert [box.take(p).zone for p in ("robot2", "robot3")] == [3, 3] and not box.pending()
+    box.broadcast("END", "robot4", ["robot1", "robot2"])
+    assert box.drop("robot2") == 1 and box.ready_cast(frozenset({"robot1", "robot2"})) is None
+
+
+def test_without_track_casts_a_mailbox_follows_no_broadcast():
+    box = Mailbox()
+    touched = watched(box)
+    box.broadcast("MAP", "hmia", ["robot1", "robot2"])
+    assert box.ready_cast(frozenset({"robot1", "robot2"})) is None and "cast" not in touched
