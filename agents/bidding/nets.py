@@ -15,7 +15,9 @@ bounded and its state space small enough to check, or one per sender (``mailbox=
   ``send_<robot>`` and ``wait``; ``receive`` takes its mail;
 * each RA: ``create``, then ``ready`` (INITIALIZED), ``bid`` (PROPOSE), ``decide``
   (ALLOCATED when it won), ``explore`` (MAPPED), ``send_<peer>`` and ``wait``;
-  ``receive`` takes its mail.
+  ``receive`` takes its mail;
+* with ``casts=True``, the HMIA and each RA also have ``cast``: a broadcast to the whole
+  team (CFP, MAP, END; PROPOSE to the other RAs) in one firing, into every mailbox.
 
 Guards (``bidding.next_*``) pick the one step the agent's state calls for; the
 envelope's ``begin`` hands out the start tokens and the slots, ``end`` collects them.
