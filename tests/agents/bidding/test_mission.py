@@ -323,7 +323,9 @@ def test_guards_are_asked_again_only_when_what_they_read_changed():
 def test_broadcasts_in_one_firing_give_the_same_mission(tmp_path):
     """With ``casts`` (and a slot per sender) a broadcast leaves in one firing: the
     auction, the messages and the zones are those of the mission that sends each copy
-    alone, with fewer firings."""
+    alone, with fewer firings; the net stays a sound workflow net."""
+    result = check_net(build(3, "autonomous", mailbox="senders", casts=True))
+    assert result["workflow_net"] and result["sound"], result["violations"]
     (tmp_path / "one").mkdir()
     (tmp_path / "cast").mkdir()
     one = _run(tmp_path / "one", 3, mailbox="senders", localization="gps")
