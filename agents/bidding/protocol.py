@@ -116,9 +116,9 @@ class Mailbox(AgentState):
         self.sent: dict[str, int] = {}
         self.received: dict[str, int] = {}
         self._signature: Any = None
+        self._track = False  # see track_casts
         # per broadcast whose copies are all still queued: its receivers and how many of
         # the copies are first in their queue (all of them: it may leave in one firing)
-        self._track = False  # see track_casts
         self._cast_to: dict[int, frozenset[str]] = {}
         self._heads: dict[int, int] = {}
         self._ready: set[int] = set()
@@ -135,7 +135,7 @@ class Mailbox(AgentState):
         box.append(message)
         self.queued += 1
         if len(box) == 1:
-            self._head(message.cast, 1)
+            self._first(message.cast)
         if self.queued == 1:
             self.touch("outbox/" + message.receiver, "pending")
         else:
@@ -157,14 +157,14 @@ class Mailbox(AgentState):
         net has a ``cast`` transition."""
         self._track = True
 
-    def _head(self, cast: int | None, change: int) -> None:
-        """A copy of broadcast ``cast`` became first in its queue (+1) or left that place (-1)."""
+    def _first(self, cast: int | None) -> None:
+        """A copy of broadcast ``cast`` became first in its queue (it leaves that place
+        only with the whole broadcast, or alone: :meth:`_alone`)."""
         if cast is None or cast not in self._heads:
             return
-        self._heads[cast] += change
-        ready = self._heads[cast] == len(self._cast_to[cast])
-        if ready != (cast in self._ready):
-            (self._ready.add if ready else self._ready.discard)(cast)
+        self._heads[cast] += 1
+        if self._heads[cast] == len(self._cast_to[cast]):
+            self._ready.add(cast)
             self.touch("cast")
 
     def _alone(self, cast: int | None) -> None:
@@ -199,7 +199,7 @@ class Mailbox(AgentState):
             box = self.outbox[peer]
             message = box.popleft()
             if box:
-                self._head(box[0].cast, 1)
+                self._first(box[0].cast)
             self.queued -= 1
             self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
             self.touch("outbox/" + peer)
@@ -222,7 +222,7 @@ class Mailbox(AgentState):
         message = box.popleft()
         self._alone(message.cast)
         if box:
-            self._head(box[0].cast, 1)
+            self._first(box[0].cast)
         self.queued -= 1
         self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
         if self.queued == 0:
