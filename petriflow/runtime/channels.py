@@ -372,10 +372,9 @@ class Channels:
         channel = self.channel[place]
         receiver = self.receiver[place]
         model, _ = self.model_for(place)
-        recorded = run.recorder.wants("message")  # the event's data is built only for a listener
-        distance = None
+        distance = None  # asked of the world only for a model that reads it or a listener of the event
         world = run.world
-        wanted = recorded or getattr(model, "needs_distance", True)
+        wanted = getattr(model, "needs_distance", True) or run.recorder.wants("message")
         if wanted and sender and receiver and hasattr(world, "distance"):
             distance = world.distance(sender, receiver)
         now = run.kernel.now
@@ -394,30 +393,21 @@ class Channels:
                                       or not 0 <= delay < math.inf):
                 raise PetriflowError(f"channel {channel!r}: model {type(model).__name__} gave a delay of {delay!r}"
                                      " (a finite number of seconds >= 0, or None for lost)")
-        info: dict[str, Any] = {}
-        if recorded:
-            info = {"place": place, "channel": channel, "receiver": receiver, "size": message.size}
-            if distance is not None:
-                info["distance"] = round(distance, 6)
+        info: dict[str, Any] = {"place": place, "channel": channel, "receiver": receiver, "size": message.size}
+        if distance is not None:
+            info["distance"] = round(distance, 6)
         if delay is None:
-            self._record(recorded, sender, fate=Fate.LOST.value, why=why, **info)
+            run.emit("message", None, sender, fate=Fate.LOST.value, why=why, **info)
             self._notice(model, place, data, sender, receiver, why, now)
             return
         if delay is _PROCESS:  # a medium decides the fate when it happens
-            self._record(recorded, sender, fate=Fate.SENT.value, **info)
+            run.emit("message", None, sender, fate=Fate.SENT.value, **info)
             model.send(message)
             return
         kernel = run.kernel
         arrival = kernel.ticks_at(now + delay)
-        self._record(recorded, sender, fate=Fate.SENT.value, arrival=round(arrival * kernel.dt, 9), **info)
+        run.emit("message", None, sender, fate=Fate.SENT.value, arrival=round(arrival * kernel.dt, 9), **info)
         kernel.schedule(arrival, Delivery(self, place, data, sender, message=message))
-
-    def _record(self, recorded: bool, sender: str | None, **data: Any) -> None:
-        """A ``message`` event, or only its number when nobody listens to them."""
-        if recorded:
-            self.run.emit("message", None, sender, **data)
-        else:
-            self.run.recorder.skip()
 
     def _notice(self, model: ChannelModel, place: str, data: Any, sender: str | None, receiver: str | None,
                 why: str, now: float) -> None:
@@ -429,8 +419,8 @@ class Channels:
     def _delivered(self, message: Message) -> None:
         """A medium delivers ``message`` now: its token appears in its channel place."""
         self.run.deliver(message.place, message.data)
-        self._record(self.run.recorder.wants("message"), message.sender, fate=Fate.DELIVERED.value,
-                     place=message.place, channel=self.channel[message.place])
+        self.run.emit("message", None, message.sender, fate=Fate.DELIVERED.value, place=message.place,
+                      channel=self.channel[message.place])
 
     def _lost(self, message: Message, why: str) -> None:
         """A medium lost ``message`` now (``why``: the reason it gives). The event says
@@ -460,5 +450,5 @@ class Channels:
         """A message reaches its place: the token appears there."""
         self.run.deliver(delivery.place, delivery.data)
         fate = Fate.NOTICED if delivery.notice else Fate.DELIVERED
-        self._record(self.run.recorder.wants("message"), delivery.sender, fate=fate.value, place=delivery.place,
-                     channel=self.channel[delivery.place])
+        self.run.emit("message", None, delivery.sender, fate=fate.value, place=delivery.place,
+                      channel=self.channel[delivery.place])

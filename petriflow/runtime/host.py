@@ -27,8 +27,9 @@ class RunHost(Protocol):
     kernel: Kernel
     world: Any
     faults: "Faults"  # which agents run and which links work (channels read it)
-    #: The run's events: a component asks ``recorder.wants(kind)`` before it builds an
-    #: event's data, and takes only its number (``recorder.skip()``) when nobody listens.
+    #: The run's events: a component asks ``recorder.wants(kind)`` before it works out
+    #: data only an event would carry (``emit`` itself takes only the event's number when
+    #: nobody listens).
     recorder: "Recorder"
 
     def emit(self, kind: str, transition: str | None = None, agent: str | None = None, **data: Any) -> None:
