@@ -121,7 +121,6 @@ class Mailbox(AgentState):
         # the copies are first in their queue (all of them: it may leave in one firing)
         self._cast_to: dict[int, frozenset[str]] = {}
         self._heads: dict[int, int] = {}
-        self._ready: set[int] = set()
 
     def to_token(self) -> dict[str, Any]:
         """What a trace records of an agent's state: who it is and its message counts."""
@@ -163,26 +162,29 @@ class Mailbox(AgentState):
         if cast is None or cast not in self._heads:
             return
         self._heads[cast] += 1
-        if self._heads[cast] == len(self._cast_to[cast]):
-            self._ready.add(cast)
+        if self._ready(cast):
             self.touch("cast")
+
+    def _ready(self, cast: int) -> bool:
+        """Every copy of broadcast ``cast`` is first in its queue."""
+        return self._heads[cast] == len(self._cast_to[cast])
 
     def _alone(self, cast: int | None) -> None:
         """Broadcast ``cast`` no longer leaves in one firing (a copy of it left alone, or
         was dropped, or all left together): its copies go one by one."""
         if cast is None or cast not in self._cast_to:
             return
+        ready = self._ready(cast)
         del self._cast_to[cast], self._heads[cast]
-        if cast in self._ready:
-            self._ready.discard(cast)
+        if ready:
             self.touch("cast")
 
     def ready_cast(self, receivers: Any) -> int | None:
         """The broadcast to exactly ``receivers`` (a set of agent names) that can leave in
         one firing now (:meth:`take_cast`): every copy first in its receiver's queue; or
         ``None``."""
-        for cast in self._ready:
-            if self._cast_to[cast] == receivers:
+        for cast, to in self._cast_to.items():  # the broadcasts in flight: a few
+            if to == receivers and self._ready(cast):
                 return cast
         return None
 
