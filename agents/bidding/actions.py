@@ -852,16 +852,21 @@ class Send(InstantAction):
         message = ctx.state.take(self.params["peer"])
         if message is None:
             raise ActionFailure(f"bidding.send: nothing waits for {self.params['peer']!r}")
-        token = message.token()
-        ctx.put(self.params["box"], token)
-        ctx.emit("bidding.sent", message=message.kind, to=message.receiver, bytes=token["size"],
-                 broadcast=message.cast)
+        _post(ctx, self.params["box"], message)
+
+
+def _post(ctx: ActionContext, box: str, message: Message) -> None:
+    """Put ``message`` into the mailbox ``box`` as a token and record it as sent."""
+    token = message.token()
+    ctx.put(box, token)
+    ctx.emit("bidding.sent", message=message.kind, to=message.receiver, bytes=token["size"],
+             broadcast=message.cast)
 
 
 class Cast(InstantAction):
     """Any agent: a broadcast to exactly the agents of ``boxes`` into all their
     mailboxes in one firing, once every copy of it is first in its receiver's queue
-    (``bidding.has_cast``). Each copy is recorded as :class:`Send` records it."""
+    (``bidding.has_cast``). Each copy is put and recorded as :class:`Send` does."""
 
     agent_state = Mailbox
     params = {"boxes": Param(dict, doc="receiving agent -> its mailbox (channel place)", places="*")}
@@ -872,10 +877,7 @@ class Cast(InstantAction):
         if not messages:
             raise ActionFailure(f"bidding.cast: no broadcast to {', '.join(sorted(boxes))} is ready")
         for message in messages:
-            token = message.token()
-            ctx.put(boxes[message.receiver], token)
-            ctx.emit("bidding.sent", message=message.kind, to=message.receiver, bytes=token["size"],
-                     broadcast=message.cast)
+            _post(ctx, boxes[message.receiver], message)
 
 
 class Wait(Action):
