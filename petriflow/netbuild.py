@@ -80,14 +80,15 @@ class Mailbox:
         slot: the place holding the mailbox's free capacity.
         owner: the agent that owns the channel place (its receiver), or ``None``.
         channel: the channel name of the channel place (``Place.channel``).
-        capacity: the most messages the mailbox holds at once.
+        capacity: the most messages the mailbox holds at once, or ``"senders"``: one
+            per agent that sends into it, counted when the net is built.
     """
 
     id: str
     slot: str
     owner: str | None
     channel: str | None
-    capacity: int
+    capacity: int | str
 
 
 class NetBuilder:
@@ -209,7 +210,10 @@ class NetBuilder:
                 when there is no owner).
             channel: the channel the place stands for (``Place.channel``: the run's channel
                 model delivers its messages); ``None``: a plain place, messages arrive at once.
-            capacity: the most messages in the mailbox at once (a whole number >= 1).
+            capacity: the most messages in the mailbox at once (a whole number >= 1), or
+                ``"senders"``: one slot per agent (or transition outside every agent)
+                that sends into it, counted by :meth:`build`, so no sender waits for a
+                receiver while it has one message in flight to it.
             id: the channel place's full id, instead of the naming rule.
             label: the channel place's label.
             slot: the slot place's id; default ``f"{id}_slot"``.
@@ -231,8 +235,9 @@ class NetBuilder:
             id = name if owner_name is None else f"{owner_name}_{name}"
         if slot is None:
             slot = f"{id}_slot"
-        if isinstance(capacity, bool) or not isinstance(capacity, int) or capacity < 1:
-            raise NetStructureError(f"mailbox {id!r}: capacity must be a whole number >= 1, got {capacity!r}")
+        if capacity != "senders" and (isinstance(capacity, bool) or not isinstance(capacity, int) or capacity < 1):
+            raise NetStructureError(f"mailbox {id!r}: capacity must be a whole number >= 1 or 'senders',"
+                                    f" got {capacity!r}")
         if channel is not None and (not isinstance(channel, str) or not channel):
             raise NetStructureError(f"mailbox {id!r}: channel must be a channel name or None,"
                                     f" got {channel!r}")
@@ -245,7 +250,7 @@ class NetBuilder:
         _check_text(slot_label, f"mailbox {id!r}: slot label")
         self._net.add_place(id, label=label, subnet=owner_name, channel=channel)
         self._net.add_place(slot, label=slot_label, subnet=slot_owner)
-        self.resource(slot, capacity)
+        self.resource(slot, 1 if capacity == "senders" else capacity)  # "senders": counted by build
         box = Mailbox(id, slot, owner_name, channel, capacity)
         self._mailboxes[id] = box
         return box
@@ -341,15 +346,20 @@ class NetBuilder:
         had fired) and done places are left as they are.
         """
         net = self._net.copy()
+        begin_out, end_in = dict(self._begin_out), dict(self._end_in)
+        for box in self._mailboxes.values():
+            if box.capacity == "senders":
+                senders = {net.transitions[t].subnet or t for t in net.place_preset(box.id)}
+                begin_out[box.slot] = end_in[box.slot] = max(1, len(senders))
         if self._envelope is None:
-            if self._begin_out:
-                net.set_initial_marking(net.initial_marking + Marking(self._begin_out))
+            if begin_out:
+                net.set_initial_marking(net.initial_marking + Marking(begin_out))
         else:
             source, begin, end, sink = self._envelope
             net.add_arc(source, begin)
-            for place, weight in self._begin_out.items():
+            for place, weight in begin_out.items():
                 net.add_arc(begin, place, weight)
-            for place, weight in self._end_in.items():
+            for place, weight in end_in.items():
                 net.add_arc(place, end, weight)
             net.add_arc(end, sink)
             net.set_final_marking({sink: 1})

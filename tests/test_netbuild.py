@@ -322,3 +322,27 @@ def test_the_comm_builders_net_built_with_the_api_is_sound():
 
     result = check_net(build(2))
     assert result["sound"] and result["k_bound"]["box_robot1_robot2"] == 1
+
+
+@pytest.mark.parametrize("envelope", [True, False])
+def test_a_mailbox_of_capacity_senders_has_a_slot_per_sending_agent(envelope):
+    """capacity="senders": the slot tokens are counted when the net is built, one per
+    agent with a transition that sends into the mailbox (two sends of one agent count
+    once; a transition outside every agent counts alone), with or without an envelope."""
+    b = NetBuilder("team")
+    receiver, a, c = b.agent("receiver"), b.agent("a"), b.agent("c")
+    box = b.mailbox(receiver, channel="lan", capacity="senders")
+    assert box.capacity == "senders"
+    for agent, name in ((a, "one"), (a, "two"), (c, "one")):
+        agent.place(f"{name}_ready")
+        b.send(agent.transition(f"send_{name}", inputs=[f"{name}_ready"]), box)
+    b.place("outside_ready")
+    b.send(b.transition("outside", inputs=["outside_ready"]), box)
+    b.agent("d").place("idle")  # sends nothing
+    if envelope:
+        b.envelope()
+    net = b.build()
+    if envelope:
+        assert net.postset("begin")[box.slot] == 3 and net.preset("end")[box.slot] == 3
+    else:
+        assert net.initial_marking[box.slot] == 3
