@@ -57,9 +57,9 @@ CAST = FINISH
 
 
 def _agent(b: NetBuilder, name: str, label: str, state: str, *,
-           listens: bool = True, capacity: int = 1) -> tuple[AgentBuilder, Mailbox | None]:
+           listens: bool = True, capacity: int | str = 1) -> tuple[AgentBuilder, Mailbox | None]:
     """An agent's places (start, work, listen, done) and its mailbox ``box_<name>`` of
-    ``capacity`` slots."""
+    ``capacity`` slots (:meth:`NetBuilder.mailbox <petriflow.netbuild.NetBuilder.mailbox>`)."""
     agent = b.agent(name, label=label, state=state)
     for local in ("start", "work", "listen", "done") if listens else ("start", "work", "done"):
         agent.place(local)
@@ -195,11 +195,8 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
     operator, _ = _agent(b, "operator", "the human operator", "bidding.operator", listens=False)
     if mailbox != "senders" and (isinstance(mailbox, bool) or not isinstance(mailbox, int) or mailbox < 1):
         raise ValueError(f"mailbox is a whole number of slots >= 1 or 'senders', got {mailbox!r}")
-    senders = mailbox == "senders"  # the HMIA hears the operator and the RAs, an RA the HMIA and the others
-    hmia, hmia_box = _agent(b, "hmia", "human/machine interface agent", "bidding.interface",
-                            capacity=robots + 1 if senders else mailbox)
-    ras = [_agent(b, name, f"robot agent {name}", "bidding.robot", capacity=robots if senders else mailbox)
-           for name in team]
+    hmia, hmia_box = _agent(b, "hmia", "human/machine interface agent", "bidding.interface", capacity=mailbox)
+    ras = [_agent(b, name, f"robot agent {name}", "bidding.robot", capacity=mailbox) for name in team]
     boxes = {box.owner: box for box in [hmia_box] + [box for _, box in ras]}
     operator.transition("request", label="REQUEST and INFORM", action="bidding.operator", params=mission,
                         inputs=["start"], outputs=["work"])
