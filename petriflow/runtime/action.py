@@ -202,6 +202,15 @@ class ActionFailure(PetriflowError):
             super().__init__(f"net {net!r}: transition {transition!r}: action {action or '-'!r} failed: {reason}")
 
 
+def first_data(inputs: dict[str, list[Any]]) -> Any:
+    """The data of the first consumed token that carries any (``None`` if none does)."""
+    for tokens in inputs.values():
+        for data in tokens:
+            if data is not None:
+                return data
+    return None
+
+
 @dataclass(eq=False, slots=True)
 class ActionContext:
     """What an action sees during one firing.
@@ -289,11 +298,7 @@ class ActionContext:
         """The data of the (first) input token, from ``place`` or from any input place."""
         if place is not None:
             return self.inputs[place][0]
-        for tokens in self.inputs.values():
-            for data in tokens:
-                if data is not None:
-                    return data
-        return None
+        return first_data(self.inputs)
 
     def read(self, port: str) -> list[Any]:
         """The data of the tokens now in the place the :class:`Port` ``port`` names
@@ -465,6 +470,19 @@ class Action:
             the reason.
         """
         return Status.OK
+
+    def delay(self) -> float | None:
+        """For an action that does nothing but wait: the simulated seconds it waits
+        before it ends ``ok`` with its input token's data (:meth:`ActionContext.token`),
+        just as its :meth:`start` and :meth:`poll` would end it.
+
+        A transition without a timeout whose action gives a delay (above a microsecond)
+        is ended at that time without :meth:`start` or :meth:`poll` being called and
+        without an :class:`ActionContext` being made (one is made if it is cancelled,
+        for :meth:`cancel`): the commonest firing of a timed net then costs one
+        scheduled event. ``None`` (the default): the runtime calls the hooks.
+        """
+        return None
 
     def cancel(self, ctx: ActionContext) -> bool:
         """Stop: a cancellation region, the transition's timeout or a fault (an agent

@@ -67,11 +67,12 @@ class Firer:
         self.enabled, self.recorder, self.faults, self.world = enabled, recorder, faults, world
         self.agents = Agents(index, enabled)
         enabled.states = self.agents.states
-        self.runner = ActionRunner(index, kernel, enabled, self.finish)
+        self.runner = ActionRunner(index, kernel, enabled, self.finish, self.context)
         enabled.running = self.runner.running
         self.channels: Channels | None = None  # set by the run once made (channels need the run)
         self.resources: Any = None  # set by the run (petriflow.runtime.resources.Resources)
         self._declared = [getattr(cls, "resources", None) or None for cls in index.action_class]
+        self._delay = self.runner.delay  # per transition: the seconds its action only waits, or None
         compiled, consumers = index.compiled, index.consumers
         self._running = self.runner.running
         self._acts = [self.agents.any_readers(index.agent[t]) for t in range(len(index.ids))]
@@ -149,31 +150,43 @@ class Firer:
         if withdrawn or index.cancels[t]:
             self._cancel_region(t, number, withdrawn)
         now = tick * kernel.dt
-        self.runner.start(t, number, ActionContext(index.ids[t], agent, index.params[t], inputs, self.world,
-                                                   self._seed_prefix + str(number), now, now, None, False, None,
-                                                   "", None, None, self, self._declared[t]))
+        if self._delay[t] is not None:  # an action that only waits: its end is scheduled
+            self.runner.wait(t, number, inputs, now)
+            return
+        self.runner.start(t, number, self.context(t, number, inputs, now))
         if t not in self._running:  # ended at once: check it again (a running one is when it ends)
             enabled.dirty.add(t)
+
+    def context(self, t: int, number: int, inputs: dict[str, list[Any]], now: float) -> ActionContext:
+        """The context of firing ``number`` of transition index ``t``, started ``now``."""
+        index = self.index
+        return ActionContext(index.ids[t], index.agent[t], index.params[t], inputs, self.world,
+                             self._seed_prefix + str(number), now, now, None, False, None, "", None, None, self,
+                             self._declared[t])
 
     def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:
         cancelled = self.runner.cancel(list(self.index.cancels[t]))
         if withdrawn or cancelled:
-            self.recorder.emit(_CANCEL, self.index.ids[t], self.index.agent[t], firing=number, withdrawn=withdrawn,
-                               actions=[self.index.ids[f.index] for f in cancelled])
+            self.recorder.emit(_CANCEL, self.index.ids[t], self.index.agent[t], firing=number,
+                               withdrawn=dict(withdrawn), actions=[self.index.ids[f.index] for f in cancelled])
         self.runner.drive(cancelled)
 
-    def finish(self, number: int, t: int, ctx: ActionContext, outcome: Outcome) -> None:
-        """Produce the outputs of ``outcome`` and record the end of the firing.
+    def finish(self, number: int, t: int, ctx: ActionContext | None, outcome: Outcome, data: Any = None) -> None:
+        """Produce the outputs of ``outcome`` and record the end of the firing (``ctx``
+        ``None``: a delay's firing ending ``ok``, its output data ``data``).
 
         Raises:
             Unrouted: a failure or timeout the net gives no arcs for.
         """
+        if ctx is None:
+            self._produce(number, t, self.index.ok_row[t], outcome, data, None, data, "")
+            return
         tid, recorder = self.index.ids[t], self.recorder
-        self.progress = self.kernel.tick
-        if self._acts[t]:
-            self.agents.acted(ctx.agent)
         row = self.index.ok_row[t] if outcome is Outcome.OK else self.index.route[t][outcome]
         if row is None and outcome is not Outcome.CANCELLED and outcome is not Outcome.OK:
+            self.progress = self.kernel.tick
+            if self._acts[t]:
+                self.agents.acted(ctx.agent)
             reason = ctx.reason or outcome.value
             recorder.emit(_END, tid, ctx.agent, firing=number, outcome=outcome.value, produced={}, reason=reason)
             raise Unrouted(ActionFailure(reason, net=self.net.id, transition=tid,
@@ -185,12 +198,23 @@ class Firer:
                 else:
                     recorder.skip()
             ctx.emitted.clear()
+        result, outputs = ctx.result, ctx.outputs
+        if ctx.per_place and isinstance(result, dict):
+            result, outputs = None, result
+        self._produce(number, t, row, outcome, result, outputs, ctx.result, ctx.reason)
+
+    def _produce(self, number: int, t: int, row: int | None, outcome: Outcome, result: Any,
+                 outputs: dict[str, Any] | None, shown: Any, reason: str) -> None:
+        """The end of firing ``number`` of ``t``: the tokens of compiled ``row`` (none if
+        ``None``) with ``result`` as data (``outputs[place]`` where given), its end event
+        (showing ``shown`` and ``reason``), then its messages."""
+        recorder, agent = self.recorder, self.index.agent[t]
+        self.progress = self.kernel.tick
+        if self._acts[t]:
+            self.agents.acted(agent)
         produced: dict[str, int] = {}
         sent: list[tuple[str, Any]] | None = None
         if row is not None:  # the outputs: tokens here, messages once the end is recorded
-            result, outputs = ctx.result, ctx.outputs
-            if ctx.per_place and isinstance(result, dict):
-                result, outputs = None, result
             channel = self.index.channel
             produced = self.tokens.produce(row, result, outputs, channel)
             self.enabled.changed.update(self._fed[row])
@@ -201,13 +225,13 @@ class Firer:
                         sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
         if recorder.by_kind[_END]:
             details: dict[str, Any] = {"firing": number, "outcome": outcome.value, "produced": produced}
-            if ctx.result is not None:
-                details["result"] = summarize(ctx.result)
-            if ctx.reason:
-                details["reason"] = ctx.reason
-            recorder.emit(_END, tid, ctx.agent, **details)
+            if shown is not None:
+                details["result"] = summarize(shown)
+            if reason:
+                details["reason"] = reason
+            recorder.emit(_END, self.index.ids[t], agent, **details)
         else:
             recorder.count += 1
         if sent:
             for place, data in sent:
-                self.channels.send(place, data, ctx.agent)
+                self.channels.send(place, data, agent)

@@ -8,6 +8,11 @@ cancellation region, a fault killing its agent) or a timeout calls
 is done. When the action ends, the runner hands its outcome to the run
 (:class:`Finisher`), which produces the outputs.
 
+An action that only waits (:meth:`~petriflow.runtime.action.Action.delay`, e.g.
+``core.wait``) on a transition without a timeout is not polled: :meth:`ActionRunner.wait`
+schedules its end, which comes at the tick its poll would have ended it, with no
+context made unless the firing is cancelled.
+
 An exception in any hook is that firing's ``failed`` outcome with the exception as
 reason, never a lost token; an exception in ``setup`` makes every firing of the
 transition fail with it.
@@ -15,10 +20,11 @@ transition fail with it.
 
 from __future__ import annotations
 
+import math
 from typing import Any, Callable, Protocol
 
 from petriflow.outcome import Outcome
-from petriflow.runtime.action import Action, ActionContext, Status
+from petriflow.runtime.action import Action, ActionContext, Status, first_data
 from petriflow.runtime.enabling import EnabledSet, reason_of
 from petriflow.runtime.index import RunIndex
 from petriflow.runtime.kernel import POLL, Deadline, Kernel, Scheduled
@@ -26,19 +32,33 @@ from petriflow.runtime.kernel import POLL, Deadline, Kernel, Scheduled
 __all__ = ["Firing", "ActionRunner", "Finisher"]
 
 
-class Finisher(Protocol):
-    """What the runner tells when a firing ends (the run produces its outputs)."""
+#: The shortest delay :meth:`ActionRunner.wait` schedules (a shorter one is polled).
+SHORTEST_DELAY = 1e-6
 
-    def __call__(self, number: int, t: int, ctx: ActionContext, outcome: Outcome) -> None: ...
+
+class Finisher(Protocol):
+    """What the runner tells when a firing ends (the run produces its outputs); ``ctx``
+    is ``None`` for a delay's firing ending ``ok``, whose output data is ``data``."""
+
+    def __call__(self, number: int, t: int, ctx: ActionContext | None, outcome: Outcome, data: Any = None) -> None:
+        ...
+
+
+class Contexts(Protocol):
+    """Makes the context of firing ``number`` of transition ``t`` (the run knows its world
+    and seed) for its consumed ``inputs``, started at ``now``."""
+
+    def __call__(self, t: int, number: int, inputs: dict[str, list[Any]], now: float) -> ActionContext: ...
 
 
 class Firing(Scheduled):
     """The running firing of one transition (a transition runs one at a time, so one
     record per transition serves all its firings); scheduled on the kernel, it is its
-    own wake-up (the poll it asked for last)."""
+    own wake-up (the poll it asked for last). A delay's firing has no ``ctx`` until it
+    is cancelled; it keeps its ``inputs`` and ``started`` time."""
 
     __slots__ = ("runner", "number", "index", "action", "ctx", "deadline", "cancelling", "wake", "polled",
-                 "running")
+                 "running", "inputs", "started")
     phase = POLL
 
     def __init__(self, runner: "ActionRunner", index: int, action: Action) -> None:
@@ -47,6 +67,8 @@ class Firing(Scheduled):
         self.action = action
         self.number = 0
         self.ctx: ActionContext | None = None
+        self.inputs: dict[str, list[Any]] = {}
+        self.started = 0.0
         self.deadline: float | None = None
         self.cancelling: Outcome | None = None
         self.wake = -1
@@ -69,17 +91,23 @@ class ActionRunner:
         kernel: the run's event kernel.
         enabled: the run's enabled set (a transition whose action stops may fire again).
         finish: called when a firing ends, with its outcome.
+        contexts: makes a firing's context (for a delay's firing being cancelled).
 
     Attributes:
         running: ``{transition index: Firing}`` of the actions running now.
+        delay: per transition, the seconds its action only waits (:meth:`wait` starts
+            it), or ``None`` (:meth:`start`); known once :meth:`setup` ran.
     """
 
-    def __init__(self, index: RunIndex, kernel: Kernel, enabled: EnabledSet, finish: Finisher) -> None:
+    def __init__(self, index: RunIndex, kernel: Kernel, enabled: EnabledSet, finish: Finisher,
+                 contexts: Contexts) -> None:
         self.index = index
         self.kernel = kernel
         self.enabled = enabled
         self.finish = finish
+        self.contexts = contexts
         self.running: dict[int, Firing] = {}
+        self.delay: list[float | None] = [None] * len(index.ids)
         self.actions: list[Action | None] = [None] * len(index.ids)
         self._slot: list[Firing | None] = [None] * len(index.ids)
         self._setup_error: list[str | None] = [None] * len(index.ids)
@@ -93,8 +121,35 @@ class ActionRunner:
             self._slot[t] = Firing(self, t, action)
             try:
                 action.setup(world)
+                seconds = action.delay() if self.index.timeout[t] is None else None
             except Exception as exc:  # every firing of t then fails with this reason
                 self._setup_error[t] = reason_of(exc, "setup")
+                continue
+            if seconds is not None and seconds >= SHORTEST_DELAY:
+                self.delay[t] = seconds
+
+    def wait(self, t: int, number: int, inputs: dict[str, list[Any]], now: float) -> None:
+        """Start firing ``number`` of transition ``t``, whose action only waits
+        (:attr:`delay`): its end is scheduled at the first tick at which the action's
+        poll would end it, nothing is called."""
+        kernel = self.kernel
+        wake = now + self.delay[t]
+        dt = kernel.dt
+        tick = kernel.tick + 1
+        at = math.ceil(wake / dt - 1e-9)  # kernel.ticks_at, inline
+        if at > tick:
+            tick = at
+        while tick * dt < wake - 1e-12:
+            tick += 1
+        firing = self._slot[t]  # a delay's record never has a deadline (no timeout)
+        firing.number = number
+        firing.ctx = firing.cancelling = None
+        firing.inputs = inputs
+        firing.started = now
+        firing.wake = tick
+        firing.running = True
+        self.running[t] = firing
+        kernel.schedule_poll(tick, firing, number)
 
     def start(self, t: int, number: int, ctx: ActionContext) -> None:
         """Start firing ``number`` of transition ``t`` (its inputs are consumed)."""
@@ -148,6 +203,15 @@ class ActionRunner:
         kernel = self.kernel
         firing.polled = tick = kernel.tick
         ctx, action = firing.ctx, firing.action
+        if ctx is None:  # a delay's firing: its time has come, or it is cancelled
+            if firing.cancelling is None:
+                t = firing.index
+                firing.running = False  # _stop, inline
+                del self.running[t]
+                self.enabled.dirty.add(t)
+                self.finish(firing.number, t, None, Outcome.OK, first_data(firing.inputs))
+                return
+            ctx = firing.ctx = self.contexts(firing.index, firing.number, firing.inputs, firing.started)
         ctx.now = now = tick * kernel.dt
         if firing.cancelling is None and firing.deadline is not None and now >= firing.deadline - 1e-9:
             firing.cancelling = Outcome.TIMEOUT

@@ -36,6 +36,8 @@ from petriflow.marking import Marking
 
 __all__ = ["TokenStore", "Agenda"]
 
+_NOTHING: Mapping[str, int] = {}  # what a firing without a cancellation region withdraws (read only)
+
 
 
 class Agenda:
@@ -113,8 +115,12 @@ class Agenda:
 
     def take(self, draw: Callable[[], float]) -> int:
         """:meth:`pick` and :meth:`discard` the transition picked (what a firing does)."""
-        level, i = self._choice(draw)
-        t = level.pop(i)
+        for level in self._levels:  # _choice, inline: the commonest call of a run
+            if level:
+                t = level.pop() if len(level) == 1 else level.pop(int(draw() * len(level)))
+                break
+        else:
+            raise LookupError("no transition is enabled")
         self.on[t] = False
         self._count -= 1
         return t
@@ -202,7 +208,7 @@ class TokenStore:
             if final is not None:
                 wanted = final[p]
                 self.mismatch += (count - w != wanted) - (count != wanted)
-        return taken, {}
+        return taken, _NOTHING
 
     def _consume_with_reset(self, row: int) -> tuple[dict[str, list[Any]], dict[str, int]]:
         compiled, counts, data, places = self.compiled, self.counts, self.data, self.places

@@ -13,6 +13,8 @@ from petriflow.engine import consume, fire, is_enabled, produce
 from petriflow.marking import Marking
 from petriflow.net import Net
 from petriflow.outcome import Outcome, StopReason
+from petriflow.runtime.builtin import Wait
+from petriflow.runtime.registry import Registry
 from petriflow.runtime.scheduler import Scheduler
 
 PLACES = [f"p{k}" for k in range(6)]
@@ -166,3 +168,78 @@ def test_nothing_enabled_is_left_unfired_at_the_end_of_an_instant(net, seed):
     except Exception as exc:
         assert type(exc).__name__ == "ZenoError", exc
     assert not missed
+
+
+class PolledWait(Wait):
+    """core.wait as a plain polled action: its start and poll are called (a subclass
+    that overrides them is never taken for a pure delay)."""
+
+    def poll(self, ctx):
+        return super().poll(ctx)
+
+
+def trace_of(net: Net, seed: int, registry: Registry | None = None, dt: float = 0.01) -> list[tuple]:
+    scheduler = Scheduler(net, seed=seed, registry=registry, config={"dt": dt})
+    events = []
+    scheduler.on_event(lambda e: events.append((e.kind, e.time, e.transition, repr(e.data))))
+    try:
+        result = scheduler.run(until=8, max_firings=300)
+    except Exception as exc:  # a cycle of instant transitions
+        return [type(exc).__name__]
+    return events + [(result.reason, result.time, result.firings)]
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(timed_nets(), st.integers(0, 3), st.sampled_from([0.01, 0.1, 0.3]))
+def test_a_wait_ended_without_polls_ends_as_a_polled_wait_would(net, seed, dt):
+    """core.wait is a pure delay, whose end the runtime schedules without polling it:
+    every run (timeouts, failures, cancellation regions cutting waits short) gives the
+    same events, at the same times, as with a wait that is polled."""
+    polled = Registry(load_plugins=False)
+    polled.register("core.wait", PolledWait, replace=True)
+    assert PolledWait({"seconds": 1.0}).delay() is None and Wait({"seconds": 1.0}).delay() == 1.0
+    assert trace_of(net, seed, dt=dt) == trace_of(net, seed, polled, dt=dt)
+
+
+def test_waits_of_awkward_lengths_end_where_their_polls_would():
+    """Waits whose end falls a hair off a tick, and waits below a microsecond (polled),
+    end at the same ticks both ways, passing their token's data on."""
+    net = Net("awkward")
+    net.add_place("a", tokens=1)
+    net.add_place("data")
+    net.add_transition("give", action="core.set", params={"value": {"x": 1}})
+    net.add_arc("a", "give")
+    net.add_arc("give", "data")
+    previous = "data"
+    for k, seconds in enumerate([0.1 + 0.2, 0.3 + 5e-11, 1e-7, 0.7, 1 / 3, 2e-6, 0.0]):
+        net.add_place(f"p{k}")
+        net.add_transition(f"w{k}", action="core.wait", params={"seconds": seconds})
+        net.add_arc(previous, f"w{k}")
+        net.add_arc(f"w{k}", f"p{k}")
+        previous = f"p{k}"
+    polled = Registry(load_plugins=False)
+    polled.register("core.wait", PolledWait, replace=True)
+    for dt in (0.1, 0.01, 1 / 3):
+        fast = trace_of(net, 0, dt=dt)
+        assert fast == trace_of(net, 0, polled, dt=dt)
+        assert [kind for kind, *_ in fast[:-1]].count("end") == 8
+        assert all("'x': 1" in data for kind, _, _, data in fast[:-1] if kind == "end")
+
+
+def test_a_region_cuts_a_wait_short_as_it_cuts_a_polled_one():
+    """A cancellation region ends a running wait at once with the cancelled outcome
+    (its cancelled arc gets the token), as it ends a polled wait."""
+    net = Net("cut")
+    for place, tokens in [("a", 1), ("b", 1), ("c", 0), ("d", 0), ("e", 0)]:
+        net.add_place(place, tokens=tokens)
+    net.add_transition("long", action="core.wait", params={"seconds": 2.0})
+    net.add_transition("cut", action="core.wait", params={"seconds": 1.0}, cancels=("long",))
+    for source, target in [("a", "long"), ("long", "c"), ("b", "cut"), ("cut", "d")]:
+        net.add_arc(source, target)
+    net.add_arc("long", "e", outcome="cancelled")
+    polled = Registry(load_plugins=False)
+    polled.register("core.wait", PolledWait, replace=True)
+    fast = trace_of(net, 0)
+    assert fast == trace_of(net, 0, polled)
+    assert ("end", 0.0, "long") in [event[:3] for event in fast[:-1] if "'cancelled'" in event[3]]
+    assert fast[-1][0] == StopReason.DEAD and fast[-1][1] == 1.0
