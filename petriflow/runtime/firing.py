@@ -132,7 +132,7 @@ class Firer:
         self.count = number = self.count + 1
         kernel = self.kernel
         tick = self.progress = kernel.tick
-        inputs, withdrawn = self.tokens.consume(index.row[t])
+        inputs, withdrawn = self.tokens.take(index.row[t])  # inputs None: all black
         enabled = self.enabled
         enabled.changed.update(enabled.taking[t])
         agent = index.agent[t]
@@ -140,8 +140,9 @@ class Firer:
             self.agents.acted(agent)
         recorder = self.recorder
         if recorder.by_kind[_START]:
-            details: dict[str, Any] = {"firing": number, "consumed": {p: len(v) for p, v in inputs.items()}}
-            carried = {p: [summarize(d) for d in v] for p, v in inputs.items() if any(d is not None for d in v)}
+            taken = self.tokens.black(index.row[t]) if inputs is None else inputs
+            details: dict[str, Any] = {"firing": number, "consumed": {p: len(v) for p, v in taken.items()}}
+            carried = {p: [summarize(d) for d in v] for p, v in taken.items() if any(d is not None for d in v)}
             if carried:
                 details["inputs"] = carried
             recorder.emit(_START, index.ids[t], agent, **details)
@@ -157,9 +158,12 @@ class Firer:
         if t not in self._running:  # ended at once: check it again (a running one is when it ends)
             enabled.dirty.add(t)
 
-    def context(self, t: int, number: int, inputs: dict[str, list[Any]], now: float) -> ActionContext:
-        """The context of firing ``number`` of transition index ``t``, started ``now``."""
+    def context(self, t: int, number: int, inputs: dict[str, list[Any]] | None, now: float) -> ActionContext:
+        """The context of firing ``number`` of transition index ``t``, started ``now``,
+        that took ``inputs`` (``None``: black tokens only)."""
         index = self.index
+        if inputs is None:
+            inputs = self.tokens.black(index.row[t])
         return ActionContext(index.ids[t], index.agent[t], index.params[t], inputs, self.world,
                              self._seed_prefix + str(number), now, now, None, False, None, "", None, None, self,
                              self._declared[t])
@@ -212,11 +216,10 @@ class Firer:
         self.progress = self.kernel.tick
         if self._acts[t]:
             self.agents.acted(agent)
-        produced: dict[str, int] = {}
         sent: list[tuple[str, Any]] | None = None
         if row is not None:  # the outputs: tokens here, messages once the end is recorded
             channel = self.index.channel
-            produced = self.tokens.produce(row, result, outputs, channel)
+            self.tokens.put(row, result, outputs, channel)
             self.enabled.changed.update(self._fed[row])
             if self._sends[row]:
                 sent, places = [], self.index.compiled.places
@@ -224,6 +227,7 @@ class Firer:
                     if channel[p]:
                         sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
         if recorder.by_kind[_END]:
+            produced = {} if row is None else self.tokens.produced(row, self.index.channel)
             details: dict[str, Any] = {"firing": number, "outcome": outcome.value, "produced": produced}
             if shown is not None:
                 details["result"] = summarize(shown)

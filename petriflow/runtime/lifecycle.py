@@ -46,9 +46,9 @@ class Finisher(Protocol):
 
 class Contexts(Protocol):
     """Makes the context of firing ``number`` of transition ``t`` (the run knows its world
-    and seed) for its consumed ``inputs``, started at ``now``."""
+    and seed) for its consumed ``inputs`` (``None``: black tokens only), started at ``now``."""
 
-    def __call__(self, t: int, number: int, inputs: dict[str, list[Any]], now: float) -> ActionContext: ...
+    def __call__(self, t: int, number: int, inputs: dict[str, list[Any]] | None, now: float) -> ActionContext: ...
 
 
 class Firing(Scheduled):
@@ -67,7 +67,7 @@ class Firing(Scheduled):
         self.action = action
         self.number = 0
         self.ctx: ActionContext | None = None
-        self.inputs: dict[str, list[Any]] = {}
+        self.inputs: dict[str, list[Any]] | None = None
         self.started = 0.0
         self.deadline: float | None = None
         self.cancelling: Outcome | None = None
@@ -128,10 +128,11 @@ class ActionRunner:
             if seconds is not None and seconds >= SHORTEST_DELAY:
                 self.delay[t] = seconds
 
-    def wait(self, t: int, number: int, inputs: dict[str, list[Any]], now: float) -> None:
+    def wait(self, t: int, number: int, inputs: dict[str, list[Any]] | None, now: float) -> None:
         """Start firing ``number`` of transition ``t``, whose action only waits
-        (:attr:`delay`): its end is scheduled at the first tick at which the action's
-        poll would end it, nothing is called."""
+        (:attr:`delay`), having taken ``inputs`` (``None``: black tokens only): its end
+        is scheduled at the first tick at which the action's poll would end it, nothing
+        is called."""
         kernel = self.kernel
         wake = now + self.delay[t]
         dt = kernel.dt
@@ -209,7 +210,8 @@ class ActionRunner:
                 firing.running = False  # _stop, inline
                 del self.running[t]
                 self.enabled.dirty.add(t)
-                self.finish(firing.number, t, None, Outcome.OK, first_data(firing.inputs))
+                inputs = firing.inputs
+                self.finish(firing.number, t, None, Outcome.OK, None if inputs is None else first_data(inputs))
                 return
             ctx = firing.ctx = self.contexts(firing.index, firing.number, firing.inputs, firing.started)
         ctx.now = now = tick * kernel.dt

@@ -183,19 +183,44 @@ class TokenStore:
         if final is not None:
             self.mismatch += (self.counts[i] != final[i]) - (before != final[i])
 
-    def consume(self, row: int) -> tuple[dict[str, list[Any]], dict[str, int]]:
+    def consume(self, row: int) -> tuple[dict[str, list[Any]], Mapping[str, int]]:
         """Start firing ``row`` (its preset enabled): take its input tokens and empty its
         cancellation region's places, by the compiled firing rule.
 
         Returns:
             ``({place: [data, ...]} taken, {place: count} withdrawn by the region)``.
         """
-        compiled, counts, data, places, final = self.compiled, self.counts, self.data, self.places, self._final
-        reset = compiled.reset[row]
-        if reset:
+        taken, withdrawn = self.take(row)
+        return (self.black(row) if taken is None else taken), withdrawn
+
+    def black(self, row: int) -> dict[str, list[Any]]:
+        """``{place: [None, ...]}``: the tokens firing ``row`` takes, all black."""
+        places = self.places
+        return {places[p]: [None] * w for p, w in self.compiled.pre[row]}
+
+    def take(self, row: int) -> tuple[dict[str, list[Any]] | None, Mapping[str, int]]:
+        """:meth:`consume`, with ``None`` for the tokens taken when none of them carries
+        data (:meth:`black` makes them if they are needed): most firings of most nets
+        then allocate nothing."""
+        compiled, counts, data, final = self.compiled, self.counts, self.data, self._final
+        if compiled.reset[row]:
             return self._consume_with_reset(row)
+        pre = compiled.pre[row]
+        for p, _ in pre:
+            if data[p] is not None:
+                return self._consume_data(row)
+        for p, w in pre:  # the compiled rule's consume
+            count = counts[p]
+            counts[p] = count - w
+            if final is not None:
+                wanted = final[p]
+                self.mismatch += (count - w != wanted) - (count != wanted)
+        return None, _NOTHING
+
+    def _consume_data(self, row: int) -> tuple[dict[str, list[Any]], Mapping[str, int]]:
+        counts, data, places, final = self.counts, self.data, self.places, self._final
         taken = {}
-        for p, w in compiled.pre[row]:  # the compiled rule's consume, with the tokens' data
+        for p, w in self.compiled.pre[row]:  # the compiled rule's consume, with the tokens' data
             queue = data[p]
             if queue is None:  # black tokens only
                 taken[places[p]] = [None] * w
@@ -239,9 +264,18 @@ class TokenStore:
         later, through :meth:`add`).
 
         Returns:
-            ``{place: count}`` produced here.
+            ``{place: count}`` produced here (:meth:`put` when nobody asks).
         """
-        produced = {}
+        self.put(row, result, outputs, skip)
+        return self.produced(row, skip)
+
+    def produced(self, row: int, skip: Sequence[bool]) -> dict[str, int]:
+        """``{place: count}`` firing ``row`` produces here (not where ``skip[index]``)."""
+        places = self.places
+        return {places[p]: w for p, w in self.compiled.post[row] if not skip[p]}
+
+    def put(self, row: int, result: Any, outputs: Mapping[str, Any] | None, skip: Sequence[bool]) -> None:
+        """:meth:`produce`, without counting what it produced."""
         counts, data, places, final = self.counts, self.data, self.places, self._final
         for p, w in self.compiled.post[row]:  # the compiled rule's produce, less what travels through channels
             if skip[p]:
@@ -256,12 +290,10 @@ class TokenStore:
                 queue.append(item)
             else:
                 queue.extend([item] * w)
-            produced[places[p]] = w
             counts[p] = count + w
             if final is not None:
                 wanted = final[p]
                 self.mismatch += (count + w != wanted) - (count != wanted)
-        return produced
 
     def add(self, i: int, item: Any) -> None:
         """One token with data ``item`` arrives in place index ``i`` (a delivery)."""
