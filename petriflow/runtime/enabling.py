@@ -189,6 +189,7 @@ class EnabledSet:
             can_fire, running, answer, on = self.can_fire, self.running, self.answer, self.agenda.on
             counts, row, pre, guard = self.tokens.counts, self.index.row, self.index.compiled.pre, self.index.guard
             agent, alive = self.index.agent, self.alive
+            everyone = all(alive.values())  # every agent runs: no transition's agent to look up
             up: list[int] = []
             down: list[int] = []
             for t in dirty:
@@ -202,8 +203,7 @@ class EnabledSet:
                             break
                     else:
                         if guard[t] is None or kept:  # no guard, or a state guard's kept "yes": the agent decides
-                            a = agent[t]
-                            ok = a is None or alive.get(a, True)
+                            ok = everyone or agent[t] is None or alive.get(agent[t], True)
                         else:
                             ok = can_fire(t)
                 if ok != on[t]:

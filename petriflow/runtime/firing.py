@@ -98,7 +98,7 @@ class Firer:
         while limit is None or self.count < limit:
             if dirty or changed:
                 refresh()
-            if not agenda:
+            if not agenda.count:
                 return
             t = agenda.take(draw)
             fire(t)
@@ -134,10 +134,11 @@ class Firer:
         tick = self.progress = kernel.tick
         inputs, withdrawn = self.tokens.take(index.row[t])  # inputs None: all black
         enabled = self.enabled
-        enabled.changed.update(enabled.taking[t])
-        agent = index.agent[t]
+        taking = enabled.taking[t]
+        if taking:
+            enabled.changed.update(taking)
         if self._acts[t]:
-            self.agents.acted(agent)
+            self.agents.acted(index.agent[t])
         recorder = self.recorder
         if recorder.by_kind[_START]:
             taken = self.tokens.black(index.row[t]) if inputs is None else inputs
@@ -145,7 +146,7 @@ class Firer:
             carried = {p: [summarize(d) for d in v] for p, v in taken.items() if any(d is not None for d in v)}
             if carried:
                 details["inputs"] = carried
-            recorder.emit(_START, index.ids[t], agent, **details)
+            recorder.emit(_START, index.ids[t], index.agent[t], **details)
         else:
             recorder.count += 1
         if withdrawn or index.cancels[t]:

@@ -53,6 +53,7 @@ class Agenda:
 
     Attributes:
         on: per transition index, whether it is in the agenda (read it, never write it).
+        count: how many transitions are in it (``len``, without a call; read only).
     """
 
     def __init__(self, priorities: Sequence[int]) -> None:
@@ -61,10 +62,10 @@ class Agenda:
         level_of = {p: i for i, p in enumerate(levels)}
         self._level = [self._levels[level_of[p]] for p in priorities]
         self.on = [False] * len(priorities)
-        self._count = 0
+        self.count = 0
 
     def __len__(self) -> int:
-        return self._count
+        return self.count
 
     def __contains__(self, t: int) -> bool:
         return self.on[t]
@@ -82,7 +83,7 @@ class Agenda:
     def change(self, up: Iterable[int], down: Iterable[int]) -> None:
         """Mark the transitions ``up`` enabled and those ``down`` not (each must be off,
         respectively on, now): :meth:`add` and :meth:`discard` for many at once."""
-        on, level_of, count = self.on, self._level, self._count
+        on, level_of, count = self.on, self._level, self.count
         for t in down:
             on[t] = False
             count -= 1
@@ -99,7 +100,7 @@ class Agenda:
                 level.append(t)
             else:
                 insort(level, t)
-        self._count = count
+        self.count = count
 
     def _choice(self, draw: Callable[[], float]) -> tuple[list[int], int]:
         for level in self._levels:
@@ -122,7 +123,7 @@ class Agenda:
         else:
             raise LookupError("no transition is enabled")
         self.on[t] = False
-        self._count -= 1
+        self.count -= 1
         return t
 
     def members(self) -> list[int]:
