@@ -38,7 +38,7 @@ Examples:
 
 from __future__ import annotations
 
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Callable, Collection, Iterable, Mapping
 
 from petriflow.errors import PetriflowError
 from petriflow.runtime.index import RunIndex
@@ -66,13 +66,18 @@ class EnabledSet:
         tokens: the run's tokens.
         alive: ``{agent: running}`` (an agent missing from it is running).
         running: the transitions whose action is running (anything with ``in``).
+        states: ``{agent: state}``, what state guards read.
+        stopped: the agents not running now, kept up to date with ``alive`` by its owner
+            (while it is empty no transition's agent is looked up); default: those
+            ``alive`` says are not running when the set is made.
     """
 
     def __init__(self, index: RunIndex, tokens: TokenStore, alive: Mapping[str, bool], running: Any,
-                 states: Mapping[str, Any] | None = None) -> None:
+                 states: Mapping[str, Any] | None = None, stopped: Collection[str] | None = None) -> None:
         self.index = index
         self.tokens = tokens
         self.alive = alive
+        self.stopped = {a for a, on in alive.items() if not on} if stopped is None else stopped
         self.running = running
         self.states: Mapping[str, Any] = {} if states is None else states
         self.agenda = Agenda(index.priority)
@@ -189,7 +194,7 @@ class EnabledSet:
             can_fire, running, answer, on = self.can_fire, self.running, self.answer, self.agenda.on
             counts, row, pre, guard = self.tokens.counts, self.index.row, self.index.compiled.pre, self.index.guard
             agent, alive = self.index.agent, self.alive
-            everyone = all(alive.values())  # every agent runs: no transition's agent to look up
+            everyone = not self.stopped  # every agent runs: no transition's agent to look up
             up: list[int] = []
             down: list[int] = []
             for t in dirty:

@@ -48,12 +48,21 @@ class Faults:
     def __init__(self, run: "RunHost", faults: Iterable[Fault], agents: Iterable[str]) -> None:
         self.run = run
         self.running = {agent: True for agent in agents}
+        #: The agents not running now (what the enabled set looks up, only when any is).
+        self.stopped: set[str] = set()
         self.down: set[frozenset[str]] = set()
         kernel = run.kernel
         for fault in faults:
             kernel.schedule(kernel.ticks_at(fault.at), FaultEvent(self.apply, fault))
             if fault.kind == FaultKind.JOIN:
-                self.running[fault.agent] = False
+                self._set(fault.agent, False)
+
+    def _set(self, agent: str, running: bool) -> None:
+        self.running[agent] = running
+        if running:
+            self.stopped.discard(agent)
+        else:
+            self.stopped.add(agent)
 
     def alive(self, agent: str | None) -> bool:
         """Whether ``agent`` runs now (``None``, no agent, always does)."""
@@ -67,11 +76,11 @@ class Faults:
         """Inject ``fault`` now."""
         run = self.run
         if fault.kind == FaultKind.KILL:
-            self.running[fault.agent] = False
+            self._set(fault.agent, False)
             run.emit("fault", None, fault.agent, fault=FaultKind.KILL.value)
             run.agent_stopped(fault.agent)
         elif fault.kind == FaultKind.JOIN:
-            self.running[fault.agent] = True
+            self._set(fault.agent, True)
             run.emit("fault", None, fault.agent, fault=FaultKind.JOIN.value)
             run.agent_started(fault.agent)
         elif fault.kind == FaultKind.DROP_LINK:
