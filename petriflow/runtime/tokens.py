@@ -207,21 +207,25 @@ class TokenStore:
         if compiled.reset[row]:
             return self._consume_with_reset(row)
         pre = compiled.pre[row]
+        taken = None
         for p, _ in pre:
             if data[p] is not None:
-                return self._consume_data(row)
+                taken = self._take_data(pre)
+                break
         for p, w in pre:  # the compiled rule's consume
             count = counts[p]
             counts[p] = count - w
             if final is not None:
                 wanted = final[p]
                 self.mismatch += (count - w != wanted) - (count != wanted)
-        return None, _NOTHING
+        return taken, _NOTHING
 
-    def _consume_data(self, row: int) -> tuple[dict[str, list[Any]], Mapping[str, int]]:
-        counts, data, places, final = self.counts, self.data, self.places, self._final
+    def _take_data(self, pre: Sequence[tuple[int, int]]) -> dict[str, list[Any]]:
+        """``{place: [data, ...]}`` of the tokens of ``pre``, taken from the places' queues
+        (the counts are the caller's)."""
+        data, places = self.data, self.places
         taken = {}
-        for p, w in self.compiled.pre[row]:  # the compiled rule's consume, with the tokens' data
+        for p, w in pre:
             queue = data[p]
             if queue is None:  # black tokens only
                 taken[places[p]] = [None] * w
@@ -229,12 +233,7 @@ class TokenStore:
                 taken[places[p]] = [queue.popleft()] if w == 1 else [queue.popleft() for _ in range(w)]
                 if not queue:
                     data[p] = None
-            count = counts[p]
-            counts[p] = count - w
-            if final is not None:
-                wanted = final[p]
-                self.mismatch += (count - w != wanted) - (count != wanted)
-        return taken, _NOTHING
+        return taken
 
     def _consume_with_reset(self, row: int) -> tuple[dict[str, list[Any]], dict[str, int]]:
         compiled, counts, data, places = self.compiled, self.counts, self.data, self.places
