@@ -31,7 +31,7 @@ Examples:
     ... transitions: [{id: go, in: [a], out: [b]}, {id: back, in: [b], out: [a]}]
     ... ''')
     >>> index = RunIndex(net, bind(net))
-    >>> enabled = EnabledSet(index, TokenStore(index.compiled, net.initial_marking), {}, {})
+    >>> enabled = EnabledSet(index, TokenStore(index.compiled, net.initial_marking), set(), {})
     >>> [index.ids[t] for t in enabled.members()]
     ['go']
 """
@@ -64,20 +64,17 @@ class EnabledSet:
     Args:
         index: the run's net index.
         tokens: the run's tokens.
-        alive: ``{agent: running}`` (an agent missing from it is running).
+        stopped: the agents not running now, kept up to date by its owner (every other
+            agent runs; while it is empty no transition's agent is looked up).
         running: the transitions whose action is running (anything with ``in``).
         states: ``{agent: state}``, what state guards read.
-        stopped: the agents not running now, kept up to date with ``alive`` by its owner
-            (while it is empty no transition's agent is looked up); default: those
-            ``alive`` says are not running when the set is made.
     """
 
-    def __init__(self, index: RunIndex, tokens: TokenStore, alive: Mapping[str, bool], running: Any,
-                 states: Mapping[str, Any] | None = None, stopped: Collection[str] | None = None) -> None:
+    def __init__(self, index: RunIndex, tokens: TokenStore, stopped: Collection[str], running: Any,
+                 states: Mapping[str, Any] | None = None) -> None:
         self.index = index
         self.tokens = tokens
-        self.alive = alive
-        self.stopped = {a for a, on in alive.items() if not on} if stopped is None else stopped
+        self.stopped = stopped
         self.running = running
         self.states: Mapping[str, Any] = {} if states is None else states
         self.agenda = Agenda(index.priority)
@@ -159,7 +156,7 @@ class EnabledSet:
             return False
         index = self.index
         agent = index.agent[t]
-        if agent is not None and not self.alive.get(agent, True):
+        if agent is not None and agent in self.stopped:
             return False
         row = index.row[t]
         if not index.compiled.is_enabled(self.tokens.counts, row):
@@ -193,8 +190,8 @@ class EnabledSet:
         if dirty:
             can_fire, running, answer, on = self.can_fire, self.running, self.answer, self.agenda.on
             counts, row, pre, guard = self.tokens.counts, self.index.row, self.index.compiled.pre, self.index.guard
-            agent, alive = self.index.agent, self.alive
-            everyone = not self.stopped  # every agent runs: no transition's agent to look up
+            agent, stopped = self.index.agent, self.stopped
+            everyone = not stopped  # every agent runs: no transition's agent to look up
             up: list[int] = []
             down: list[int] = []
             for t in dirty:
@@ -208,7 +205,7 @@ class EnabledSet:
                             break
                     else:
                         if guard[t] is None or kept:  # no guard, or a state guard's kept "yes": the agent decides
-                            ok = everyone or agent[t] is None or alive.get(agent[t], True)
+                            ok = everyone or agent[t] not in stopped
                         else:
                             ok = can_fire(t)
                 if ok != on[t]:

@@ -47,26 +47,24 @@ class Faults:
 
     def __init__(self, run: "RunHost", faults: Iterable[Fault], agents: Iterable[str]) -> None:
         self.run = run
-        self.running = {agent: True for agent in agents}
-        #: The agents not running now (what the enabled set looks up, only when any is).
+        self.agents = list(agents)
+        #: The agents not running now (killed, or not yet joined): every other agent runs.
         self.stopped: set[str] = set()
         self.down: set[frozenset[str]] = set()
         kernel = run.kernel
         for fault in faults:
             kernel.schedule(kernel.ticks_at(fault.at), FaultEvent(self.apply, fault))
             if fault.kind == FaultKind.JOIN:
-                self._set(fault.agent, False)
+                self.stopped.add(fault.agent)
 
-    def _set(self, agent: str, running: bool) -> None:
-        self.running[agent] = running
-        if running:
-            self.stopped.discard(agent)
-        else:
-            self.stopped.add(agent)
+    @property
+    def running(self) -> dict[str, bool]:
+        """``{agent: running}`` for every agent of the run."""
+        return {agent: agent not in self.stopped for agent in self.agents}
 
     def alive(self, agent: str | None) -> bool:
         """Whether ``agent`` runs now (``None``, no agent, always does)."""
-        return agent is None or self.running.get(agent, True)
+        return agent not in self.stopped
 
     def link_down(self, sender: str | None, receiver: str | None) -> bool:
         """Whether messages between the two agents are being lost."""
@@ -76,11 +74,11 @@ class Faults:
         """Inject ``fault`` now."""
         run = self.run
         if fault.kind == FaultKind.KILL:
-            self._set(fault.agent, False)
+            self.stopped.add(fault.agent)
             run.emit("fault", None, fault.agent, fault=FaultKind.KILL.value)
             run.agent_stopped(fault.agent)
         elif fault.kind == FaultKind.JOIN:
-            self._set(fault.agent, True)
+            self.stopped.discard(fault.agent)
             run.emit("fault", None, fault.agent, fault=FaultKind.JOIN.value)
             run.agent_started(fault.agent)
         elif fault.kind == FaultKind.DROP_LINK:

@@ -163,7 +163,7 @@ class Scheduler:
         self.tokens = TokenStore(index.compiled, net.initial_marking, net.final_marking)
         self.recorder = Recorder(kernel)
         self.faults = Faults(self, self.config.faults, index.agents)
-        self.enabled_set = EnabledSet(index, self.tokens, self.faults.running, {}, stopped=self.faults.stopped)
+        self.enabled_set = EnabledSet(index, self.tokens, self.faults.stopped, {})
         self.firer = Firer(net, index, kernel, self.tokens, self.enabled_set, self.recorder, self.faults, world,
                            self.seed)
         self.runner = self.firer.runner
