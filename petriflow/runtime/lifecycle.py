@@ -20,7 +20,6 @@ transition fail with it.
 
 from __future__ import annotations
 
-import math
 from typing import Any, Callable, Protocol
 
 from petriflow.outcome import Outcome
@@ -136,10 +135,7 @@ class ActionRunner:
         kernel = self.kernel
         wake = now + self.delay[t]
         dt = kernel.dt
-        tick = kernel.tick + 1
-        at = math.ceil(wake / dt - 1e-9)  # kernel.ticks_at, inline
-        if at > tick:
-            tick = at
+        tick = max(kernel.tick + 1, kernel.ticks_at(wake))
         while tick * dt < wake - 1e-12:
             tick += 1
         firing = self._slot[t]  # a delay's record never has a deadline (no timeout)

@@ -116,12 +116,8 @@ class Agenda:
 
     def take(self, draw: Callable[[], float]) -> int:
         """:meth:`pick` and :meth:`discard` the transition picked (what a firing does)."""
-        for level in self._levels:  # _choice, inline: the commonest call of a run
-            if level:
-                t = level.pop() if len(level) == 1 else level.pop(int(draw() * len(level)))
-                break
-        else:
-            raise LookupError("no transition is enabled")
+        level, i = self._choice(draw)
+        t = level.pop(i)
         self.on[t] = False
         self.count -= 1
         return t
