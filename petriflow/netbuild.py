@@ -65,7 +65,13 @@ from petriflow.errors import NetStructureError, UnknownElementError, did_you_mea
 from petriflow.marking import Marking
 from petriflow.net import OUTCOMES, Net
 
-__all__ = ["NetBuilder", "AgentBuilder", "Mailbox", "Places"]
+__all__ = ["NetBuilder", "AgentBuilder", "Mailbox", "Places", "is_capacity"]
+
+
+def is_capacity(value: Any) -> bool:
+    """Whether ``value`` is a mailbox capacity :meth:`NetBuilder.mailbox` takes: a whole
+    number >= 1 (not a bool), or ``"senders"``."""
+    return value == "senders" or (isinstance(value, int) and not isinstance(value, bool) and value >= 1)
 
 #: Places an arc list names: one id, a list of ids (weight 1 each) or ``{id: weight}``.
 Places = Union[str, Sequence[str], Mapping[str, int]]
@@ -235,7 +241,7 @@ class NetBuilder:
             id = name if owner_name is None else f"{owner_name}_{name}"
         if slot is None:
             slot = f"{id}_slot"
-        if capacity != "senders" and (isinstance(capacity, bool) or not isinstance(capacity, int) or capacity < 1):
+        if not is_capacity(capacity):
             raise NetStructureError(f"mailbox {id!r}: capacity must be a whole number >= 1 or 'senders',"
                                     f" got {capacity!r}")
         if channel is not None and (not isinstance(channel, str) or not channel):

@@ -44,7 +44,7 @@ import yaml
 
 from petriflow.agents.bidding.cost import SPEED_M_S
 from petriflow.net import Net
-from petriflow.netbuild import AgentBuilder, Mailbox, NetBuilder
+from petriflow.netbuild import AgentBuilder, Mailbox, NetBuilder, is_capacity
 
 __all__ = ["build", "main"]
 
@@ -193,7 +193,7 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
     b = NetBuilder(f"bidding-{deployment}-{robots}", label=f"seed 004 collaborative mapping: {robots}"
                    f" robot{'s' if robots > 1 else ''}, {deployment} deployment")
     operator, _ = _agent(b, "operator", "the human operator", "bidding.operator", listens=False)
-    if mailbox != "senders" and (isinstance(mailbox, bool) or not isinstance(mailbox, int) or mailbox < 1):
+    if not is_capacity(mailbox):
         raise ValueError(f"mailbox is a whole number of slots >= 1 or 'senders', got {mailbox!r}")
     hmia, hmia_box = _agent(b, "hmia", "human/machine interface agent", "bidding.interface", capacity=mailbox)
     ras = [_agent(b, name, f"robot agent {name}", "bidding.robot", capacity=mailbox) for name in team]
