@@ -37,14 +37,14 @@ import numpy as np
 NETS = Path(__file__).resolve().parents[1] / "nets" / "swarm"
 
 
-def run_petriflow(robots: int, until: float | None, seed: int = 1) -> dict:
+def run_petriflow(robots: int, until: float | None, seed: int = 1, tiles: int = 1) -> dict:
     from petriflow.agents.swarm.nets import build, world
     from petriflow.runtime.config import load_config
     from petriflow.runtime.scheduler import Scheduler
     from petriflow.world import World
 
-    description = world(robots)
-    net = build(robots)
+    description = world(robots, tiles=tiles)
+    net = build(robots, tiles=tiles)
     config = load_config(NETS / "run.yaml")
     w = World(description, base=NETS)
     record = {"poses": [], "velocities": [], "rays": {}, "queries": {}}
@@ -74,10 +74,12 @@ def run_petriflow(robots: int, until: float | None, seed: int = 1) -> dict:
         cpu = time.process_time()
         result = scheduler.run(until=until)
         cpu = time.process_time() - cpu
-    out = {"robots": robots, "sim_s": result.time, "reason": result.reason.value, "cpu_s": cpu,
+    out = {"robots": robots, "tiles": tiles, "sim_s": result.time, "reason": result.reason.value, "cpu_s": cpu,
            "cpu_per_sim_s": cpu / result.time, "ticks": len(record["poses"]), "firings": result.firings,
            "rays": sum(len(s) for batches in record["rays"].values() for s, _, _ in batches),
-           "queries": sum(len(q) for q in record["queries"].values())}
+           "queries": sum(len(q) for q in record["queries"].values()),
+           "bytes": sum(state.sent_bytes for state in scheduler.firer.agents.states.values()
+                        if hasattr(state, "sent_bytes"))}
     w.close()
     return out | {"record": record, "description": description, "dt": description["dt"],
                   "model": radio.index(None)}
@@ -199,6 +201,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--until", type=float, default=None, help="simulated seconds (default: the mission's end)")
     parser.add_argument("--markdown", action="store_true", help="print the README table")
     parser.add_argument("--json", action="store_true")
+    parser.add_argument("--tile", type=int, default=None, metavar="ROBOTS",
+                        help="run each team as copies of the ROBOTS-robot maze (the work per robot held equal)")
     parser.add_argument("--cores", action="store_true", help="measure what a second core would give, and stop")
     args = parser.parse_args(argv)
     if args.cores:
@@ -206,7 +210,10 @@ def main(argv: list[str] | None = None) -> None:
         return
     rows = []
     for robots in args.robots:
-        run = run_petriflow(robots, args.until)
+        tiles = robots // args.tile if args.tile else 1
+        if args.tile and (tiles < 1 or robots % args.tile):
+            parser.error(f"--tile {args.tile} does not divide {robots} robots")
+        run = run_petriflow(robots, args.until, tiles=tiles)
         sim = run["sim_s"]
         floor = run_floor(run["description"], run["record"]) / sim
         plain = run_numpy(run["record"], run["dt"], run["model"]) / sim
@@ -216,8 +223,9 @@ def main(argv: list[str] | None = None) -> None:
                 "petriflow_over_numpy": run["cpu_per_sim_s"] / plain if plain else math.inf}
         rows.append(row)
         if not args.json:
-            print(f"N={robots}: {sim:.1f} simulated s ({row['reason']}, {row['ticks']} ticks, {row['rays']} rays,"
-                  f" {row['queries']} radio queries, {row['firings']} firings): petriflow {row['cpu_per_sim_s']:.4f}, pybullet floor"
+            shape = f" as {tiles} tiles" if tiles > 1 else ""
+            print(f"N={robots}{shape}: {sim:.1f} simulated s ({row['reason']}, {row['ticks']} ticks, {row['rays']} rays,"
+                  f" {row['queries']} radio queries, {row['firings']} firings, {row['bytes']} bytes): petriflow {row['cpu_per_sim_s']:.4f}, pybullet floor"
                   f" {floor:.4f}, numpy {plain:.5f} CPU s per simulated s", flush=True)
     if args.json:
         print(json.dumps(rows, indent=1))

@@ -25,7 +25,8 @@ def _cells(record: Any) -> int:
     meta = getattr(record.world, "meta", {}) or {}
     if "maze" not in meta:
         raise ValueError("the world has no meta.maze: swarm metrics need the maze")
-    return int(meta["maze"]["rows"]) * int(meta["maze"]["cols"])
+    tiles = int((meta.get("tiles") or {}).get("count", 1))  # copies of the maze (their cell ids differ)
+    return int(meta["maze"]["rows"]) * int(meta["maze"]["cols"]) * tiles
 
 
 def _custom(record: Any, name: str):

@@ -23,6 +23,15 @@ cells a robot (``cols`` = ``rows`` = ceil(sqrt(robots x cells_per_robot))), cell
 ``cell`` metres, the robots spread over a lattice of cells, in the kinematic world mode
 (masses none, poses integrated in arrays).
 
+**Tiles** (``tiles`` = k, the same in :func:`build` and :func:`world`): the team cut into
+k equal teams, each in its own copy of the (robots / k)-robot maze, the copies stacked
+north of each other ``gap`` metres apart (beyond the radio's range: no robot hears
+another tile). Every tile runs the same mission as the (robots / k)-robot world, so the
+work is exactly k times one tile's: a control for measuring how the run's cost grows
+with the team when the work per robot does not (a larger single maze has fewer robots
+at its edges, so more neighbours and more map per robot). Cell ids stay unique: every
+robot's map is the whole stack (``rows`` counts the gaps' rows, which no robot enters).
+
 ``python -m petriflow.agents.swarm.nets`` writes ``nets/swarm/`` (the 3-robot net and
 world, the sweep's worlds).
 
@@ -45,7 +54,7 @@ from typing import Any
 from petriflow.net import Net
 from petriflow.netbuild import NetBuilder
 
-__all__ = ["build", "world", "size", "starts", "main"]
+__all__ = ["build", "world", "size", "starts", "tiling", "main"]
 
 #: The robots' body (a differential-drive disc; its masses are dropped in the kinematic mode).
 URDF = "petriflow.agents:robots/diffdrive.urdf"
@@ -66,8 +75,23 @@ def starts(robots: int, cols: int) -> list[tuple[int, int]]:
     return spots[:robots]
 
 
+def tiling(robots: int, tiles: int = 1, cells_per_robot: float = 8.0, cell: float = 1.0,
+           gap: float = 10.0) -> tuple[int, int, int]:
+    """``(robots a tile, cells a side of a tile's maze, rows from one tile's first row to
+    the next's)`` for a team cut into ``tiles`` (see the module)."""
+    if not 1 <= robots <= 100_000:
+        raise ValueError(f"robots must be from 1 to 100,000, got {robots}")
+    if not 1 <= tiles <= robots or robots % tiles:
+        raise ValueError(f"tiles must divide the robots ({robots}) into equal teams, got {tiles}")
+    if not gap >= 0:
+        raise ValueError(f"gap must be at least 0 m, got {gap}")
+    each = robots // tiles
+    side = size(each, cells_per_robot)
+    return each, side, side + math.ceil(gap / cell)
+
+
 def build(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, reach: int = 4,
-          speed: float = 0.5, turn_rate: float = 2.0, **ignored: Any) -> Net:
+          speed: float = 0.5, turn_rate: float = 2.0, tiles: int = 1, gap: float = 10.0, **ignored: Any) -> Net:
     """The mission's net (see the module).
 
     Args:
@@ -77,12 +101,15 @@ def build(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, r
         reach: cells a robot looks ahead for unmapped cells; with none that near, it
             goes home.
         speed, turn_rate: the robots' cruise speed (m/s) and turn rate (rad/s).
+        tiles, gap: the team cut into this many equal teams, each in its own copy of
+            the maze, ``gap`` metres apart (see the module; the world's must match).
         ignored: other sweep parameters (they go elsewhere).
     """
-    if not 1 <= robots <= 100_000:
-        raise ValueError(f"robots must be from 1 to 100,000, got {robots}")
-    side = size(robots, cells_per_robot)
-    b = NetBuilder(f"swarm-{robots}", label=f"a swarm of {robots} robots maps a {side} x {side} maze")
+    _, side, pitch = tiling(robots, tiles, cells_per_robot, cell, gap)
+    rows = pitch * (tiles - 1) + side
+    shape = f"a {side} x {side} maze" if tiles == 1 else f"{tiles} copies of a {side} x {side} maze"
+    b = NetBuilder(f"swarm-{robots}" if tiles == 1 else f"swarm-{robots}-tiles-{tiles}",
+                   label=f"a swarm of {robots} robots maps {shape}")
     for k in range(1, robots + 1):
         name = f"robot{k}"
         a = b.agent(name, label=f"robot {k}", state="swarm.scout")
@@ -90,7 +117,7 @@ def build(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, r
             a.place(local)
         air = a.place("air", channel="swarm", label=f"{name}'s radio")
         move = {"speed": speed, "turn_rate": turn_rate, "air": air}
-        wake = {"air": air, "cols": side, "rows": side, "cell": cell, "origin": [0.0, 0.0], "horizon": 2 * reach}
+        wake = {"air": air, "cols": side, "rows": rows, "cell": cell, "origin": [0.0, 0.0], "horizon": 2 * reach}
         a.transition("wake", action="swarm.wake", params=wake, inputs=["start"], outputs=["idle"])
         a.transition("step", label="one cell of exploration", action="swarm.explore", params=dict(move, reach=reach),
                      inputs=["idle"], outputs=["moved"])
@@ -110,16 +137,24 @@ def build(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, r
 
 
 def world(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, maze_seed: int = MAZE_SEED,
-          dt: float = 0.1) -> dict[str, Any]:
-    """The mission's world (see the module)."""
+          dt: float = 0.1, tiles: int = 1, gap: float = 10.0) -> dict[str, Any]:
+    """The mission's world (see the module); ``meta.maze`` is one tile's maze and, with
+    tiles, ``meta.tiles`` their count and the rows from one to the next."""
     from petriflow.agents.mobile.maze import generate
 
-    side = size(robots, cells_per_robot)
+    each, side, pitch = tiling(robots, tiles, cells_per_robot, cell, gap)
     maze = generate(side, side, seed=maze_seed, cell=cell, loops=LOOPS)
-    bodies = [{"id": f"robot{k + 1}", "urdf": URDF, "position": [round((c + 0.5) * cell, 6), round((r + 0.5) * cell, 6)],
-               "z": 0.0, "colour": ("red", "blue", "green", "orange")[k % 4]}
-              for k, (r, c) in enumerate(starts(robots, side))]
+    lattice = starts(each, side)
+    bodies = [{"id": f"robot{t * each + k + 1}", "urdf": URDF,
+               "position": [round((c + 0.5) * cell, 6), round((t * pitch + r + 0.5) * cell, 6)],
+               "z": 0.0, "colour": ("red", "blue", "green", "orange")[(t * each + k) % 4]}
+              for t in range(tiles) for k, (r, c) in enumerate(lattice)]
     description = maze.world(bodies, dt=dt)
+    if tiles > 1:
+        for t in range(1, tiles):
+            copy = generate(side, side, seed=maze_seed, cell=cell, loops=LOOPS, origin=(0.0, t * pitch * cell))
+            description["boxes"] += [dict(box, id=f"tile{t}_{box['id']}") for box in copy.boxes()]
+        description["meta"]["tiles"] = {"count": tiles, "pitch_rows": pitch}
     description["gravity"] = 0.0
     description["mode"] = "kinematic"
     return description

@@ -120,13 +120,13 @@ def test_two_scouts_end_with_each_others_maps_and_nothing_more_to_say():
     assert not any(a.outbox.values())               # nothing pending: nothing sent again
 
 
-def _mission(robots: int, until: float = 900.0):
+def _mission(robots: int, until: float = 900.0, tiles: int = 1):
     from petriflow.runtime.config import load_config
 
     config = load_config(NETS / "run.yaml")
-    description = world(robots)
+    description = world(robots, tiles=tiles)
     w = World(description, base=NETS)
-    scheduler = Scheduler(build(robots), world=w, config=config, seed=1)
+    scheduler = Scheduler(build(robots, tiles=tiles), world=w, config=config, seed=1)
     events = []
     scheduler.on_event(events.append)
     with scheduler:
@@ -157,6 +157,55 @@ def test_a_small_swarm_maps_its_maze_shares_it_and_goes_home():
         assert sum(len(s.history.sources()) > 1 for s in states.values()) >= 4
     finally:
         w.close()
+
+
+def test_tiles_repeat_one_teams_mission_each_in_its_own_maze():
+    """Two tiles of three robots: each runs the 3-robot mission, its cells shifted north
+    by the tiles' pitch; no frame crosses from one tile to the other."""
+    from petriflow.agents.swarm.metrics import coverage
+    from petriflow.runtime.metrics import RunRecord
+
+    def per_robot(events, kind):
+        out: dict[str, list] = {}
+        for e in events:
+            if e.kind == "custom" and e.data["name"] == kind:
+                out.setdefault(e.agent, []).append(e.data["data"]["cell"])
+            if kind == "sent" and e.kind == "message" and e.data["fate"] == "sent":
+                out.setdefault(e.agent, []).append(e.data["size"])
+        return out
+
+    one, events1, description1, w1, _ = _mission(3)
+    two, events2, description2, w2, scheduler = _mission(6, tiles=2)
+    try:
+        assert one.reason.value == two.reason.value == "final" and two.time == one.time
+        meta = description2["meta"]
+        shift = meta["tiles"]["pitch_rows"] * meta["maze"]["cols"]
+        ids = [b["id"] for b in description2["boxes"]]
+        assert len(ids) == len(set(ids)) == 2 * len(description1["boxes"])
+        sensed1, sensed2 = per_robot(events1, "swarm.sensed"), per_robot(events2, "swarm.sensed")
+        sent1, sent2 = per_robot(events1, "sent"), per_robot(events2, "sent")
+        for k in range(1, 4):
+            first, second = f"robot{k}", f"robot{k + 3}"
+            assert sensed2[first] == sensed1[first] and sent2[first] == sent1[first]
+            assert sensed2[second] == [cell + shift for cell in sensed1[first]] and sent2[second] == sent1[first]
+        states = scheduler.firer.agents.states
+        for name, state in states.items():   # what a robot heard of came from its own tile only
+            tile = (int(name[5:]) - 1) // 3
+            assert {(int(other[5:]) - 1) // 3 for other in state.names.values()} <= {tile}
+        covered = [coverage(RunRecord(events=events, world=w, result=result))
+                   for events, w, result in ((events1, w1, one), (events2, w2, two))]
+        assert covered[0] == covered[1] > 0.9
+    finally:
+        w1.close()
+        w2.close()
+
+
+@pytest.mark.parametrize("robots, tiles", [(10, 3), (10, 0), (4, 8)])
+def test_tiles_that_do_not_cut_the_team_evenly_are_refused(robots, tiles):
+    with pytest.raises(ValueError, match="tiles must divide"):
+        world(robots, tiles=tiles)
+    with pytest.raises(ValueError, match="tiles must divide"):
+        build(robots, tiles=tiles)
 
 
 def test_the_radio_reaches_only_the_robots_in_range():
