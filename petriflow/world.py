@@ -31,7 +31,12 @@ something reads pybullet (a ray test that may hit robots, a camera, :meth:`World
 for code that calls pybullet itself) or for drawing in the GUI, and
 ``stepSimulation`` runs only when a body still has dynamics (a robot with
 ``motion: dynamic``, a box with mass): legged and chain robots keep full dynamics in
-a kinematic world. **Sensors on demand**: :meth:`World.request_rays` records rays an
+a kinematic world. While nothing has read them, the robots' bodies are out of the
+scene's way: at the first ray test that sees the scene only, in a world with nothing
+to step and no GUI, they are **parked**, each on its own spot of a lot far below and
+beside the scene (a ray test walks pybullet's tree of bounding boxes, robots it then
+leaves out included, so bodies near the rays cost every ray), and the first
+:meth:`World.sync` puts them back where the arrays say (after which they stay). **Sensors on demand**: :meth:`World.request_rays` records rays an
 action asks for; the world casts every request of a tick in one ``rayTestBatch`` at
 its next step (or at :meth:`World.flush_sensors`), and the request then holds the hits.
 
@@ -62,6 +67,8 @@ __all__ = ["World", "Camera", "RayRequest", "load_world", "COLOURS", "DRIVES", "
 #: The collision filter group of kinematic robots: ray tests that should see only the
 #: scene (walls, boxes) leave it out of their mask.
 ROBOT_GROUP = 1 << 5
+#: Where parked kinematic robots' bodies start (metres): far below and beside any scene.
+_LOT = (-1.0e4, -1.0e4, -1.0e3)
 #: Rays per ``rayTestBatch`` call (pybullet's own limit is 16,384).
 _RAY_BATCH = 16384
 
@@ -214,6 +221,8 @@ class World:
         self._commanded: dict[int, tuple[float, float, float]] = {}  # dynamic bodies driven by velocity
         self._requests: list[RayRequest] = []
         self._gui = gui
+        self._parked = False                    # kinematic robots' bodies on the lot (see the module)
+        self._stay = description["mode"] != "kinematic" or gui  # robots stay in the scene
         if description["plane"]:
             self.bodies["plane"] = self._load_urdf("pybullet_data:plane.urdf", (0, 0, 0), 0.0, fixed=True)
         for box in description["boxes"]:
@@ -307,8 +316,10 @@ class World:
                 p.changeDynamics(body, link, mass=0.0, physicsClientId=client)
                 p.setCollisionFilterGroupMask(body, link, ROBOT_GROUP, 0xFFFF, physicsClientId=client)
             self._kin[body] = len(self._kin_rows)
+            # pybullet places a body by its base's centre of mass: the base link's frame to it
+            inertial = p.getDynamicsInfo(body, -1, physicsClientId=client)[3:5]
             self._kin_rows.append({"body": body, "x": x, "y": y, "yaw": robot["yaw"], "z": robot["z"],
-                                   "roll": robot["roll"], "pitch": robot["pitch"],
+                                   "roll": robot["roll"], "pitch": robot["pitch"], "inertial": inertial,
                                    "drive": DRIVES.index(robot.get("drive", "diff"))})
         else:
             self._dynamic += 1
@@ -324,6 +335,7 @@ class World:
         self.velocities = np.zeros((len(rows), 3))
         self._z = np.array([r["z"] for r in rows], dtype=float)
         self._tilt = [(r["roll"], r["pitch"]) for r in rows]
+        self._inertial = [r["inertial"] for r in rows]
         self._drive = np.array([r["drive"] for r in rows], dtype=np.int8)
         self._live = np.ones(len(rows), dtype=bool)
         self._moving = np.zeros(len(rows), dtype=bool)
@@ -347,6 +359,8 @@ class World:
         if self._commanded:
             self._apply_commands()
         if self.mode == "dynamic" or self._dynamic:
+            if self._parked:  # a body with mass added since: it meets the robots where they are
+                self.sync()
             self.p.stepSimulation(physicsClientId=self.client)
         if self._gui:
             self.sync()
@@ -440,6 +454,10 @@ class World:
         call it themselves)."""
         import numpy as np
 
+        self._stay = True
+        if self._parked:  # every robot back from the lot
+            self._parked = False
+            self._stale[:] = True
         rows = np.flatnonzero(self._stale & self._live)
         if not len(rows):
             return
@@ -447,9 +465,34 @@ class World:
         for row in rows.tolist():
             x, y, yaw = self.poses[row]
             roll, pitch = self._tilt[row]
-            p.resetBasePositionAndOrientation(self.kinematic_bodies[row], (x, y, self._z[row]),
-                                              p.getQuaternionFromEuler((roll, pitch, yaw)), physicsClientId=client)
+            at, turned = p.multiplyTransforms((x, y, self._z[row]), p.getQuaternionFromEuler((roll, pitch, yaw)),
+                                              *self._inertial[row])
+            p.resetBasePositionAndOrientation(self.kinematic_bodies[row], at, turned, physicsClientId=client)
         self._stale[rows] = False
+
+    def _park(self) -> None:
+        """The kinematic robots' bodies to the lot (see the module), if nothing can
+        need them where they are: no GUI, nothing to step."""
+        import numpy as np
+
+        live = np.flatnonzero(self._live).tolist()
+        if self._dynamic or not live:
+            self._stay = True
+            return
+        p, client = self.p, self.client
+        extent = 1.0
+        for row in live:  # the lot's spots apart by the largest body: parked bodies never overlap
+            body = self.kinematic_bodies[row]
+            for link in range(-1, p.getNumJoints(body, physicsClientId=client)):
+                low, high = p.getAABB(body, link, physicsClientId=client)
+                extent = max(extent, *(b - a for a, b in zip(low, high)))
+        spacing, side = 2.0 * extent, math.ceil(math.sqrt(len(live)))
+        x0, y0, z0 = _LOT
+        for k, row in enumerate(live):
+            p.resetBasePositionAndOrientation(self.kinematic_bodies[row],
+                                              (x0 - spacing * (k % side), y0 - spacing * (k // side), z0),
+                                              (0.0, 0.0, 0.0, 1.0), physicsClientId=client)
+        self._parked = True
 
     # Sensors ------------------------------------------------------------------------
     def rays(self, starts, ends, *, robots: bool = True) -> list[tuple[int, float, tuple[float, float, float]]]:
@@ -458,6 +501,8 @@ class World:
         rays see the scene only, and no pose needs writing back)."""
         if robots:
             self.sync()
+        elif not self._stay and not self._parked:
+            self._park()
         p = self.p
         mask = 0xFFFF & ~ROBOT_GROUP if not robots else 0xFFFF
         out: list[tuple[int, float, tuple[float, float, float]]] = []

@@ -68,7 +68,8 @@ def test_poses_reach_pybullet_only_when_read():
         # a ray that may hit robots writes the poses back first and finds the robot where it is now
         _drive(world, 0.5, 0.0, 20)
         x, y, _ = world.pose("r")
-        hit = world.rays([(x, y + 2.0, 0.5)], [(x, y - 2.0, 0.5)])[0]
+        # (at the body's height: its cylinder spans 0.04 to 0.12 m above the base link's z of 0.5)
+        hit = world.rays([(x, y + 2.0, 0.58)], [(x, y - 2.0, 0.58)])[0]
         assert hit[0] == body
     finally:
         world.close()
@@ -112,6 +113,63 @@ def test_a_batch_of_requested_rays_returns_what_single_rays_return():
         for (body, fraction, _), end in zip(batch, ends):
             hit = p.rayTest((x, y, 0.5), end, physicsClientId=world.client)[0]
             assert body == hit[0] and fraction == pytest.approx(hit[2])
+    finally:
+        world.close()
+
+
+def test_a_robot_written_back_stands_where_it_was_loaded():
+    world = _world("kinematic")         # a body whose centre of mass is 8 cm above its base link
+    try:
+        p, body = world.p, world.body("r")
+        loaded = [p.getAABB(body, link, physicsClientId=world.client) for link in range(-1, 3)]
+        world.set_pose("r", *world.pose("r"))
+        world.sync()
+        for link, (low, high) in zip(range(-1, 3), loaded):
+            now_low, now_high = p.getAABB(body, link, physicsClientId=world.client)
+            assert now_low == pytest.approx(low, abs=1e-6) and now_high == pytest.approx(high, abs=1e-6)
+    finally:
+        world.close()
+
+
+def test_robots_nothing_reads_leave_the_scene_and_come_back_where_they_are_when_read():
+    world = _maze_world()
+    try:
+        p, client = world.p, world.client
+        from petriflow.world import ROBOT_GROUP
+
+        starts, ends = [], []
+        for i in range(8):
+            x, y, _ = world.pose(f"r{i}")
+            starts += [(x, y - 1.0, 0.1), (x - 0.6, y, 0.1)]
+            ends += [(x, y + 1.0, 0.1), (x + 3.0, y, 0.1)]
+        scene = [(h[0], h[2]) for h in p.rayTestBatch(starts, ends, collisionFilterMask=0xFFFF & ~ROBOT_GROUP,
+                                                      physicsClientId=client)]
+        world.command("r3", v=0.5)
+        world.step()
+        assert [(b, f) for b, f, _ in world.rays(starts, ends, robots=False)] == scene
+        x, y, _ = world.pose("r3")
+        parked = p.getBasePositionAndOrientation(world.body("r3"), physicsClientId=client)[0]
+        assert math.dist(parked[:2], (x, y)) > 100.0              # out of the scene's way
+        assert p.rayTest((x, y - 1.0, 0.1), (x, y + 1.0, 0.1), physicsClientId=client)[0][0] != world.body("r3")
+        # a ray that sees robots brings every robot back where the arrays say, for good
+        assert world.rays([(x, y - 1.0, 0.1)], [(x, y + 1.0, 0.1)])[0][0] == world.body("r3")
+        for i in range(8):
+            back = p.getBasePositionAndOrientation(world.body(f"r{i}"), physicsClientId=client)[0]
+            assert back[:2] == pytest.approx(world.pose(f"r{i}")[:2])
+        world.rays(starts, ends, robots=False)
+        assert p.getBasePositionAndOrientation(world.body("r3"), physicsClientId=client)[0][:2] == pytest.approx((x, y))
+    finally:
+        world.close()
+
+
+def test_robots_stay_in_a_world_that_steps_bodies_with_mass():
+    world = World({"dt": 0.05, "mode": "kinematic", "boxes": [{"id": "crate", "size": [0.2, 0.2, 0.2],
+                                                                "position": [3, 0, 0.1], "mass": 1.0}],
+                   "robots": [{"id": "r", "urdf": URDF, "position": [0.5, 0.0], "z": 0.05}]})
+    try:
+        world.rays([(0, 0, 0.1)], [(5, 0, 0.1)], robots=False)
+        where = world.p.getBasePositionAndOrientation(world.body("r"), physicsClientId=world.client)[0]
+        assert where[:2] == pytest.approx((0.5, 0.0))
     finally:
         world.close()
 
