@@ -12,6 +12,11 @@ For each team size, in one run:
   what a world that keeps poses in pybullet pays), then the same rays in the same
   batches (``rayTestBatch``, the wall counts' rounds included). No ``stepSimulation``:
   the bodies are static.
+* **tiles** (``--tile ROBOTS``): each team run as copies of the ROBOTS-robot maze side
+  by side, out of each other's radio range (``petriflow.agents.swarm.nets``, tiles):
+  the work per robot held equal, so the growth of the cost with the team is the
+  runtime's and the world's, not the scenario's (in one larger maze fewer robots stand
+  near its edges, so each has more neighbours and more map).
 * **numpy**: a plain loop over the same ticks integrating the same velocities with the
   same formula on arrays, and the same neighbour queries answered by one distance row
   and the log-distance threshold (free space: no walls, which need the ray tests).
@@ -22,11 +27,14 @@ The table (``--markdown``) is the one in ``nets/swarm/README.md``. CPU time
     python bench/swarm.py                    # 10, 100, 1000 robots (several minutes)
     python bench/swarm.py --robots 10 100 --until 60
     python bench/swarm.py --cores            # does a second core pay? (rays in a thread, a second process)
+    python bench/swarm.py --rays             # what robots standing in the scene cost scene-only rays
+    python bench/swarm.py --robots 100 1000 --tile 100   # 1,000 robots as ten copies of the 100-robot maze
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import math
 import time
@@ -70,19 +78,50 @@ def run_petriflow(robots: int, until: float | None, seed: int = 1, tiles: int = 
         return neighbours(agent)
 
     radio.neighbours = recorded_neighbours
+    collector = {"cpu_s": 0.0, "passes": [0, 0, 0], "started": 0.0}
+
+    def timed(phase: str, info: dict) -> None:  # the cycle collector's passes during the run
+        if phase == "start":
+            collector["started"] = time.process_time()
+        else:
+            collector["cpu_s"] += time.process_time() - collector["started"]
+            collector["passes"][info["generation"]] += 1
+
     with scheduler:
+        gc.callbacks.append(timed)
         cpu = time.process_time()
-        result = scheduler.run(until=until)
-        cpu = time.process_time() - cpu
+        try:
+            result = scheduler.run(until=until)
+        finally:
+            cpu = time.process_time() - cpu
+            gc.callbacks.remove(timed)
     out = {"robots": robots, "tiles": tiles, "sim_s": result.time, "reason": result.reason.value, "cpu_s": cpu,
+           "collector_cpu_s": collector["cpu_s"], "collector_passes": collector["passes"],
            "cpu_per_sim_s": cpu / result.time, "ticks": len(record["poses"]), "firings": result.firings,
            "rays": sum(len(s) for batches in record["rays"].values() for s, _, _ in batches),
            "queries": sum(len(q) for q in record["queries"].values()),
            "bytes": sum(state.sent_bytes for state in scheduler.firer.agents.states.values()
                         if hasattr(state, "sent_bytes"))}
+    out["per_robot"] = _per_robot(scheduler.firer.agents.states.values(), radio.agents, neighbours)
     w.close()
     return out | {"record": record, "description": description, "dt": description["dt"],
                   "model": radio.index(None)}
+
+
+def _per_robot(states, agents: list, neighbours) -> dict:
+    """The scenario's work per robot at the end: what a robot holds and how many it hears."""
+    scouts = [s for s in states if hasattr(s, "history")]
+    if not scouts:
+        return {}
+    n = len(scouts)
+    heard = [len(neighbours(a)) for a in agents if a]  # now, at the end
+    return {"cells known": sum(len(s.sides) for s in scouts) / n,
+            "history items": sum(len(s.history.data) for s in scouts) / n,
+            "sources": sum(len(s.history.sources()) for s in scouts) / n,
+            "history rows": sum(len(s.history.rows) for s in scouts) / n,
+            "items peers hold": sum(len(h) for s in scouts for h in s.history.held.values()) / n,
+            "peers heard so far": sum(len(s.names) for s in scouts) / n,
+            "neighbours now": sum(heard) / max(1, len(heard))}
 
 
 def run_floor(description: dict, record: dict) -> float:
@@ -187,6 +226,41 @@ def measure_cores(robots: int = 1000) -> None:
     w.close()
 
 
+def measure_rays(robots: int = 1000) -> None:
+    """What the robots' bodies cost rays that leave them out: the same scene-only rays
+    (four of one metre and four of about three from every robot's cell) with the
+    robots standing in the scene, parked by the world, and removed."""
+    from petriflow.agents.swarm.nets import world
+    from petriflow.world import ROBOT_GROUP, World
+
+    w = World(world(robots), base=NETS)
+    p, client = w.p, w.client
+    points = w.poses[:, :2].tolist()
+    reach = ((1, 0), (0, 1), (-1, 0), (0, -1), (3, 1), (1, 3), (-3, 2), (2, -3))
+    starts = [(x, y, 0.1) for x, y in points for _ in reach]
+    ends = [(x + dx, y + dy, 0.1) for x, y in points for dx, dy in reach]
+    mask = 0xFFFF & ~ROBOT_GROUP
+
+    def per_ray() -> float:
+        best = math.inf
+        for _ in range(7):
+            cpu = time.process_time()
+            for _ in range(10):
+                p.rayTestBatch(starts, ends, collisionFilterMask=mask, physicsClientId=client)
+            best = min(best, (time.process_time() - cpu) / 10)
+        return best / len(starts) * 1e6
+
+    standing = per_ray()
+    w.rays(starts[:1], ends[:1], robots=False)  # the world parks them
+    parked = per_ray()
+    for body in list(w.kinematic_bodies):
+        p.removeBody(body, physicsClientId=client)
+    removed = per_ray()
+    print(f"{len(starts)} scene-only rays among {robots} robots, µs a ray (best of 7): robots standing"
+          f" {standing:.2f}, parked {parked:.2f}, removed {removed:.2f}")
+    w.close()
+
+
 def _echo(connection) -> None:
     while True:
         message = connection.recv()
@@ -204,9 +278,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--tile", type=int, default=None, metavar="ROBOTS",
                         help="run each team as copies of the ROBOTS-robot maze (the work per robot held equal)")
     parser.add_argument("--cores", action="store_true", help="measure what a second core would give, and stop")
+    parser.add_argument("--rays", action="store_true", help="measure what robots standing in the scene cost rays, and stop")
     args = parser.parse_args(argv)
     if args.cores:
         measure_cores()
+        return
+    if args.rays:
+        for robots in args.robots:
+            measure_rays(robots)
         return
     rows = []
     for robots in args.robots:
@@ -227,6 +306,8 @@ def main(argv: list[str] | None = None) -> None:
             print(f"N={robots}{shape}: {sim:.1f} simulated s ({row['reason']}, {row['ticks']} ticks, {row['rays']} rays,"
                   f" {row['queries']} radio queries, {row['firings']} firings, {row['bytes']} bytes): petriflow {row['cpu_per_sim_s']:.4f}, pybullet floor"
                   f" {floor:.4f}, numpy {plain:.5f} CPU s per simulated s", flush=True)
+            print(f"  collector {row['collector_cpu_s']:.2f} CPU s (passes by generation {row['collector_passes']});"
+                  " per robot at the end: " + ", ".join(f"{k} {v:.1f}" for k, v in row["per_robot"].items()))
     if args.json:
         print(json.dumps(rows, indent=1))
     if args.markdown:

@@ -19,6 +19,17 @@ generation is collected after 2,000 allocations instead of 700: the young and mi
 passes still collect short-lived cycles, and the old generation is still collected,
 less often. The thresholds are set back when the run returns.
 
+What exists when the run starts (the net, its index, the world, the scheduler's
+tables: 160,000 tracked objects for the swarm of 1,000 robots) lives as long as the
+run, so during it those objects are also set aside from the collector's walks
+(``gc.freeze``) and given back when the run returns (``gc.unfreeze``); a run inside a
+run that froze leaves the freezing to the outer one. Over 120 simulated seconds of
+1,000 robots (ten copies of the 100-robot maze) that took the collector's time from
+3.8 s to 2.7 s (two full passes instead of three), and for 100 robots from 0.21 s to
+0.17 s (``python bench/swarm.py --robots 100 1000 --tile 100 --until 120``, its
+``collector`` column; one run each). A cycle that was already garbage when the run
+started is collected after it.
+
 Examples:
     >>> import gc
     >>> with paused():
@@ -54,8 +65,8 @@ def paused() -> Iterator[None]:
 
 @contextlib.contextmanager
 def relaxed() -> Iterator[None]:
-    """Raise the collector's thresholds to at least :data:`RUN_THRESHOLDS` for the block
-    and set them back after (see the module).
+    """Raise the collector's thresholds to at least :data:`RUN_THRESHOLDS` and set aside
+    what exists now from its walks for the block; undo both after (see the module).
 
     Examples:
         >>> import gc
@@ -65,10 +76,20 @@ def relaxed() -> Iterator[None]:
         True
         >>> gc.get_threshold() == before
         True
+        >>> with relaxed():
+        ...     gc.get_freeze_count() > 0
+        True
+        >>> gc.get_freeze_count()
+        0
     """
     before = gc.get_threshold()
     gc.set_threshold(*(max(now, least) for now, least in zip(before, RUN_THRESHOLDS)))
+    freeze = gc.get_freeze_count() == 0
+    if freeze:
+        gc.freeze()
     try:
         yield
     finally:
+        if freeze:
+            gc.unfreeze()
         gc.set_threshold(*before)
