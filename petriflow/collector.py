@@ -24,11 +24,12 @@ tables: 160,000 tracked objects for the swarm of 1,000 robots) lives as long as 
 run, so during it those objects are also set aside from the collector's walks
 (``gc.freeze``) and given back when the run returns (``gc.unfreeze``); a run inside a
 run that froze leaves the freezing to the outer one. Over 120 simulated seconds of
-1,000 robots (ten copies of the 100-robot maze) that took the collector's time from
-3.8 s to 2.7 s (two full passes instead of three), and for 100 robots from 0.21 s to
-0.17 s (``python bench/swarm.py --robots 100 1000 --tile 100 --until 120``, its
-``collector`` column; one run each). A cycle that was already garbage when the run
-started is collected after it.
+1,000 robots (ten copies of the 100-robot maze) the collector took 2.8 to 3.1 s in
+four runs with it (two full passes), 5.3 s in one run without (three full passes; the
+machine was busier then) (``python bench/swarm.py --robots 100 1000 --tile 100 --until
+120``, its ``collector`` line); timed the same way around one run each, 3.8 s without
+and 2.7 s with. A cycle that was already garbage when the run started is collected
+after it.
 
 Examples:
     >>> import gc
