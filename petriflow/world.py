@@ -36,9 +36,11 @@ scene's way: at the first ray test that sees the scene only, in a world with not
 to step and no GUI, they are **parked**, each on its own spot of a lot far below and
 beside the scene (a ray test walks pybullet's tree of bounding boxes, robots it then
 leaves out included, so bodies near the rays cost every ray), and the first
-:meth:`World.sync` puts them back where the arrays say (after which they stay). **Sensors on demand**: :meth:`World.request_rays` records rays an
-action asks for; the world casts every request of a tick in one ``rayTestBatch`` at
-its next step (or at :meth:`World.flush_sensors`), and the request then holds the hits.
+:meth:`World.sync` puts them back where the arrays say (after which they stay).
+
+**Sensors on demand**: :meth:`World.request_rays` records rays an action asks for; the
+world casts every request of a tick in one ``rayTestBatch`` at its next step (or at
+:meth:`World.flush_sensors`), and the request then holds the hits.
 
 A ``urdf`` is a path relative to the description file, or ``"package:path"`` naming a
 file shipped inside an installed Python package (``pybullet_data:r2d2.urdf``). It is
