@@ -143,10 +143,9 @@ class ActionRunner:
         firing.ctx = firing.cancelling = None
         firing.inputs = inputs
         firing.started = now
-        firing.wake = tick
         firing.running = True
         self.running[t] = firing
-        kernel.schedule_poll(tick, firing, number)
+        self._wake(firing, tick)
 
     def start(self, t: int, number: int, ctx: ActionContext) -> None:
         """Start firing ``number`` of transition ``t`` (its inputs are consumed)."""
@@ -202,12 +201,10 @@ class ActionRunner:
         ctx, action = firing.ctx, firing.action
         if ctx is None:  # a delay's firing: its time has come, or it is cancelled
             if firing.cancelling is None:
-                t = firing.index
-                firing.running = False  # _stop, inline
-                del self.running[t]
-                self.enabled.dirty.add(t)
+                self._stop(firing)
                 inputs = firing.inputs
-                self.finish(firing.number, t, None, Outcome.OK, None if inputs is None else first_data(inputs))
+                self.finish(firing.number, firing.index, None, Outcome.OK,
+                            None if inputs is None else first_data(inputs))
                 return
             ctx = firing.ctx = self.contexts(firing.index, firing.number, firing.inputs, firing.started)
         ctx.now = now = tick * kernel.dt
