@@ -171,6 +171,17 @@ def run_numpy(record: dict, dt: float, model) -> float:
     return time.process_time() - cpu
 
 
+#: The four one-metre sensing rays of a robot (east, north, west, south).
+_SENSING = ((1, 0), (0, 1), (-1, 0), (0, -1))
+
+
+def _fan(points, offsets, z: float = 0.1) -> tuple[list, list]:
+    """Ray starts and ends: from every point, one ray to each ``(dx, dy)`` offset."""
+    starts = [(x, y, z) for x, y in points for _ in offsets]
+    ends = [(x + dx, y + dy, z) for x, y in points for dx, dy in offsets]
+    return starts, ends
+
+
 def measure_cores(robots: int = 1000) -> None:
     """What using the second core would give the world's work: rays cast with pybullet's
     own threads, rays in a Python thread beside the firing (does pybullet release the
@@ -184,8 +195,7 @@ def measure_cores(robots: int = 1000) -> None:
     w = World(world(robots), base=NETS)
     p = w.p
     points = w.poses[:, :2].tolist()
-    starts = [(x, y, 0.1) for x, y in points for _ in range(4)]
-    ends = [(x + dx, y + dy, 0.1) for x, y in points for dx, dy in ((1, 0), (0, 1), (-1, 0), (0, -1))]
+    starts, ends = _fan(points, _SENSING)
     mask = 0xFFFF & ~ROBOT_GROUP
     for threads in (1, 2):
         cpu = time.process_time()
@@ -237,9 +247,7 @@ def measure_rays(robots: int = 1000) -> None:
     w = World(world(robots), base=NETS)
     p, client = w.p, w.client
     points = w.poses[:, :2].tolist()
-    reach = ((1, 0), (0, 1), (-1, 0), (0, -1), (3, 1), (1, 3), (-3, 2), (2, -3))
-    starts = [(x, y, 0.1) for x, y in points for _ in reach]
-    ends = [(x + dx, y + dy, 0.1) for x, y in points for dx, dy in reach]
+    starts, ends = _fan(points, _SENSING + ((3, 1), (1, 3), (-3, 2), (2, -3)))
     mask = 0xFFFF & ~ROBOT_GROUP
 
     def per_ray() -> float:
