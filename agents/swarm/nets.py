@@ -151,9 +151,10 @@ def world(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, m
               for t in range(tiles) for k, (r, c) in enumerate(lattice)]
     description = maze.world(bodies, dt=dt)
     if tiles > 1:
-        for t in range(1, tiles):
-            copy = generate(side, side, seed=maze_seed, cell=cell, loops=LOOPS, origin=(0.0, t * pitch * cell))
-            description["boxes"] += [dict(box, id=f"tile{t}_{box['id']}") for box in copy.boxes()]
+        walls = description["boxes"]
+        description["boxes"] = walls + [dict(box, id=f"tile{t}_{box['id']}",
+                                             position=[x, y + t * pitch * cell, z])
+                                        for t in range(1, tiles) for box in walls for x, y, z in [box["position"]]]
         description["meta"]["tiles"] = {"count": tiles, "pitch_rows": pitch}
     description["gravity"] = 0.0
     description["mode"] = "kinematic"
