@@ -11,6 +11,7 @@ import argparse
 import json
 import os
 import re
+import shutil
 import sys
 import warnings
 from typing import Any, Sequence
@@ -273,25 +274,34 @@ def cmd_run(args: argparse.Namespace) -> int:
     from petriflow.runtime.session import resume, run_files
     from petriflow.view.command import run_view_finish, run_view_start
 
+    if args.resume and args.db is None:
+        raise PetriflowError("--resume needs --db RUN_DB (the journal of the run to continue)")
+    if args.resume and args.net is not None and not os.path.lexists(args.db):
+        # killed before its journal was made: nothing happened yet, so it starts over
+        print(f"petriflow: note: {args.db}: no journal (the run was stopped before it began);"
+              f" running {args.net} from its beginning", file=sys.stderr)
+        args.resume = False
     made_up_trace = run_view_start(args)  # --view: a trace (and poses) for the page
-
-    if args.resume:
-        if args.db is None:
-            raise PetriflowError("--resume needs --db RUN_DB (the journal of the run to continue)")
-        outcome = resume(args.db, trace=args.trace, xes=args.xes, realtime=args.realtime,
-                         gui=args.gui, progress=_progress(args))
-    else:
-        if args.net is None:
-            raise PetriflowError("give the net to run (or --resume --db RUN_DB)")
-        if args.until is not None:
-            limits.check_seconds(args.until, "--until")
-        if args.max_firings is not None and args.max_firings < 0:
-            raise PetriflowError(f"--max-firings must be >= 0, got {args.max_firings}")
-        outcome = run_files(args.net, world=args.world, config=args.config, seed=args.seed,
-                            until=args.until, trace=args.trace, xes=args.xes, db=args.db, poses=args.poses,
-                            realtime=args.realtime, gui=args.gui, progress=_progress(args),
-                            max_firings=args.max_firings, metrics=_metric_names(args.metrics),
-                            picture=args.picture)
+    try:
+        if args.resume:
+            outcome = resume(args.db, trace=args.trace, xes=args.xes, realtime=args.realtime,
+                             gui=args.gui, progress=_progress(args), picture=args.picture)
+        else:
+            if args.net is None:
+                raise PetriflowError("give the net to run (or --resume --db RUN_DB)")
+            if args.until is not None:
+                limits.check_seconds(args.until, "--until")
+            if args.max_firings is not None and args.max_firings < 0:
+                raise PetriflowError(f"--max-firings must be >= 0, got {args.max_firings}")
+            outcome = run_files(args.net, world=args.world, config=args.config, seed=args.seed,
+                                until=args.until, trace=args.trace, xes=args.xes, db=args.db, poses=args.poses,
+                                realtime=args.realtime, gui=args.gui, progress=_progress(args),
+                                max_firings=args.max_firings, metrics=_metric_names(args.metrics),
+                                picture=args.picture)
+    except BaseException:
+        if made_up_trace is not None:  # the page's made-up trace, in a folder of its own
+            shutil.rmtree(made_up_trace.parent, ignore_errors=True)
+        raise
     run_view_finish(args, outcome, made_up_trace)
     result = outcome.result
     summary = {
@@ -481,7 +491,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--trace", help="write the events as JSON Lines")
     run.add_argument("--xes", help="write the firings as an XES event log")
     run.add_argument("--db", help="SQLite run journal (new file; or the one to --resume)")
-    run.add_argument("--resume", action="store_true", help="continue the killed run journaled in --db")
+    run.add_argument("--resume", action="store_true",
+                     help="continue the killed run journaled in --db (with NET given and no journal there yet:"
+                     " start the run from its beginning, saying so)")
     run.add_argument("--realtime", action="store_true", help="pace simulated time to the wall clock")
     run.add_argument("--gui", action="store_true", help="open pybullet's GUI (needs a display)")
     from petriflow.view.command import add_parser as add_view, add_run_options

@@ -2,36 +2,186 @@
 
 from __future__ import annotations
 
+import glob
 import os
 import tempfile
+import time
 from pathlib import Path
 from typing import Any
 
+try:  # POSIX: a writer holds a lock on its temporary file for as long as it lives
+    import fcntl
+except ImportError:  # pragma: no cover - Windows
+    fcntl = None
+
 from petriflow import limits
 
-__all__ = ["write_atomic", "read_yaml_file", "parse_json", "decode_text", "read_text_file"]
+__all__ = ["PartialFile", "write_atomic", "remove_stale", "read_yaml_file", "parse_json", "decode_text",
+           "read_text_file"]
+
+
+class PartialFile:
+    """An output file written under a temporary name in its target folder and renamed into
+    place when finished: an existing file of that name is never half-overwritten, and two
+    writers never share a temporary file.
+
+    The temporary name is ``.NAME.<pid>-<random>.partial<suffix>`` (the target's suffix
+    kept, for writers that choose a format by it), and the writer holds an exclusive
+    ``flock`` on it while it lives. A writer that was killed holds no lock any more (the
+    kernel drops it with the process, before its parent has even reaped it), so its
+    temporary files are recognised and removed by the next writer of the same target: at
+    its start and when it finishes (:func:`remove_stale`).
+
+    Args:
+        path: the target file.
+        binary: open :attr:`file` for bytes rather than UTF-8 text.
+        opened: open :attr:`file` at all; with ``False`` the caller writes
+            :attr:`temporary` by its name (a picture library, SQLite), and the lock is held
+            all the same.
+
+    Examples:
+        >>> import tempfile
+        >>> folder = Path(tempfile.mkdtemp())
+        >>> out = PartialFile(folder / "a.txt")
+        >>> _ = out.file.write("done")
+        >>> out.finish()
+        >>> (folder / "a.txt").read_text(), sorted(p.name for p in folder.iterdir())
+        ('done', ['a.txt'])
+    """
+
+    def __init__(self, path: str | Path, *, binary: bool = False, opened: bool = True) -> None:
+        self.path = Path(path)
+        remove_stale(self.path)
+        fd, name = tempfile.mkstemp(prefix=f".{self.path.name}.{os.getpid()}-", suffix=f".partial{self.path.suffix}",
+                                    dir=self.path.parent if str(self.path.parent) else ".")
+        self.temporary = Path(name)
+        if fcntl is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX)  # a new file of ours: never waits
+        self._fd: int | None = fd
+        self.file: Any = None
+        if opened:
+            self.file = os.fdopen(os.dup(fd), "wb" if binary else "w",
+                                  **({} if binary else {"encoding": "utf-8"}))
+
+    def finish(self, keep: bool = True) -> None:
+        """Close the file and rename it into place (an ordinary file's mode, not
+        ``mkstemp``'s 0600), or drop it when ``keep`` is false."""
+        try:
+            if self.file is not None:
+                self.file.close()
+            if not keep:
+                self.temporary.unlink(missing_ok=True)
+                return
+            os.chmod(self.temporary, 0o666 & ~_umask())
+            os.replace(self.temporary, self.path)
+        finally:
+            self.release()
+        remove_stale(self.path)
+
+    def link(self) -> None:
+        """Put the finished file in place only if nothing is there yet (``FileExistsError``
+        otherwise), keeping the lock: the target is the same file, so a caller that goes on
+        writing it by its name (a database) still holds it against other writers."""
+        if self.file is not None:
+            self.file.close()
+            self.file = None
+        os.chmod(self.temporary, 0o666 & ~_umask())
+        os.link(self.temporary, self.path)
+        self.temporary.unlink()
+
+    def release(self) -> None:
+        """Stop holding the lock (its descriptor closed)."""
+        if self._fd is not None:
+            os.close(self._fd)
+            self._fd = None
+
+    def detach(self) -> int:
+        """The descriptor holding the lock, now the caller's to close (after :meth:`link`:
+        the lock of the file in place)."""
+        fd, self._fd = self._fd, None
+        assert fd is not None
+        return fd
+
+
+def remove_stale(path: str | Path) -> None:
+    """Remove the temporary files of ``path`` (:class:`PartialFile`'s, and the files a
+    library made beside them, such as SQLite's ``-wal``) whose writer is gone: nothing
+    holds their lock, and the process their name carries is not running on this machine
+    (gone, or a zombie not yet reaped), or they were untouched for a minute (a name
+    without a process id, or a process id now reused)."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    now = time.time()
+    for stale in folder.glob(f".{glob.escape(path.name)}.*.partial*"):
+        writer = stale.name[len(path.name) + 2:].split("-", 1)[0]
+        try:
+            if path.exists() and os.path.samefile(stale, path):  # linked into place, not yet unlinked
+                stale.unlink()
+                continue
+            fd = os.open(stale, os.O_RDONLY)
+        except OSError:  # gone already, or not ours to read
+            continue
+        try:
+            gone = not (writer.isdigit() and _running(int(writer)))
+            if fcntl is not None and not _lock(fd, wait=2.0 if gone else 0.0):
+                continue  # its writer lives
+            if gone or os.fstat(fd).st_mtime < now - 60:
+                stale.unlink(missing_ok=True)
+        except OSError:
+            pass
+        finally:
+            os.close(fd)
+
+
+def _lock(fd: int, wait: float) -> bool:
+    """Take the lock of ``fd`` if it is free within ``wait`` seconds. A killed process's
+    main thread turns zombie before its other threads have exited, and its files (with
+    their locks) go with the last one: a writer seen dead gets a moment to let go."""
+    deadline = time.monotonic() + wait
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return True
+        except OSError:
+            if time.monotonic() >= deadline:
+                return False
+            time.sleep(0.01)
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` runs on this machine (a zombie, dead but not yet reaped by its
+    parent, does not)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return True
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as stat:
+            state = stat.read().rsplit(b")", 1)[1].split()[0]
+        return state not in (b"Z", b"X")
+    except (OSError, IndexError):
+        return True
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file and an atomic rename.
+    """Write ``data`` to ``path`` through a :class:`PartialFile` (a temporary file and an
+    atomic rename).
 
     If anything fails before the rename, ``path`` keeps its old content (or stays
-    absent) and the temporary file is removed.
+    absent) and the temporary file is removed; one left by a killed writer is removed by
+    the next write of ``path``.
     """
-    path = Path(path)
-    mode = "wb" if isinstance(data, bytes) else "w"
-    fd, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent or ".")
+    out = PartialFile(path, binary=isinstance(data, bytes))
     try:
-        with os.fdopen(fd, mode, **({} if isinstance(data, bytes) else {"encoding": "utf-8"})) as out:
-            out.write(data)
-        os.chmod(temporary, 0o666 & ~_umask())  # an ordinary file's mode, not mkstemp's 0600
-        os.replace(temporary, path)
+        out.file.write(data)
     except BaseException:
-        try:
-            os.unlink(temporary)
-        except FileNotFoundError:
-            pass
+        out.finish(keep=False)
         raise
+    out.finish()
 
 
 #: Byte-order marks, longest first (UTF-32's little-endian mark starts with UTF-16's).

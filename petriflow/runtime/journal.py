@@ -27,7 +27,7 @@ except ImportError:  # pragma: no cover - Windows
     fcntl = None
 
 from petriflow.errors import PetriflowError
-from petriflow.io.files import parse_json
+from petriflow.io.files import PartialFile, parse_json, remove_stale
 from petriflow.runtime.trace import Event
 
 __all__ = ["Journal", "JournalError", "ResumeMismatch"]
@@ -134,24 +134,10 @@ class Journal:
     def __init__(self, path: str | Path, inputs: dict[str, Any] | None = None) -> None:
         self.path = Path(path)
         resuming = inputs is None
-        if resuming and not self.path.is_file():
-            raise JournalError(f"{self.path}: no such journal")
-        try:
-            if resuming:
-                self._lock = os.open(self.path, os.O_RDWR)
-            else:  # created here and now, or refused: two runs never share a new journal
-                self._lock = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o666)
-        except FileExistsError:
-            raise JournalError(f"{self.path}: already exists; use --resume to continue it or pick a new file") \
-                from None
-        except OSError as exc:
-            raise JournalError(f"{self.path}: cannot open: {exc.strerror or exc}") from None
-        if fcntl is not None:
-            try:
-                fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                os.close(self._lock)
-                raise JournalError(f"{self.path}: in use by another run (one writer at a time)") from None
+        if resuming:
+            self._open_existing()
+        else:
+            self._create(inputs)
         try:
             self._db = sqlite3.connect(str(self.path), isolation_level=None)
             self._db.execute("PRAGMA journal_mode=WAL")
@@ -177,13 +163,58 @@ class Journal:
             self.inputs = inputs
             self.finished = False
             self.journaled = 0
-            with self._db:
-                self._db.execute("BEGIN")
-                self._db.execute("INSERT INTO run VALUES ('inputs', ?)", (json.dumps(inputs, sort_keys=True),))
         # Re-executed events are checked against the journal in chunks read on demand,
         # so neither a new run nor a resumed one holds the whole journal in memory.
         self._chunk: list[str] = []
         self._chunk_start = 0
+
+    def _open_existing(self) -> None:
+        """Open a journal to resume, holding its lock (one writer at a time)."""
+        if not self.path.is_file():
+            raise JournalError(f"{self.path}: no such journal")
+        try:
+            self._lock = os.open(self.path, os.O_RDWR)
+        except OSError as exc:
+            raise JournalError(f"{self.path}: cannot open: {exc.strerror or exc}") from None
+        if fcntl is not None:
+            try:
+                fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                self._release()
+                raise JournalError(f"{self.path}: in use by another run (one writer at a time)") from None
+        remove_stale(self.path)  # a creation killed between putting the journal in place and tidying up
+
+    def _create(self, inputs: dict[str, Any]) -> None:
+        """Make a new journal whole or not at all: its schema and the run's inputs are
+        written to a temporary file beside it, which is then linked into place only if no
+        file of that name exists (two runs never share a new journal). A kill at any
+        moment leaves either no journal or one that can be resumed; a killed creation's
+        temporary file is removed by the next run that writes this journal."""
+        if self.path.exists():
+            raise JournalError(f"{self.path}: already exists; use --resume to continue it or pick a new file")
+        try:
+            partial = PartialFile(self.path, opened=False)
+        except OSError as exc:
+            raise JournalError(f"{self.path}: cannot create: {exc.strerror or exc}") from None
+        try:
+            db = sqlite3.connect(str(partial.temporary), isolation_level=None)
+            try:
+                db.execute("PRAGMA journal_mode=WAL")
+                db.executescript(_SCHEMA)
+                with db:
+                    db.execute("BEGIN")
+                    db.execute("INSERT INTO run VALUES ('inputs', ?)", (json.dumps(inputs, sort_keys=True),))
+            finally:
+                db.close()
+            partial.link()
+        except FileExistsError:
+            partial.finish(keep=False)
+            raise JournalError(f"{self.path}: already exists; use --resume to continue it or pick a new file") \
+                from None
+        except (OSError, sqlite3.Error) as exc:
+            partial.finish(keep=False)
+            raise JournalError(f"{self.path}: cannot create: {getattr(exc, 'strerror', None) or exc}") from None
+        self._lock = partial.detach()  # the lock of the journal now in place
 
     def events(self) -> list[Event]:
         """The events in the journal (committed ones only)."""

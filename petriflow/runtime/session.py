@@ -34,6 +34,7 @@ Examples:
 from __future__ import annotations
 
 import sys
+import warnings
 import time as wallclock
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -289,8 +290,8 @@ def _can_create_in(folder: Path) -> bool:
     superuser, nor on read-only or pseudo file systems such as /proc)."""
     import tempfile
 
-    try:
-        with tempfile.NamedTemporaryFile(dir=folder, prefix=".petriflow-", suffix=".probe"):
+    try:  # nameless where the system allows (O_TMPFILE): a kill here leaves nothing behind
+        with tempfile.TemporaryFile(dir=folder, prefix=".petriflow-", suffix=".probe"):
             return True
     except OSError:
         return False
@@ -482,25 +483,31 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
 
 def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path | None = None,
            realtime: bool = False, gui: bool = False, registry: Registry | None = None,
-           progress: bool | float = False) -> RunOutcome:
+           progress: bool | float = False, picture: str | Path | None = None) -> RunOutcome:
     """Continue the run journaled in ``db`` after a kill.
 
     The run is re-executed from its journaled inputs (the firing limit and the trace and
     XES files it was started with included); every event up to the journal's end must
     come out identical (else :class:`~petriflow.runtime.journal.ResumeMismatch`), and
     only later events are appended. The trace written is the whole run's; ``trace``
-    and ``xes`` write it elsewhere.
+    and ``xes`` write it elsewhere; ``picture`` draws the world's top view at the end,
+    as :func:`run_files` does. A run whose end is journaled already (killed while it
+    wrote its outputs) is re-executed all the same, with a warning, so that a resume
+    after a kill at any moment leaves the outputs of an uninterrupted run.
     """
     journal = Journal(db)
     try:
-        if journal.finished:
-            raise JournalError(f"{db}: the run already finished ({journal.journaled} events)")
+        if journal.finished:  # killed after its end was journaled, before it was done with its outputs
+            warnings.warn(f"{db}: the run already finished ({journal.journaled} events); re-executing it,"
+                          " checked against the journal, to write its outputs", stacklevel=2)
         inputs = journal.inputs
         started_with = inputs.get("outputs") if isinstance(inputs.get("outputs"), dict) else {}
         trace = trace if trace is not None else started_with.get("trace")
         xes = xes if xes is not None else started_with.get("xes")
-        _check_outputs({"--trace": trace, "--xes": xes, "--db": db}, [])
-        _make_folders(trace, xes)
+        if picture is not None and inputs.get("world_text") is None:
+            raise NetFormatError("--picture draws the run's world, and this run has none", path=str(db))
+        _check_outputs({"--trace": trace, "--xes": xes, "--db": db, "--picture": picture}, [])
+        _make_folders(trace, xes, picture)
         net = _net_from_text(inputs["net_text"], inputs["net_file"])
         try:
             config = RunConfig.from_dict(inputs["config"])
@@ -511,7 +518,7 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
         return _execute(net, binding, config, inputs, journal=journal,
                         trace=None if trace is None else Path(trace), xes=None if xes is None else Path(xes),
                         realtime=realtime, gui=gui, progress=progress, max_firings=inputs.get("max_firings"),
-                        extras=extras_for(config, registry=binding.registry))
+                        extras=extras_for(config, registry=binding.registry, picture=picture))
     finally:
         journal.close()
 

@@ -11,7 +11,6 @@ top view at the end (:func:`petriflow.picture.draw_run`).
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -64,17 +63,20 @@ class RunExtras:
             from petriflow.picture import draw_run
 
             self.track.sample(scheduler.world, scheduler.now)
-            partial = self.picture.with_name(f".{self.picture.name}.{os.getpid()}.partial{self.picture.suffix}")
+            from petriflow.io.files import PartialFile
+
             try:
-                draw_run(scheduler.world, self.track.paths, partial,
-                         title=f"{outcome.net.id}: {outcome.result.reason} at t = {outcome.result.time:g} s")
-                os.replace(partial, self.picture)
+                partial = PartialFile(self.picture, opened=False)
+                try:
+                    draw_run(scheduler.world, self.track.paths, partial.temporary,
+                             title=f"{outcome.net.id}: {outcome.result.reason} at t = {outcome.result.time:g} s")
+                except BaseException:
+                    partial.finish(keep=False)
+                    raise
+                partial.finish()
             except OSError as exc:
                 raise NetFormatError(f"cannot write the picture: {getattr(exc, 'strerror', None) or exc}",
                                      path=str(self.picture)) from None
-            finally:
-                if partial.exists():
-                    partial.unlink()
             outcome.written.append(str(self.picture))
 
 

@@ -14,13 +14,9 @@ compare bit for bit between runs and processes.
 
 from __future__ import annotations
 
-import glob
 import hashlib
 import json
 import math
-import os
-import tempfile
-import time
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +24,7 @@ from typing import Any, Iterable
 from xml.sax.saxutils import quoteattr
 
 from petriflow.errors import NetFormatError
+from petriflow.io.files import PartialFile
 from petriflow.outcome import Name, Outcome
 
 __all__ = ["Event", "EventKind", "summarize", "TraceWriter", "XesWriter", "read_trace", "write_xes",
@@ -153,67 +150,6 @@ def _sha1(data: str | bytes) -> str:
     return hashlib.sha1(data).hexdigest()[:12]
 
 
-class _PartialFile:
-    """A text file written under a unique temporary name in its target folder and
-    renamed into place when finished: an existing file of that name is never
-    half-overwritten, and two writers never share a temporary file.
-
-    The temporary name carries the writer's process id
-    (``.NAME.<pid>-<random>.partial``), so the temporary files of writers that were
-    killed are recognised and removed by the next writer of the same file: at its start
-    (a resume that fails leaves nothing behind either) and when it finishes.
-    """
-
-    def __init__(self, path: str | Path) -> None:
-        self.path = Path(path)
-        self._started = time.time()
-        _remove_stale(self.path, self._started)
-        fd, self._partial = tempfile.mkstemp(prefix=f".{self.path.name}.{os.getpid()}-", suffix=".partial",
-                                             dir=self.path.parent if str(self.path.parent) else ".")
-        self.file = os.fdopen(fd, "w", encoding="utf-8")
-
-    def finish(self, keep: bool = True) -> None:
-        """Close the file and rename it into place (ordinary file mode), or drop it."""
-        self.file.close()
-        if not keep:
-            os.unlink(self._partial)
-            return
-        os.chmod(self._partial, 0o666 & ~_umask())
-        os.replace(self._partial, self.path)
-        _remove_stale(self.path, self._started)
-
-
-def _remove_stale(path: Path, started: float) -> None:
-    """Remove the temporary files of ``path`` whose writer is gone: its process no longer
-    exists, or (a name without a process id, or a process on another machine sharing
-    the folder) the file was untouched for a minute before ``started``."""
-    for stale in path.parent.glob(f".{glob.escape(path.name)}.*.partial"):
-        writer = stale.name[len(path.name) + 2:].split("-", 1)[0]
-        try:
-            if writer.isdigit() and int(writer) != os.getpid() and not _alive(int(writer)):
-                stale.unlink()
-            elif stale.stat().st_mtime < started - 60:
-                stale.unlink()
-        except OSError:  # gone already, or not ours to remove
-            pass
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError, ValueError):
-        return True
-    return True
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 class TraceWriter:
     """Writes events to a JSON Lines file as they happen (an observer).
 
@@ -224,7 +160,7 @@ class TraceWriter:
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
-        self._out = _PartialFile(path)
+        self._out = PartialFile(path)
         self._write = self._out.file.write
 
     def __call__(self, event: Event) -> None:
@@ -351,7 +287,7 @@ class XesWriter:
         self.silent = set(silent)
         self.case = case
         self.count = 0
-        self._out = _PartialFile(path)
+        self._out = PartialFile(path)
         self._file = self._out.file
         self._file.write("\n".join(_XES_HEAD) + "\n")
         self._file.write(f'  <date key="petriflow:epoch" value="{XES_EPOCH}"/>\n')

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import sqlite3
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -51,23 +52,26 @@ class Store:
     def __init__(self, path: str | Path | None) -> None:
         self.path = None if path is None else Path(path)
         self.db: sqlite3.Connection | None = None
+        self._noted = False
 
     def _refuse(self, resume: bool) -> bool:
-        """Whether the database exists; refuses one that exists without ``resume``, is
-        missing with it, or is a folder."""
+        """Whether the database exists; refuses one that exists without ``resume``, or a
+        folder (one missing with ``resume`` is made, with a warning)."""
         where = str(self.path)
         exists = self.path.exists()
         if exists and not resume:
             raise StoreError(f"{where}: already exists; use --resume to finish that sweep, or another --db")
-        if not exists and resume:
-            raise StoreError(f"{where}: no such results database to resume")
+        if not exists and resume and not self._noted:  # killed before it was made: nothing to keep
+            warnings.warn(f"{where}: no results database yet (the sweep was stopped before it began);"
+                          " running the sweep from its beginning", stacklevel=3)
+            self._noted = True
         if self.path.is_dir():
             raise NetFormatError("--db names a folder, not a file", path=where)
         return exists
 
     def check(self, meta: dict[str, str], resume: bool) -> None:
-        """Refuse early, creating nothing: ``path`` exists without ``resume``, is
-        missing with it, or holds another sweep (see :meth:`begin`)."""
+        """Refuse early, creating nothing: ``path`` exists without ``resume``, or holds
+        another sweep (see :meth:`begin`)."""
         if self.path is None:
             return
         if self._refuse(resume):
@@ -92,18 +96,15 @@ class Store:
         where, exists = str(self.path), self._refuse(resume)
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
+            if not exists:
+                self._create(meta)
             self.db = sqlite3.connect(where, timeout=5.0, isolation_level=None)
-            if exists:
-                known = dict(self.db.execute("SELECT key, value FROM sweep").fetchall())
-                if known.get("format") != FORMAT:
-                    raise StoreError(f"{where}: not a petriflow sweep results database")
-                if known.get("digest") != meta["digest"]:
-                    raise StoreError(f"{where}: {_changed(known, meta)}")
-                self.db.execute("SELECT row, params, seed, status, outcome, metrics, wall, error FROM trials LIMIT 1")
-            else:
-                self.db.execute("PRAGMA journal_mode=WAL")
-                self.db.executescript(_SCHEMA)
-                self._meta({"format": FORMAT, **meta})
+            known = dict(self.db.execute("SELECT key, value FROM sweep").fetchall())
+            if known.get("format") != FORMAT:
+                raise StoreError(f"{where}: not a petriflow sweep results database")
+            if known.get("digest") != meta["digest"]:
+                raise StoreError(f"{where}: {_changed(known, meta)}")
+            self.db.execute("SELECT row, params, seed, status, outcome, metrics, wall, error FROM trials LIMIT 1")
         except sqlite3.Error as exc:
             self.close()
             raise StoreError(f"{where}: not a petriflow sweep results database ({exc})") from None
@@ -113,6 +114,34 @@ class Store:
         except StoreError:
             self.close()
             raise
+
+    def _create(self, meta: dict[str, str]) -> None:
+        """Make the database whole or not at all: its tables and what it says it is are
+        written to a temporary file beside it, linked into place only if nothing of that
+        name exists, so a kill at any moment leaves no database or one that resumes."""
+        from petriflow.io.files import PartialFile
+
+        assert self.path is not None
+        partial = PartialFile(self.path, opened=False)
+        try:
+            db = sqlite3.connect(str(partial.temporary), isolation_level=None)
+            try:
+                db.execute("PRAGMA journal_mode=WAL")
+                db.executescript(_SCHEMA)
+                with db:
+                    db.executemany("INSERT OR REPLACE INTO sweep VALUES (?, ?)",
+                                   sorted({"format": FORMAT, **meta}.items()))
+            finally:
+                db.close()
+            partial.link()
+        except FileExistsError:
+            partial.finish(keep=False)
+            raise StoreError(f"{self.path}: already exists; use --resume to finish that sweep, or another --db") \
+                from None
+        except BaseException:
+            partial.finish(keep=False)
+            raise
+        partial.release()
 
     def _meta(self, meta: dict[str, str]) -> None:
         assert self.db is not None

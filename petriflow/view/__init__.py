@@ -25,7 +25,7 @@ SWEEP_SUFFIXES = (".db", ".sqlite", ".sqlite3")
 
 
 def view(source: str | Path, *, net: str | Path | None = None, out: str | Path | None = None,
-         sweep: str | Path | None = None, max_mb: float | None = None) -> Path:
+         sweep: str | Path | None = None, max_mb: float | None = None, trace_name: str | None = "") -> Path:
     """Write the page of a run's trace (``.jsonl``) or of a sweep's results (``.db``).
 
     Args:
@@ -41,6 +41,8 @@ def view(source: str | Path, *, net: str | Path | None = None, out: str | Path |
             into ``inputs`` and ``result``, an action's own reports) is left out of the
             events' records, each such value replaced by a note naming its trace line;
             every event stays in the page.
+        trace_name: what a run's page calls its trace (default: the file's name; ``None``
+            for a trace that was only a means to the page, which then names the net).
 
     Returns:
         The page written.
@@ -72,7 +74,8 @@ def view(source: str | Path, *, net: str | Path | None = None, out: str | Path |
 
         if max_mb is not None and not max_mb > 0:
             raise PetriflowError(f"--max-mb must be a size in MB > 0, got {max_mb}")
-        html = run_page(source, net=net, max_mb=DEFAULT_MAX_MB if max_mb is None else max_mb)
+        html = run_page(source, net=net, max_mb=DEFAULT_MAX_MB if max_mb is None else max_mb,
+                        trace_name=trace_name)
     from petriflow.io.files import write_atomic
 
     try:
@@ -83,11 +86,12 @@ def view(source: str | Path, *, net: str | Path | None = None, out: str | Path |
     return out
 
 
-def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float = 20.0) -> str:
+def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float = 20.0,
+             trace_name: str | None = "") -> str:
     """The HTML of a run's page (see :mod:`petriflow.view.run_page`)."""
     from petriflow.view.run_page import run_page as build
 
-    return build(trace, net=net, max_mb=max_mb)
+    return build(trace, net=net, max_mb=max_mb, trace_name=trace_name)
 
 
 def sweep_page(db: str | Path, *, sweep: str | Path | None = None) -> str:

@@ -34,7 +34,14 @@ def add_parser(sub) -> argparse.ArgumentParser:
 def cmd_view(args: argparse.Namespace) -> int:
     from petriflow.view import view
 
+    import sys
+
+    from petriflow.view import SWEEP_SUFFIXES
+
     page = view(args.source, net=args.net, out=args.out, sweep=args.sweep, max_mb=args.max_mb)
+    if args.net is None and Path(args.source).suffix.lower() not in SWEEP_SUFFIXES:
+        print(f"petriflow: note: {args.source}: no --net given, so the page shows the marking as a table of"
+              " places instead of drawing the net (--net NET draws it)", file=sys.stderr)
     print(f"wrote {page} ({Path(page).stat().st_size / 1e6:.2f} MB)")
     return 0
 
@@ -64,8 +71,10 @@ def run_view_start(args: argparse.Namespace) -> Path | None:
         args.poses = DEFAULT_POSES
     if args.trace is not None:
         return None
-    # beside the page; the run makes its folder once every input is checked
-    temporary = Path(page).resolve().parent / f".{Path(page).name}.trace.jsonl"
+    # in a folder of its own outside the page's, so that a kill leaves nothing beside the page
+    import tempfile
+
+    temporary = Path(tempfile.mkdtemp(prefix="petriflow-view-")) / "run.jsonl"
     args.trace = str(temporary)
     return temporary
 
@@ -79,10 +88,12 @@ def run_view_finish(args: argparse.Namespace, outcome, temporary: Path | None) -
     from petriflow.view import view
 
     try:
-        view(args.trace, net=args.net, out=page)
+        view(args.trace, net=args.net, out=page, trace_name=None if temporary is not None else "")
     finally:
         if temporary is not None:
-            temporary.unlink(missing_ok=True)
+            import shutil
+
+            shutil.rmtree(temporary.parent, ignore_errors=True)
             if str(temporary) in outcome.written:
                 outcome.written.remove(str(temporary))
     outcome.written.append(str(page))

@@ -349,8 +349,11 @@ def restored(s: dict[str, Any], records: list[dict[str, Any]], templates: list[i
     return m
 
 
-def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float = DEFAULT_MAX_MB) -> str:
-    """The HTML of the page of ``trace`` (optionally drawing ``net``).
+def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float = DEFAULT_MAX_MB,
+             trace_name: str | None = "") -> str:
+    """The HTML of the page of ``trace`` (optionally drawing ``net``). The page names the
+    trace by ``trace_name`` (default: its file name; ``None``: no trace file to name, as
+    for a run's ``--view`` without ``--trace``).
 
     Raises:
         NetFormatError: the trace or the net is malformed (file, line, what).
@@ -386,7 +389,7 @@ def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float 
     data = {
         "kind": "run",
         "name": name,
-        "trace": trace.name,
+        "trace": trace.name if trace_name == "" else trace_name,
         "net_file": None if net is None else Path(net).name,
         "seed": first.get("seed"),
         "events": len(events),

@@ -132,11 +132,14 @@ def test_killed_process_resumes_without_lost_or_duplicated_firings(tmp_path, tic
     assert firings == list(range(1, len(firings) + 1))
 
 
-def test_resume_of_a_finished_run_is_refused(tmp_path, ticker):
-    """A finished journal cannot be resumed."""
-    run_files(ticker, until=0.2, db=tmp_path / "run.sqlite")
-    with pytest.raises(JournalError, match="already finished"):
-        resume(tmp_path / "run.sqlite")
+def test_resume_of_a_finished_run_writes_its_outputs_again(tmp_path, ticker):
+    """A finished journal (a run killed while writing its outputs) is re-executed against
+    the journal, with a warning, and writes the uninterrupted run's trace."""
+    run_files(ticker, until=0.2, db=tmp_path / "run.sqlite", trace=tmp_path / "whole.jsonl")
+    with pytest.warns(UserWarning, match="already finished"):
+        outcome = resume(tmp_path / "run.sqlite", trace=tmp_path / "again.jsonl")
+    assert outcome.result.reason == run_files(ticker, until=0.2).result.reason
+    assert lines(tmp_path / "again.jsonl") == lines(tmp_path / "whole.jsonl")
 
 
 def test_existing_journal_is_never_overwritten(tmp_path, ticker):

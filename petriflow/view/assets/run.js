@@ -876,7 +876,7 @@
     const stop = M.kinds[kindOf[N - 1]] === "stop" ? ev(N - 1).data.reason : "no stop event";
     const failed = firings.filter(f => f.outcome && f.outcome !== "ok").length;
     document.getElementById("summary").textContent =
-      `${D.trace}${D.net_file ? " on " + D.net_file : ""} · ${N} events over ${span.toFixed(2)} s simulated · ` +
+      `${[D.trace, D.net_file].filter(Boolean).join(" on ") || D.name} · ${N} events over ${span.toFixed(2)} s simulated · ` +
       `${firings.length} firings (${failed} not ok) · ${messages.length} messages · ${bodies.size} bodies posed · ` +
       `ended: ${stop} · trace ${(D.trace_bytes / 1e6).toFixed(2)} MB, page ${(D.page_bytes / 1e6).toFixed(2)} MB` +
       (D.shortened ? ` · to stay under ${D.shortened.max_mb} MB, ${D.shortened.events} events carry their bulky data` +
