@@ -416,9 +416,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         _print_json(plain(result))
     else:
         print(format_report(result))
-    if not result["complete"]:
+    code = exit_code(result)
+    if not result["complete"] and code == 2:
+        # no verdict: the limit is the answer; a verdict reached anyway (a deadlock found,
+        # soundness decided by another method) is an answer, the limit a note in the report
         print(f"petriflow: {args.net}: {result['error']}", file=sys.stderr)
-    return exit_code(result)
+    return code
 
 
 # Parser ------------------------------------------------------------------------------

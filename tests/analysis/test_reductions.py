@@ -315,7 +315,7 @@ def test_cli_method_and_json(capsys, tmp_path):
     assert result["states_visited"]["symmetry"] == result["symmetry"]["canonical_states"] < full["states"]
     assert main(["check", path, "--method", "explicit"]) == code
     out = capsys.readouterr().out
-    assert "method (explicit): explicit: sound" in out
+    assert "sound: yes (state space)" in out and "method: explicit" in out
     assert f"markings stored: explicit {full['states']:,}" in out
     with pytest.raises(SystemExit) as stop:
         main(["check", path, "--method", "nope"])

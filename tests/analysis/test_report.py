@@ -232,6 +232,9 @@ def test_a_deadlock_found_before_the_limit_is_reported():
     text = format_report(result)
     assert "PROBLEM" in text.splitlines()[0] and "found before the limit" in text
     assert "witness: all_stop" in text
+    assert "  deadlock-free: no (state space, found before the limit; witness below)" in text
+    assert "  live: undecided (state space over --max-states=1000)" in text
+    assert text.splitlines()[-1].startswith("  note: live, reversible, dead transitions undecided")
 
 
 def test_a_place_over_its_bound_found_before_the_limit_is_reported():
@@ -293,3 +296,139 @@ def test_check_command_budget_options(tmp_path, capsys):
     assert result["invariants"]["not_computed"] == {"p_semiflows": "skipped", "t_semiflows": "skipped"}
     assert main(["check", str(path), "--max-coverability", "-1"]) == 2
     assert "--max-coverability must be >= 0" in capsys.readouterr().err
+
+
+# The text names each verdict with the method that decided it -------------------------
+
+SEQUENCE = """
+petriflow: 1
+net: sequence
+places: [i, a, o]
+transitions: [{id: t1, in: [i], out: [a]}, {id: t2, in: [a], out: [o]}]
+"""
+
+
+def test_check_text_of_a_deadlock_decided_past_the_state_limit(tmp_path, capsys):
+    """Issue 40: the textbook philosophers (not a WF-net, a deadlock 30 firings deep) with
+    the exploration stopped at --max-states: stubborn sets decide the deadlock. The text
+    gives each verdict with its method (no line reads as 'sound' or 'deadlock_free'), the
+    exit code is 1 and the limit is a note on the last line, not an error on stderr."""
+    from petriflow.io.yaml import dumps_net
+    from tests.analysis.nets import philosophers_one_fork
+
+    path = tmp_path / "philosophers.yaml"
+    path.write_text(dumps_net(philosophers_one_fork(30)))
+    code = main(["check", str(path), "--max-states", "2000"])
+    captured = capsys.readouterr()
+    assert code == EXIT_PROBLEM and captured.err == ""
+    lines = captured.out.splitlines()
+    assert lines[0].endswith("-- PROBLEM")
+    for expected in ("  sound: no (WF-net structure)",
+                     "  bounded: yes (P-semiflows), safe",
+                     "  deadlock-free: no (stubborn sets; witness below)",
+                     "  live: undecided (state space over --max-states=2000)",
+                     "  reversible: undecided (state space over --max-states=2000)"):
+        assert expected in lines
+    assert any(line.startswith("  dead transitions: undecided (state space over --max-states=2000)")
+               for line in lines)
+    # nothing reads as a verdict the net does not have
+    assert "deadlock_free" not in captured.out and "method (" not in captured.out
+    assert all(line.startswith("  sound: no") for line in lines if "sound" in line)
+    assert lines[-1] == ("  note: live, reversible, dead transitions undecided (state space over"
+                         " --max-states=2000); the verdict (a deadlock) does not depend on them")
+    deadlock = next(k for k, line in enumerate(lines) if line.startswith("  - deadlock: "))
+    assert lines[deadlock + 1].startswith("      witness: take_left_0")
+    # --json: the same verdicts, nothing on stderr either
+    assert main(["check", str(path), "--max-states", "2000", "--json"]) == EXIT_PROBLEM
+    captured = capsys.readouterr()
+    result = json.loads(captured.out)
+    assert captured.err == "" and result["complete"] is False
+    assert (result["sound"], result["deadlock_free"], result["methods"]["deadlock_free"]) == (
+        False, False, "stubborn")
+
+
+def test_check_text_of_a_sound_workflow_net_says_why_it_is_not_live():
+    """A sound WF-net deadlocks, is not live and not reversible, as given: the final
+    marking is dead. The text says so beside each verdict, and that the short-circuited
+    net (o back to i) is deadlock-free, live and reversible; the JSON keeps the verdicts
+    for the net as given."""
+    result = check_net(loads_net(SEQUENCE))
+    assert (result["sound"], result["deadlock_free"], result["live"], result["reversible"]) == (
+        True, False, False, False)
+    assert result["final_marking"] == {"o": 1}
+    lines = format_report(result).splitlines()
+    assert lines[0] == "sequence: 3 places, 2 transitions -- OK"
+    for expected in (
+            "  sound: yes (state space; the Rank Theorem agrees)",
+            "  deadlock-free: no (state space) -- only at the final marking o=1, where a run ends",
+            "  live: no (state space) -- no transition fires again once the final marking o=1 is reached",
+            "  reversible: no (state space) -- the initial marking i=1 is not reached again from the"
+            " final marking o=1",
+            "    (short-circuited, o connected back to i as WF-net tools analyse it: deadlock-free,"
+            " live and reversible, as soundness implies)",
+            "  dead transitions: none (state space)"):
+        assert expected in lines
+    # decided on the stubborn-set graph alone: the same reasons, exit 0, no error line
+    stubborn = check_net(loads_net(SEQUENCE), method="stubborn")
+    text = format_report(stubborn)
+    assert exit_code(stubborn) == EXIT_OK and stubborn["complete"] is False
+    assert "  deadlock-free: no (stubborn sets) -- only at the final marking o=1, where a run ends" in text
+    assert text.splitlines()[-1] == ("  note: --method stubborn builds no full state space; every"
+                                     " property above was decided without it")
+
+
+def test_check_command_with_method_stubborn_on_a_sound_net_prints_no_error(tmp_path, capsys):
+    """A verdict reached without the full state space is an answer: exit 0, stderr empty."""
+    path = tmp_path / "sequence.yaml"
+    path.write_text(SEQUENCE)
+    assert main(["check", str(path), "--method", "stubborn"]) == EXIT_OK
+    captured = capsys.readouterr()
+    assert captured.err == "" and "  sound: yes (stubborn sets)" in captured.out
+
+
+def test_an_unsound_workflow_net_gets_no_run_end_reasons():
+    """The reasons beside deadlock-free, live and reversible are only for sound WF-nets
+    (and nets whose one dead marking is their declared final marking)."""
+    text = format_report(check_net(loads_net(WORKFLOW)))
+    assert "  sound: no (state space; the Rank Theorem agrees; witnesses below)" in text
+    assert "where a run ends" not in text and "short-circuited" not in text
+
+
+def test_a_net_ending_in_its_declared_final_marking_says_so():
+    """Not a WF-net; its only dead marking is its declared final marking (exit 0)."""
+    from petriflow.io import load_net
+
+    result = check_net(load_net("nets/passage/passage.yaml"))
+    text = format_report(result)
+    assert exit_code(result) == EXIT_OK and result["final_marking"] == {
+        "red_done": 1, "blue_done": 1, "mutex": 1}
+    assert ("  deadlock-free: no (state space up to symmetry) -- only at the declared final marking"
+            " blue_done=1, mutex=1, red_done=1, where a run ends") in text.splitlines()
+    assert "short-circuited" not in text
+
+
+def test_check_text_when_nothing_decisive_was_found(tmp_path, capsys):
+    """Deadlocks undecided at --max-states (explicit, no stubborn sets): exit 2, each open
+    property says undecided and why, the last line says there is no verdict, and the limit
+    is the one line on stderr."""
+    from petriflow.io.yaml import dumps_net
+
+    path = tmp_path / "philosophers.yaml"
+    path.write_text(dumps_net(dining_philosophers(12)))
+    code = main(["check", str(path), "--max-states", "50", "--method", "explicit"])
+    captured = capsys.readouterr()
+    assert code == EXIT_UNDECIDED
+    lines = captured.out.splitlines()
+    assert lines[0].endswith("-- UNDECIDED")
+    assert "  deadlock-free: undecided (state space over --max-states=50)" in lines
+    assert "  live: undecided (state space over --max-states=50)" in lines
+    assert lines[-1] == "  no verdict: deadlock-free undecided (state space over --max-states=50)"
+    error_lines = captured.err.strip().splitlines()
+    assert len(error_lines) == 1 and "max_states=50" in error_lines[0]
+
+
+def test_every_verdict_line_without_the_methods_key():
+    """check_net(method=None) (the explicit exploration, no ``methods``) still names one."""
+    text = format_report(check_net(producer_consumer(2), method=None))
+    assert "  bounded: yes (P-semiflows), 2-bounded" in text
+    assert "  deadlock-free: yes (state space)" in text and "  live: yes (state space)" in text
