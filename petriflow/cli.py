@@ -225,10 +225,15 @@ def _size(text: str | None) -> tuple[float, float] | None:
 def cmd_export(args: argparse.Namespace) -> int:
     from petriflow.export import export_net, format_of
 
-    format = format_of(args.output, args.format)  # a bad format or ending fails before any work
+    to_stdout = args.output == "-"  # the file's bytes on standard output, as Graphviz's -o- does
+    if to_stdout and args.format is None:
+        raise PetriflowError("-o -: standard output has no file ending to tell the format by; give -f")
+    # a bad format or ending fails before any work
+    format = format_of(f"net.{args.format}" if to_stdout else args.output, args.format)
     from petriflow.runtime.session import _check_outputs
 
-    _check_outputs({"--output": args.output}, [args.net])
+    if not to_stdout:
+        _check_outputs({"--output": args.output}, [args.net])
     size = _size(args.size)
     net = load_net(args.net)
     marking = _start_marking(net, args.marking)
@@ -253,10 +258,22 @@ def cmd_export(args: argparse.Namespace) -> int:
         marking = net.check_marking(witness.get("marking") or {})
         caption = (f"red: {witness['message']}, reached by firing {' '.join(witness['transitions'])};"
                    " tokens: the marking it reaches")
-        print(witness["message"])
-    export_net(net, args.output, format, marking=marking, highlight=highlight, caption=caption,
-               rankdir=args.rankdir, size=size, fold=args.fold)
-    print(f"wrote {args.output}")
+        print(witness["message"], file=sys.stderr if to_stdout else sys.stdout)
+    options = {"marking": marking, "highlight": highlight, "caption": caption, "rankdir": args.rankdir,
+               "size": size, "fold": args.fold}
+    if not to_stdout:
+        export_net(net, args.output, format, **options)
+        print(f"wrote {args.output}")
+        return EXIT_OK
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="petriflow-export-") as folder:
+        made = os.path.join(folder, f"net.{format}")
+        export_net(net, made, format, **options)
+        with open(made, "rb") as data:
+            sys.stdout.flush()
+            shutil.copyfileobj(data, sys.stdout.buffer)
+        sys.stdout.buffer.flush()
     return EXIT_OK
 
 
@@ -461,7 +478,7 @@ def build_parser() -> argparse.ArgumentParser:
     export = net_command("export", "Convert a net or draw it.", cmd_export)
     export.add_argument("--format", "-f", choices=["pnml", "yaml", "dot", "svg", "png"],
                         help="output format (default: from the output file's ending)")
-    export.add_argument("--output", "-o", required=True, help="output file")
+    export.add_argument("--output", "-o", required=True, help="output file ('-': standard output, with -f)")
     export.add_argument("--rankdir", choices=["LR", "TB", "auto"], default="auto",
                         help="pictures: left to right, top to bottom, or auto (top to bottom when left to"
                         " right would be too wide; the default)")

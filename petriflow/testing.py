@@ -69,6 +69,9 @@ class FiredTransition:
         tokens: token data afterwards, ``{place: [data, ...]}`` (marked places only).
         events: the events recorded (start, end, messages...).
         time: simulated seconds the firing took.
+        reason: why the firing did not end ``ok``: the message of the action's
+            :class:`~petriflow.runtime.action.ActionFailure` (``"charger fault"``), of an
+            error it raised, or of its timeout; ``None`` for an ``ok`` firing.
     """
 
     outcome: str | None

@@ -32,5 +32,9 @@ if [ ! -x .venv/bin/python ]; then
     "$PYTHON" -m venv .venv
 fi
 .venv/bin/python -m pip install -q --disable-pip-version-check --upgrade pip
-.venv/bin/python -m pip install -q --disable-pip-version-check -e ".[dev]"
+# setuptools boxes a generic warning around every editable install whose packages map
+# folders (agents/ -> petriflow.agents): it says nothing about this project, so it is
+# silenced by its message; every other warning still shows.
+PYTHONWARNINGS="ignore:Editable installation" \
+    .venv/bin/python -m pip install -q --disable-pip-version-check -e ".[dev]"
 echo "setup: done; run 'source .venv/bin/activate' to have the petriflow command on your PATH" >&2

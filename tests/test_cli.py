@@ -7,6 +7,7 @@ import sys
 import pytest
 
 from petriflow.cli import main
+from petriflow.io.yaml import loads_net
 from tests.conftest import NETS, SEQUENCE_YAML
 
 INSPECTION = str(NETS / "examples" / "inspection.yaml")
@@ -247,3 +248,16 @@ def test_run_summary_says_how_it_ended_and_the_seed(capsys, sequence_file):
     out = capsys.readouterr().out
     assert "firings at t = 0 s after 1 firing (seed 4;" in out and "no simulated time passed" in out
     assert "marking at the end: p=1" in out and "final marking" not in out
+
+
+def test_export_to_dash_writes_standard_output_and_no_file(tmp_path, monkeypatch, capfdbinary, sequence_file):
+    """``-o -`` writes the export's bytes to standard output (a picture too), never a file named '-'."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["export", str(sequence_file), "-f", "yaml", "-o", "-"]) == 0
+    out = capfdbinary.readouterr().out
+    assert out.startswith(b"petriflow: 1") and loads_net(out.decode()).transitions
+    assert main(["export", str(sequence_file), "-f", "png", "-o", "-"]) == 0
+    assert capfdbinary.readouterr().out.startswith(b"\x89PNG")
+    assert main(["export", str(sequence_file), "-o", "-"]) == 2
+    assert "give -f" in capfdbinary.readouterr().err.decode()
+    assert [p.name for p in tmp_path.iterdir()] == ["sequence.yaml"]

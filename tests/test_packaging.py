@@ -23,3 +23,15 @@ def test_every_folder_with_files_is_a_listed_package():
             if name not in listed:
                 missing.append(name)
     assert not missing, f"add to [tool.setuptools] packages in pyproject.toml: {missing}"
+
+
+def test_a_quiet_test_run_names_its_random_order_seed(tmp_path):
+    """``scripts/test.sh`` runs pytest with ``-q``, which hides the header where
+    pytest-randomly names its seed: the seed comes in the last lines instead."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "randomly", "--randomly-seed=7",
+                           str(ROOT / "tests" / "test_marking.py")], cwd=ROOT, capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout[-2000:]
+    assert "--randomly-seed=7" in done.stdout.splitlines()[-2]
