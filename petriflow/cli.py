@@ -81,8 +81,9 @@ def _load_bound(path: str, import_actions: bool = False) -> tuple[Net, list[str]
     """Load a net as a run would: its run configuration found, every action, parameter,
     port and guard bound (``file:line`` errors with close matches, before anything else
     happens). The configuration's action modules (user code) are imported only when
-    ``import_actions``; otherwise the names only they could provide are not checked,
-    and the notes returned (also printed to standard error) say which."""
+    ``import_actions``; otherwise what they declare is read from their source and checked
+    the same way, and the notes returned (also printed to standard error) list what
+    their source cannot tell, each with the reason (docs/security.md)."""
     from pathlib import Path
 
     from petriflow.runtime.session import prepare
@@ -91,15 +92,15 @@ def _load_bound(path: str, import_actions: bool = False) -> tuple[Net, list[str]
     config = prepared.config
     if not prepared.binding.unchecked:
         return prepared.net, []
-    modules = ", ".join(repr(Path(m).name if Path(m).is_absolute() else m) for m in config.unimported_actions())
+    modules = [repr(Path(m).name if Path(m).is_absolute() else m) for m in config.unimported_actions()]
     where = config.path or path
     line = config.lines.get("actions") if config.path else prepared.net.lines.get("run")
+    named = (f"module{'s' if len(modules) > 1 else ''} {', '.join(modules)} named in {where}"
+             f"{f':{line}' if line else ''} {'are' if len(modules) > 1 else 'is'} not imported")
     notes = []
     for item in prepared.binding.unchecked:
         at = f"{path}:{item.line}" if item.line else path
-        notes.append(f"{at}: {item.transition!r}: {item.kind} {item.name!r} not checked: provided by module"
-                     f" {modules} named in {where}{f':{line}' if line else ''} (not imported;"
-                     " --import-actions to check)")
+        notes.append(f"{at}: {item.transition!r}: {item.describe()} ({named}; --import-actions to check)")
     for note in notes:
         print(f"petriflow: note: {note}", file=sys.stderr)
     return prepared.net, notes
@@ -459,7 +460,8 @@ def build_parser() -> argparse.ArgumentParser:
         return command
 
     import_help = ("import the action modules the net's run configuration names (user code) and check"
-                   " their actions too; by default looking at a net never runs its code")
+                   " their actions with it; by default looking at a net never runs its code: their source"
+                   " is read instead, and what it cannot tell is listed as not checked")
     info = net_command("info", "Show sizes, subnets and bound actions of a net.", cmd_info)
     info.add_argument("--json", action="store_true", help="print JSON")
     info.add_argument("--import-actions", action="store_true", help=import_help)

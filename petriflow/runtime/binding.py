@@ -13,6 +13,14 @@ BehaviorTree.CPP checks a tree's ports against its node manifest when it loads):
 
 Errors name the file and the line the loader recorded (``net.lines``), location first.
 
+A command that only looks at a net (``info``, ``check``) binds it without importing
+the action modules its run configuration names (``unimported``): a name the registry
+lacks is then looked up in what those modules declare, read from their source
+(:mod:`petriflow.runtime.declared`), and checked against a stand-in made of the
+declaration by the same code as a run, so the errors are the same. ``core.*`` and the
+installed plugins' namespaces are closed: a name there that they lack is an error even
+so. What the source cannot tell is listed in :attr:`Binding.unchecked`, with the reason.
+
 Examples:
     >>> from petriflow.io.yaml import loads_net
     >>> net = loads_net('''
@@ -41,6 +49,8 @@ Examples:
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,9 +58,10 @@ from petriflow import limits
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, Port
+from petriflow.runtime.declared import ActionDeclaration, Declarations, GuardDeclaration, read_declarations
 from petriflow.runtime.registry import Predicate, Registry, UnknownActionError, default_registry
 
-__all__ = ["Binding", "BoundTransition", "Unchecked", "bind", "check_sizes", "check_world"]
+__all__ = ["Binding", "BoundTransition", "Unchecked", "bind", "check_sizes", "check_world", "closed_namespaces"]
 
 
 @dataclass(frozen=True)
@@ -78,20 +89,30 @@ class BoundTransition:
 
 @dataclass(frozen=True)
 class Unchecked:
-    """A name a static command could not check: only an action module named in the run
-    configuration, which looking at a net never imports, could provide it.
+    """What a static command could not check: a name only an action module named in the
+    run configuration (which looking at a net never imports) may provide, that its source
+    does not show; or a part of a declaration read from source that only running it tells.
 
     Attributes:
         transition: the transition naming it.
-        kind: ``action`` or ``guard``.
-        name: the action or guard name.
+        kind: ``action``, ``guard`` or ``agent state``.
+        name: the action, guard or agent-state name.
         line: where the net names it.
+        reason: why it could not be checked.
+        partly: the name was found (declared in a module's source) and checked; only
+            what ``reason`` says was not.
     """
 
     transition: str
     kind: str
     name: str
     line: int | None
+    reason: str = "an action module that was not imported may provide it"
+    partly: bool = False
+
+    def describe(self) -> str:
+        """``action 'x' not checked: why`` (``partly checked`` when :attr:`partly`)."""
+        return f"{self.kind} {self.name!r} {'partly checked' if self.partly else 'not checked'}: {self.reason}"
 
 
 @dataclass(frozen=True)
@@ -148,17 +169,19 @@ def check_sizes(net: Net, path: str | None = None) -> None:
 
 
 def bind(net: Net, registry: Registry | None = None, *, path: str | None = None,
-         unimported: bool = False) -> Binding:
+         unimported: bool | Sequence[str] = False) -> Binding:
     """Resolve every transition of ``net`` against ``registry`` (default: the run registry).
 
     Args:
         net: the net, as loaded (its ``lines`` give error lines).
         registry: where action and guard names are looked up.
         path: the file named in errors (default: the file the net was read from).
-        unimported: action modules the net's run configuration names were not imported
-            (a static command): an action or guard name nothing registered is recorded
-            in :attr:`Binding.unchecked` instead of failing, since one of those modules
-            may provide it.
+        unimported: the action modules the net's run configuration names that were not
+            imported (a static command; entries as :attr:`RunConfig.actions` keeps them):
+            a name the registry lacks is checked against what their source declares
+            (module docstring); what cannot be known that way is recorded in
+            :attr:`Binding.unchecked` with the reason. ``True``: modules not imported
+            and not to be read (every such name unchecked).
 
     Raises:
         NetFormatError: ``file:line: 'transition': ...`` for an unknown action or guard,
@@ -172,27 +195,78 @@ def bind(net: Net, registry: Registry | None = None, *, path: str | None = None,
 class _Binder:
     """Binds one net's transitions, one at a time (see :func:`bind`)."""
 
-    def __init__(self, net: Net, registry: Registry, path: str | None, unimported: bool) -> None:
+    def __init__(self, net: Net, registry: Registry, path: str | None,
+                 unimported: bool | Sequence[str]) -> None:
         self.net, self.registry, self.path, self.unimported = net, registry, path, unimported
         self.unchecked: list[Unchecked] = []
-        self.cache: dict[tuple[str, str], Any] = {}
+        self.cache: dict[tuple[str, str], tuple[Any, str | None]] = {}
+        self._declared: Declarations | None = None
+        self.noted: set[tuple[str, str, bool]] = set()
 
     def fail(self, tid: str, message: str, *keys: str) -> NetFormatError:
         return NetFormatError(message, path=self.path, line=_line(self.net, *keys, tid), element=tid)
 
+    @property
+    def declared(self) -> Declarations:
+        """What the modules not imported declare, read from their source the first time
+        a name is not registered."""
+        if self._declared is None:
+            if self.unimported is True:
+                self._declared = Declarations(hidden={"*": [("", ("an action module that was not imported"
+                                                                   " may provide it"))]})
+            else:
+                self._declared = read_declarations(list(self.unimported or ()))
+        return self._declared
+
+    def find(self, kind: str, name: str) -> tuple[Any, str | None]:
+        """What ``name`` of ``kind`` (``action``, ``guard``, ``agent state``, ``resource``)
+        is: the registered code, or what a module not imported declares in its source;
+        and, when neither tells, why (then the thing is ``None``).
+
+        Raises:
+            UnknownActionError: nothing provides it: the registry's message, with close
+                matches among the registered and the declared names (as a run gives).
+        """
+        if (kind, name) in self.cache:
+            return self.cache[kind, name]
+        find = {"action": self.registry.resolve, "guard": self.registry.guard,
+                "agent state": self.registry.state_type, "resource": self.registry.resource_factory}[kind]
+        try:
+            self.cache[kind, name] = (find(name), None)
+        except UnknownActionError as exc:
+            if not self.unimported:
+                raise
+            declared = self.declared.names(kind).get(name)
+            if declared is not None:
+                found = declared.action_class() if kind == "action" else declared
+                self.cache[kind, name] = (found, None)
+                return self.cache[kind, name]
+            closed = "." in name and name.partition(".")[0] in closed_namespaces()
+            reason = None if closed else self.declared.missing(kind, name)
+            if reason is None:
+                known = [*_registered(self.registry, kind), *self.declared.names(kind)]
+                raise self.registry._unknown(kind, name, known) from exc
+            self.cache[kind, name] = (None, reason)
+        return self.cache[kind, name]
+
+    def note(self, tid: str, kind: str, name: str, reason: str | None, *, partly: bool = False,
+             once: bool = False) -> None:
+        """List what was not checked (``once``: for the first transition only)."""
+        if reason and not (once and (kind, name, partly) in self.noted):
+            self.noted.add((kind, name, partly))
+            self.unchecked.append(Unchecked(tid, kind, name, _line(self.net, f"{tid}/{kind}", tid), reason, partly))
+
     def lookup(self, tid: str, kind: str, name: str) -> Any:
         """The action class or guard named ``name`` (``None``: not checked, see ``unimported``)."""
-        if (kind, name) not in self.cache:
-            find = self.registry.guard if kind == "guard" else self.registry.resolve
-            try:
-                self.cache[kind, name] = find(name)
-            except UnknownActionError as exc:
-                if not self.unimported:
-                    raise self.fail(tid, str(exc), f"{tid}/{kind}") from None
-                self.cache[kind, name] = None
-        if self.cache[kind, name] is None:
-            self.unchecked.append(Unchecked(tid, kind, name, _line(self.net, f"{tid}/{kind}", tid)))
-        return self.cache[kind, name]
+        try:
+            found, reason = self.find(kind, name)
+        except UnknownActionError as exc:
+            raise self.fail(tid, str(exc), f"{tid}/{kind}") from None
+        self.note(tid, kind, name, reason)
+        declared = getattr(found, "declaration", found)
+        if isinstance(declared, (ActionDeclaration, GuardDeclaration)):
+            self.note(tid, kind, name, "; ".join(declared.gaps), partly=True)
+        return found
 
     def transition(self, transition: Any) -> BoundTransition:
         tid = transition.id
@@ -201,17 +275,21 @@ class _Binder:
         if cls is None:  # no action, or not checked (its module was not imported)
             params = dict(transition.params)
             return BoundTransition(tid, None, params, guard, None, self.reads(transition, guard, params))
-        try:
-            params = cls.check_params(transition.params, tid)
-        except NetFormatError as exc:
-            param = getattr(exc, "param", None)
-            raise self.fail(tid, exc.message, f"{tid}/params/{param}", f"{tid}/params") from None
+        declared = getattr(cls, "declaration", None)
+        if declared is not None and declared.params is None:  # read from source, parameters unknown
+            params = dict(transition.params)
+        else:
+            try:
+                params = cls.check_params(transition.params, tid)
+            except NetFormatError as exc:
+                param = getattr(exc, "param", None)
+                raise self.fail(tid, exc.message, f"{tid}/params/{param}", f"{tid}/params") from None
         ports = self.ports(tid, cls, params)
         self.requirements(tid, transition.action, cls.requirements(params), params)
         self.state(tid, transition.action, cls)
         for name, kind in getattr(cls, "resources", {}).items():
             try:
-                self.registry.resource_factory(kind)
+                self.find("resource", kind)
             except UnknownActionError as exc:
                 raise self.fail(tid, f"action {transition.action} uses resource {name!r}: {exc}",
                                 f"{tid}/action") from None
@@ -221,7 +299,10 @@ class _Binder:
         """The state keys the transition's guard reads, its placeholders filled in."""
         if guard is None:
             return None
-        declared = self.registry.guard_reads(transition.guard)
+        if isinstance(guard, GuardDeclaration):  # read from a module's source
+            declared = guard.reads
+        else:
+            declared = self.registry.guard_reads(transition.guard)
         if declared is None:
             return None
         tid = transition.id
@@ -241,10 +322,16 @@ class _Binder:
         declared = None if subnet is None else self.net.subnets[subnet].state
         if declared is not None:
             try:
-                kind = self.registry.state_type(declared)
+                kind, reason = self.find("agent state", declared)
             except UnknownActionError as exc:
                 raise self.fail(tid, f"subnet {subnet!r}: {exc}", tid) from None
-            if wanted is not None and not issubclass(kind, wanted):
+            self.note(tid, "agent state", declared, reason, once=True)
+            if not isinstance(kind, type):  # declared in a module's source: what it is is not known
+                if wanted is not None:
+                    self.note(tid, "agent state", declared, f"action {action} reads a {_type_names(wanted)}"
+                              f" state, and what {declared!r} is cannot be known without importing the module"
+                              " that registers it", partly=True, once=True)
+            elif wanted is not None and not issubclass(kind, wanted):
                 raise self.fail(tid, f"action {action} reads a {_type_names(wanted)} state, but subnet"
                                 f" {subnet!r} declares state {declared!r} ({kind.__name__})", f"{tid}/action")
         elif wanted is not None:
@@ -279,6 +366,32 @@ class _Binder:
         if "robot" in needs and params.get("robot") is None and agent is None:
             raise self.fail(tid, f"action {action} moves a robot: give params.robot or put the transition in"
                             " an agent subnet", f"{tid}/action")
+
+
+@functools.lru_cache(maxsize=1)
+def closed_namespaces() -> frozenset[str]:
+    """The namespaces (``core`` of ``core.wait``) of the core's and the installed plugins'
+    actions, guards and agent states: trusted installed code (the ``petriflow.actions``
+    entry points), loaded by any registry. A name under one of them that they lack is an
+    error even when action modules were not imported."""
+    installed = Registry()  # the core and the entry points only, whatever this process imported
+    names = [*installed.names(), *_registered(installed, "guard"), *_registered(installed, "agent state")]
+    return frozenset({"core"} | {name.partition(".")[0] for name in names if "." in name})
+
+
+def _registered(registry: Registry, kind: str) -> list[str]:
+    """The names ``registry`` knows of ``kind`` (``action``, ``guard``, ``agent state``,
+    ``resource``): what a run's error offers as close matches."""
+    if kind == "action":
+        return registry.names()
+    registry._load_plugins()
+    table = {"guard": "_predicates", "agent state": "_states", "resource": "_resources"}[kind]
+    names = list(getattr(registry, table, {}))
+    if kind == "resource":
+        from petriflow.runtime.resources import LIVENESS
+
+        names.append(LIVENESS)  # made by the run itself
+    return names
 
 
 def _type_names(kinds: Any) -> str:

@@ -227,7 +227,7 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
     if import_actions:
         run_config.import_actions()
     pending = [] if import_actions else run_config.unimported_actions()
-    binding = bind(net, registry, path=str(net_path), unimported=bool(pending))
+    binding = bind(net, registry, path=str(net_path), unimported=pending)
     run_config.check(net)
     world_path = Path(world) if world is not None else (Path(run_config.world) if run_config.world else None)
     return Prepared(net, text, run_config, binding, world_path)
