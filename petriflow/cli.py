@@ -322,6 +322,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise
     run_view_finish(args, outcome, made_up_trace)
     result = outcome.result
+    from petriflow.workflow import final_marking_of
+
+    final = final_marking_of(outcome.net)  # declared, else a WF-net's sink: the rule check uses
+    problem = result.reason in ("failed", "stalled") or (final is not None and result.reason != "final")
     summary = {
         "net": outcome.net.id,
         "reason": result.reason,
@@ -332,6 +336,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         "realtime_factor": round(outcome.realtime_factor, 2) if outcome.wall > 0 and result.time > 0 else None,
         "seed": outcome.seed,
         "marking": result.marking.to_dict(),
+        "final_marking": None if final is None else final.to_dict(),
         "error": result.error,
         "metrics": outcome.metrics,
         "written": outcome.written,
@@ -345,14 +350,13 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"{outcome.net.id}: {result.reason} at t = {result.time:g} s after {result.firings}"
               f" firing{'' if result.firings == 1 else 's'} (seed {outcome.seed}; {outcome.wall:.2f} s wall, {pace})")
         print(f"  marking at the end: {_format_marking(result.marking)}")
+        if final is not None and outcome.net.final_marking is None:
+            print(f"  final marking: {_format_marking(final)} (the file declares none: the WF-net's sink)")
         if result.error:
             print(f"  error: {result.error}")
         _print_metrics(outcome.metrics)
         for path in outcome.written:
             print(f"  wrote {path}")
-    problem = result.reason in ("failed", "stalled") or (
-        outcome.net.final_marking is not None and result.reason != "final"
-    )
     return EXIT_PROBLEM if problem else EXIT_OK
 
 

@@ -204,6 +204,7 @@ def load(net: Net | str | Path, *, config: Any = None, world: Any = None,
     else:
         config = RunConfig.from_dict(config) if isinstance(config, dict) else (
             load_config(config) if isinstance(config, (str, Path)) else config) or RunConfig()
+        net = config.bound(net)
         config.import_actions()
         binding, world_file = None, None
     binding = validate(net, config, binding=None if binding is None or binding.net is not net else binding,

@@ -25,9 +25,10 @@ from __future__ import annotations
 from typing import Any, Mapping, Sequence
 
 from petriflow.errors import NetStructureError
+from petriflow.marking import Marking
 from petriflow.net import OPERATOR_KINDS, Net, Operator
 
-__all__ = ["add_operator", "operator_groups", "source_places", "sink_places"]
+__all__ = ["add_operator", "operator_groups", "source_places", "sink_places", "final_marking_of"]
 
 
 def _weights(branches: Sequence[str] | Mapping[str, int]) -> list[tuple[str, int]]:
@@ -100,6 +101,26 @@ def source_places(net: Net) -> list[str]:
     """Places no transition puts tokens into (a WF-net has exactly one: ``i``)."""
     fed = {a.target for a in net.arcs if a.target in net.places}
     return [p for p in net.places if p not in fed]
+
+
+def final_marking_of(net: Net) -> Marking | None:
+    """The marking a run of ``net`` should end in, the one rule ``run`` and ``check`` share:
+    the net's declared final marking, else, for a WF-net, one token in its sink place ``o``
+    (WoPeD, PM4Py and ProM files often declare none); else ``None`` (the run simply ends
+    when nothing is enabled).
+
+    Examples:
+        >>> from petriflow.io.yaml import loads_net
+        >>> final_marking_of(loads_net("{petriflow: 1, places: [i, o], transitions: [{id: t, in: [i], out: [o]}]}"))
+        Marking({'o': 1})
+        >>> final_marking_of(loads_net("{petriflow: 1, places: [a], transitions: [{id: t, in: [a], out: [a]}]}"))
+    """
+    if net.final_marking is not None:
+        return net.final_marking
+    from petriflow.analysis.soundness import workflow_structure
+
+    structure = workflow_structure(net)
+    return Marking({structure.sink: 1}) if structure.is_wf_net else None
 
 
 def sink_places(net: Net) -> list[str]:

@@ -141,7 +141,7 @@ def test_a_resume_that_diverges_says_where_and_changes_nothing(tmp_path):
         con.execute("UPDATE event SET line = ? WHERE seq = 3", (json.dumps(line, sort_keys=True),))
     con.close()
     trace.write_text("an older trace\n")
-    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if not p.name.endswith(".partial")}
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if ".partial" not in p.name}
     resumed = _python(KILL_AT, 10**9, "run", "--resume", "--db", db, hash_seed=2)
     assert resumed.returncode == 2
     message = resumed.stderr.strip()

@@ -344,7 +344,9 @@ def soundness_final(net: Net, structure) -> Marking | None:
     """The final marking soundness is decided for: the net's, else one token in ``o``."""
     if not structure.is_wf_net:
         return None
-    return net.final_marking if net.final_marking is not None else Marking({structure.sink: 1})
+    from petriflow.workflow import final_marking_of
+
+    return final_marking_of(net)
 
 
 def _coverability_note(result: dict[str, Any], probe: CoverabilitySearch | None, budget: int) -> None:

@@ -34,6 +34,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator
 
+from petriflow.errors import NetFormatError
 from petriflow.net import Net
 from petriflow.runtime.binding import Binding, bind, check_sizes, check_world
 from petriflow.runtime.clock import Clock, RealtimeClock, SimulatedClock
@@ -62,7 +63,11 @@ def validate(net: Net, config: RunConfig, *, binding: Binding | None = None, reg
     """
     if binding is not None and binding.checked and has_world is None:
         return binding
-    binding = binding if binding is not None else bind(net, registry, path=path)
+    if binding is None:
+        try:
+            binding = bind(net, registry, path=path)
+        except NetFormatError as exc:
+            raise config.blame(exc) from None
     config.check(net)
     check_sizes(net, path or net.path)
     if has_world is not None:

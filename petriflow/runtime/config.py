@@ -17,6 +17,9 @@ or the net's own ``run:`` mapping) or built in code::
     metrics:            # what `petriflow run` prints at the end (a sweep file's syntax)
       - core.messages
       - done_at: {metric: core.time_of, transition: done}
+    bind:               # actions for a net's transitions without editing its file
+      register: core.wait                                    # by id, or by label
+      "check ticket": {action: core.wait, params: {seconds: 60}}
 
 Examples:
     >>> config = RunConfig.from_dict({"seed": 3, "faults": [{"kill": "r1", "at": 5}]})
@@ -42,7 +45,7 @@ from petriflow.runtime.metrics import MetricRef, parse_refs
 
 __all__ = ["RunConfig", "Fault", "FaultKind", "load_config"]
 
-_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall", "metrics"}
+_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall", "metrics", "bind"}
 
 #: Default of :attr:`RunConfig.stall`: simulated seconds a run may step tick by tick
 #: with actions running and no firing starting or ending before it is stopped.
@@ -133,6 +136,10 @@ class RunConfig:
         metrics: the registered metrics ``petriflow run`` reports at the end (the
             scenario's own measures: bytes sent, map accuracy...), as a sweep file
             names them (:func:`petriflow.runtime.metrics.parse_refs`).
+        bind: ``{transition: (action, params)}``: actions bound to a net's transitions
+            by the configuration rather than by the net's file (a net drawn in another
+            tool), each transition named by its id or by its label (every transition of
+            that label); applied by :meth:`bound`, over what the file binds.
 
     The files a configuration names (``world``, ``.py`` action modules) must be in its
     own folder (or below it), or in a folder listed in ``PETRIFLOW_PATH``: a
@@ -150,6 +157,9 @@ class RunConfig:
     stall: float | None = DEFAULT_STALL
     lines: dict[str, int | None] = field(default_factory=dict, compare=False, repr=False)
     metrics: list[MetricRef] = field(default_factory=list)
+    bind: dict[str, tuple[str, dict[str, Any]]] = field(default_factory=dict)
+    #: ``{transition: name in bind}`` of the transitions :meth:`bound` bound last.
+    bound_by: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
     def from_dict(cls, data: Any, path: str | None = None, *, base: str | None = None,
@@ -190,6 +200,14 @@ class RunConfig:
                   for entry in entries]
         lines = {f"faults/{i}": getattr(entry, "line", None) for i, entry in enumerate(entries)}
         lines.update({f"channels/{name}": getattr(channels, "key_lines", {}).get(name) for name in channels})
+        binds = data.get("bind") or {}
+
+        def bind_fail(message: str, key: str | None = None) -> None:
+            at = getattr(binds, "key_lines", {}).get(key) if key is not None else None
+            raise NetFormatError(message, path=path, line=at or getattr(data, "key_lines", {}).get("bind") or line)
+
+        bindings = _bindings(data.get("bind"), bind_fail)
+        lines.update({f"bind/{name}": getattr(binds, "key_lines", {}).get(name) for name in bindings})
         lines["actions"] = getattr(data, "key_lines", {}).get("actions")
         lines["metrics"] = getattr(data, "key_lines", {}).get("metrics")
         lines = {key: at or getattr(data, "key_lines", {}).get(key.split("/")[0]) or line
@@ -198,7 +216,7 @@ class RunConfig:
         metrics = [] if data.get("metrics") is None else parse_refs(data["metrics"], fail)
         config = cls(seed, None if until is None else float(until), float(dt), world,
                      {str(k): dict(v) for k, v in channels.items()}, faults, path, located,
-                     None if stall is None else float(stall), lines, metrics)
+                     None if stall is None else float(stall), lines, metrics, bindings)
         try:
             config.channel_models()  # fail early on a bad model
         except NetFormatError as exc:
@@ -206,6 +224,45 @@ class RunConfig:
             raise NetFormatError(exc.message, path=path, line=lines.get(f"channels/{name}"),
                                  element=exc.element) from None
         return config
+
+    def bound(self, net: Net) -> Net:
+        """``net`` with the actions of :attr:`bind` bound to its transitions (a copy; the
+        net itself when there is nothing to bind).
+
+        Raises:
+            NetFormatError: a name is neither a transition's id nor a label of the net,
+                naming the configuration's file and line.
+        """
+        if not self.bind:
+            return net
+        import dataclasses
+
+        by_label: dict[str, list[str]] = {}
+        for transition in net.transitions.values():
+            if transition.label:
+                by_label.setdefault(transition.label, []).append(transition.id)
+        bound = net.copy()
+        for name, (action, params) in self.bind.items():
+            targets = [name] if name in net.transitions else by_label.get(name, [])
+            if not targets:
+                raise NetFormatError(
+                    f"bind: {name!r} is neither a transition nor a transition's label of net {net.id!r}"
+                    f"{did_you_mean(name, [*net.transitions, *by_label])}",
+                    path=self.path, line=self.lines.get(f"bind/{name}"))
+            for tid in targets:
+                bound.transitions[tid] = dataclasses.replace(bound.transitions[tid], action=action,
+                                                             params=dict(params))
+                self.bound_by[tid] = name
+        return bound
+
+    def blame(self, error: NetFormatError) -> NetFormatError:
+        """``error`` about a transition this configuration bound (an unknown action, a bad
+        parameter), located at its ``bind:`` entry rather than at the net's file."""
+        name = self.bound_by.get(error.element or "")
+        if name is None:
+            return error
+        return NetFormatError(f"bind: {name!r}: {error.message}", path=self.path,
+                              line=self.lines.get(f"bind/{name}"), element=error.element)
 
     def import_actions(self) -> None:
         """Import the modules of :attr:`actions` (each registers its actions when
@@ -294,7 +351,43 @@ class RunConfig:
                 "channels": self.channels, "faults": faults, "actions": list(self.actions), "stall": self.stall}
         if self.metrics:
             data["metrics"] = [{m.name: {"metric": m.metric, **m.params}} for m in self.metrics]
+        if self.bind:
+            data["bind"] = {name: {"action": action, "params": dict(params)}
+                            for name, (action, params) in self.bind.items()}
         return data
+
+
+def _bindings(given: Any, fail: Callable[..., Any]) -> dict[str, tuple[str, dict[str, Any]]]:
+    """A configuration's ``bind``: ``{transition or label: action}`` or
+    ``{transition or label: {action: NAME, params: {...}}}``, checked for its shape (the
+    names are checked against the net by :meth:`RunConfig.bound`, the actions and their
+    parameters when the net is bound)."""
+    if given is None:
+        return {}
+    if not isinstance(given, dict):
+        fail("bind maps a transition (its id or label) to an action, e.g. {register: core.wait}")
+    out = {}
+    for name, entry in given.items():
+        if isinstance(entry, str):
+            entry = {"action": entry}
+        if not isinstance(entry, dict) or set(entry) - {"action", "params"} or not isinstance(
+                entry.get("action"), str) or not entry["action"].strip():
+            fail(f"bind: {name!r} takes an action name, or {{action: NAME, params: {{...}}}}, got {entry!r}",
+                 key=str(name))
+        params = entry.get("params") or {}
+        if not isinstance(params, dict) or not all(isinstance(k, str) for k in params):
+            fail(f"bind: {name!r}: params must map parameter names to values, got {params!r}", key=str(name))
+        out[str(name)] = (entry["action"], {k: _plain(v) for k, v in params.items()})
+    return out
+
+
+def _plain(value: Any) -> Any:
+    """Parsed YAML (mappings and lists that know their lines) as plain data."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    return value
 
 
 def _times(data: Any, fail: Callable[..., Any]) -> tuple[int, Any, Any, Any]:

@@ -39,15 +39,24 @@ def markings(events: Iterable[Event]) -> Iterator[tuple[Event, Marking]]:
         yield event, Marking({p: c for p, c in counts.items() if c > 0})
 
 
-def describe(event: Event) -> str:
-    """One readable line for an event."""
+def describe(event: Event, labels: dict[str, str] | None = None) -> str:
+    """One readable line for an event; a transition with a label (``labels``: the run
+    event's, ``{id: label}``) is named by it, its id beside it.
+
+    Examples:
+        >>> describe(Event(1, 0.0, "start", "n18", None, {"firing": 1}), {"n18": "register"})
+        'fire   register (n18) (firing 1)'
+    """
     who = f" [{event.agent}]" if event.agent else ""
     data = event.data
+    name = event.transition
+    if labels and name in labels:
+        name = f"{labels[name]} ({name})"
     if event.kind == "start":
-        return f"fire   {event.transition}{who} (firing {data['firing']})"
+        return f"fire   {name}{who} (firing {data['firing']})"
     if event.kind == "end":
         extra = f": {data['reason']}" if data.get("reason") else ""
-        return f"end    {event.transition}{who} {data['outcome']}{extra}"
+        return f"end    {name}{who} {data['outcome']}{extra}"
     if event.kind == "message":
         return f"msg    {data.get('place')} via {data.get('channel')}{who}: {data.get('fate')}"
     if event.kind == "fault":
@@ -115,9 +124,11 @@ def replay(trace: str | Path, *, net_path: str | Path | None = None, draw: str |
             raise PetriflowError(f"{trace} was not recorded on {net_path}: it fires {', '.join(unknown[:3])},"
                                  " which the net does not have")
     last = Marking()
+    labels = events[0].data.get("labels") if events and events[0].kind == "run" else None
+    labels = labels if isinstance(labels, dict) else None
     for event, marking in markings(events):
         shown = ", ".join(f"{p}={c}" for p, c in marking.items()) or "(empty)"
-        print(f"{event.seq:6d}  t={event.time:10.3f}  {describe(event):48}  {shown}")
+        print(f"{event.seq:6d}  t={event.time:10.3f}  {describe(event, labels):48}  {shown}")
         last = marking
     if draw is not None and net is not None:
         from petriflow.export import export_net

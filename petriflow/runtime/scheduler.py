@@ -53,7 +53,7 @@ Examples:
     >>> run = Scheduler(net, seed=1)
     >>> result = run.run()
     >>> result.reason, result.time, result.marking
-    (<StopReason.DEAD: 'dead'>, 2.0, Marking({'o': 1}))
+    (<StopReason.FINAL: 'final'>, 2.0, Marking({'o': 1}))
     >>> run = Scheduler(net, seed=1)
     >>> run.peek(), run.step(), run.peek(), run.running()
     (0.0, None, 2.0, ['rest'])
@@ -69,6 +69,7 @@ from petriflow.collector import paused, relaxed
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 from petriflow.net import Net
+from petriflow.workflow import final_marking_of
 from petriflow.outcome import StopReason
 from petriflow.runtime.action import Action
 from petriflow.runtime.assembly import validate
@@ -160,7 +161,8 @@ class Scheduler:
         kernel = self.kernel = Kernel(float(getattr(world, "dt", None) or self.config.dt))
         index = self.index = RunIndex(net, self.binding)
         self.compiled = index.compiled
-        self.tokens = TokenStore(index.compiled, net.initial_marking, net.final_marking)
+        self.final = final_marking_of(net)  # declared, else a WF-net's sink (the rule check uses)
+        self.tokens = TokenStore(index.compiled, net.initial_marking, self.final)
         self.recorder = Recorder(kernel)
         self.faults = Faults(self, self.config.faults, index.agents)
         self.enabled_set = EnabledSet(index, self.tokens, self.faults.stopped, {})
@@ -271,8 +273,11 @@ class Scheduler:
         self.resources.need(sorted({kind for cls in self.index.action_class if cls is not None
                                     for kind in getattr(cls, "resources", {}).values()}))
         self.clock.start()
+        # the names a tool gave transitions whose ids are not (PNML ids are often UUIDs):
+        # the trace says them, so replay shows them without the net
+        labels = {t.id: t.label for t in self.net.transitions.values() if t.label and t.label != t.id}
         self.emit(_RUN, None, None, net=self.net.id, seed=self.seed, dt=self.kernel.dt,
-                  marking=self.marking().to_dict(), agents=self.agents())
+                  marking=self.marking().to_dict(), agents=self.agents(), **({"labels": labels} if labels else {}))
         self.runner.setup(self.world)
 
     def _advance(self, tick: int) -> None:

@@ -224,10 +224,14 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
         if run_config is None and (net_path.parent / "run.yaml").is_file():
             run_config = load_config(net_path.parent / "run.yaml")
         run_config = run_config or RunConfig()
+    net = run_config.bound(net)  # the configuration's bind: over what the file binds
     if import_actions:
         run_config.import_actions()
     pending = [] if import_actions else run_config.unimported_actions()
-    binding = bind(net, registry, path=str(net_path), unimported=pending)
+    try:
+        binding = bind(net, registry, path=str(net_path), unimported=pending)
+    except NetFormatError as exc:
+        raise run_config.blame(exc) from None
     run_config.check(net)
     world_path = Path(world) if world is not None else (Path(run_config.world) if run_config.world else None)
     return Prepared(net, text, run_config, binding, world_path)
@@ -401,6 +405,19 @@ def _inputs(prepared: Prepared, net_path: Path, seed: int | None, until: float |
     }
 
 
+def _warn_unbound(net: Net, path: Path) -> None:
+    """Warn when no transition of ``net`` is bound to an action (a net from another tool,
+    say): each then fires the moment it is enabled, and the run is only a token game."""
+    transitions = list(net.transitions.values())
+    if not transitions or any(t.action for t in transitions):
+        return
+    names = [t.id if not t.label or t.label == t.id else f"{t.label} ({t.id})" for t in transitions]
+    shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
+    warnings.warn(f"{path}: no transition is bound to an action, so each fires at once when enabled (a token"
+                  f" game): {shown}; bind them in a run configuration's 'bind:' (docs/runtime.md,"
+                  " \"Binding a net from another tool\")", stacklevel=3)
+
+
 def _pose_interval(every: Any) -> float:
     """``poses``: simulated seconds between pose samples, checked (> 0)."""
     from petriflow import limits
@@ -448,6 +465,7 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     prepared = prepare(net_path, config=config, world=world, registry=registry)
     binding = validate(prepared.net, prepared.config, binding=prepared.binding, path=str(net_path),
                        has_world=prepared.world is not None)
+    _warn_unbound(prepared.net, net_path)
     inputs = _inputs(prepared, net_path, seed, until)
     inputs["max_firings"] = max_firings
     if poses is not None:  # journaled, so a resumed run samples them too
@@ -513,6 +531,7 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
             config = RunConfig.from_dict(inputs["config"])
         except NetFormatError as exc:
             raise JournalError(f"{db}: a damaged journal: its run configuration: {exc}") from None
+        net = config.bound(net)
         config.import_actions()
         binding = validate(net, config, registry=registry, path=inputs["net_file"])
         return _execute(net, binding, config, inputs, journal=journal,
@@ -566,6 +585,8 @@ def run(net: Net | str | Path, *, world: Any = None, config: RunConfig | dict | 
         prepared = prepare(net, config=config, registry=registry)  # a file run over a World made in code
         net, config, binding = prepared.net, prepared.config, prepared.binding
     config = (load_config(config) if isinstance(config, (str, Path)) else config) or RunConfig()
+    if binding is None:  # a net made in code: the configuration's bind: applies to it here
+        net = config.bound(net)
     config.import_actions()
     close = False
     if isinstance(world, (str, Path)):

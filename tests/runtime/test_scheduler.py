@@ -31,7 +31,7 @@ transitions: [{id: t, action: core.wait, params: {seconds: 2.5}, in: [a], out: [
     result = run.run()
     start, end = [e for e in events if e.kind in ("start", "end")]
     assert (start.time, end.time) == (0.0, 2.5)
-    assert result.marking == {"b": 1} and result.reason == "dead"
+    assert result.marking == {"b": 1} and result.reason == "final"  # a WF-net ends at its sink b
 
 
 def test_concurrent_actions_of_two_agents_overlap_in_time():
