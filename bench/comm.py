@@ -39,7 +39,7 @@ def run(robots: int, mode: str, folder: Path, until: float = 6000.0) -> dict:
     area = round(cols * 5 / 6, 6)
     (folder / "world.yaml").write_text(yaml.safe_dump(world(robots=robots, cols=cols, area=area), sort_keys=False))
     (folder / "run.yaml").write_text(f"seed: 1\nuntil: {until}\nstall: 1200\nworld: world.yaml\n"
-                                     "channels: {radio: {model: comm.radio, adapter_limit: [central]}}\n")
+                                     "channels: {radio: {model: comm.radio, adapter_limit: [central], on_loss: notify}}\n")
     net = folder / f"{mode}-{robots}.yaml"
     built = build(robots, mode, cols=cols, area=area, cell=area / cols)
     if not isinstance(built, str):  # a Net (the builder's return since it uses petriflow.netbuild)

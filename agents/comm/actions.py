@@ -189,8 +189,29 @@ def _plan(ctx: ActionContext, state: CommAgent, links: dict[str, Any]) -> None:
         usable = model.usable(state.name, peer.name, positions) if isinstance(model, RadioChannel) else True
         if usable:
             heard.add(peer.name)
+            for message in state.resend(peer.name):  # TCP gets what the radio lost through first
+                _take_in(ctx, state, message, resent=True)
             state.plan_for(peer)
     state.hear(heard)
+
+
+def _take_in(ctx: ActionContext, state: CommAgent, message: Any, resent: bool = False) -> None:
+    """One message that reached this agent: into its history and map (``resent``: one
+    the radio had lost, now through)."""
+    if resent:
+        sender = state.by_address(message.sender)
+        ctx.emit("comm.resent", sender=sender.name if sender is not None else str(message.sender),
+                 code=message.code, source=message.source)
+    new = state.receive(message)
+    sender = state.by_address(message.sender)
+    if sender is not None:
+        state.met(sender.name)  # within range here: a place to meet again
+    if new or message.final:
+        state.last_news = ctx.now
+    if new:
+        if state.explorer is not None:
+            state.explorer.learn((v // state.cols, v % state.cols) for v in new)
+        ctx.emit("comm.learnt", ids=new)
 
 
 class Explore(Action):
@@ -517,7 +538,15 @@ class Send(InstantAction):
 
 
 class Receive(InstantAction):
-    """Take one message from a channel place into this agent's history and map."""
+    """Take one message from a channel place into this agent's history and map.
+
+    The token may be the run's loss notice instead (``{"lost": True, "why": ...,
+    "data": <the packet>}``: the radio model lost the frame, and the comm radio's
+    ``on_loss`` is ``notify``): the slot goes back all the same, so the pair can talk
+    again, and the lost message is kept for TCP's retransmission
+    (:meth:`~petriflow.agents.comm.agent.CommAgent.keep_lost`): it is taken in, before
+    anything newer from that sender, when a later message of it gets through or when
+    this agent's next plan hears it."""
 
     params = {"box": Param(str, doc="the channel place", places="")}
     agent_state = CommAgent
@@ -525,20 +554,22 @@ class Receive(InstantAction):
     def run(self, ctx: ActionContext) -> None:
         state = ctx.state
         packet = ctx.inputs[self.params["box"]][0]
-        message = packet["message"] if isinstance(packet, dict) else None
+        notice = isinstance(packet, dict) and packet.get("lost") is True
+        if notice:
+            packet = packet.get("data")
+        message = packet.get("message") if isinstance(packet, dict) else None
         if message is None:
             raise ActionFailure(f"comm.receive: the token of {self.params['box']!r} carries no message")
         state.now = ctx.now
-        new = state.receive(message)
         sender = state.by_address(message.sender)
-        if sender is not None:
-            state.met(sender.name)  # within range here: a place to meet again
-        if new or message.final:
-            state.last_news = ctx.now
-        if new:
-            if state.explorer is not None:
-                state.explorer.learn((v // state.cols, v % state.cols) for v in new)
-            ctx.emit("comm.learnt", ids=new)
+        name = sender.name if sender is not None else str(message.sender)
+        if notice:
+            state.keep_lost(name, message)
+            ctx.emit("comm.lost", sender=name, code=message.code, bytes=message.size, source=message.source)
+            return
+        for earlier in state.resend(name):  # a later frame got through: so does TCP's retransmission
+            _take_in(ctx, state, earlier, resent=True)
+        _take_in(ctx, state, message)
 
 
 def has_message(state: CommAgent | None, params: dict[str, Any]) -> bool:
@@ -554,7 +585,8 @@ def _done(state: CommAgent) -> bool:
         return False
     silent = {name for name, peer in state.peers.items()
               if peer.address in state.gave_up or state.now - state.heard.get(name, state.since) > state.patience}
-    waiting = any(box for name, box in state.outbox.items() if name not in silent)
+    waiting = any(box for name, box in state.outbox.items() if name not in silent) \
+        or any(lost for name, lost in state.lost.items() if name not in silent)  # a retransmission to come
     return not waiting and not state.untold()
 
 

@@ -83,6 +83,8 @@ class CommAgent(AgentState):
     gave_up: set = field(default_factory=set)   # robots given up on (silent too long)
     last_news: float = 0.0                       # simulated time new map data last arrived
     heard: dict = field(default_factory=dict)    # peer -> simulated time of its last message
+    lost: dict = field(default_factory=dict)     # peer -> its messages the radio lost on the way here,
+                                                 # oldest first, until TCP gets them through (see resend)
     now: float = 0.0                             # simulated time of the agent's last action
     patience: float = 240.0                      # seconds of silence after which a peer counts as gone
     since: float = 0.0                           # simulated time the agent started its task
@@ -217,6 +219,20 @@ class CommAgent(AgentState):
                 self.queue(note)
                 if unsent:
                     self.queue(Message(2, source, count, self.address, peer.address, unsent, final=True))
+
+    def keep_lost(self, peer: str, message: Message) -> None:
+        """A message from ``peer`` the radio lost on the way here (the run's loss notice,
+        ``on_loss: notify``). The paper's transport is TCP (§3.2.3, "to ensure packet
+        transmission without information loss"): a lost segment is sent again until it
+        arrives, in order. Its receiving end keeps it here until the link carries frames
+        again (:meth:`resend`)."""
+        self.lost.setdefault(peer, []).append(message)
+
+    def resend(self, peer: str) -> list[Message]:
+        """The messages from ``peer`` lost on the way, oldest first, now that the link
+        carries frames again (this agent hears ``peer``, or a later message of it got
+        through): TCP's retransmission arrives before anything sent after it."""
+        return self.lost.pop(peer, [])
 
     def take(self, peer: str) -> Message | None:
         box = self.outbox.get(peer)

@@ -13,7 +13,9 @@ mailbox (``box_S_R``, the channel place in the receiver's subnet) holds at most 
 message: its slot (``slot_S_R``, with the sender) is taken by the sender and given back
 by the receiver, so the net is bounded and its analysis finite; the WF envelope's
 ``begin`` hands out every slot and ``end`` collects them, so no message is left in
-flight.
+flight. A frame the radio loses leaves a loss notice in the mailbox (the comm radio's
+``on_loss: notify``), which the receive takes like a message: a loss does not take the
+slot with it.
 
 Used directly by sweep files (``net: {builder: petriflow.agents.comm.nets:build}``);
 ``python -m petriflow.agents.comm.nets`` writes the shipped nets of ``nets/comm/``.

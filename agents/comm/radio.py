@@ -66,6 +66,12 @@ class RadioChannel(ChannelModel):
     #: ``lossless_dbm``) instead of above the framework's threshold: a central unit,
     #: which every robot must reach and which has no peers to choose between
     adapter_limit: list = field(default_factory=list)
+    #: What a lost frame leaves: a loss notice in its channel place (the run
+    #: configuration's ``on_loss``; the runtime's default is ``drop``). The paper's
+    #: transport is TCP, whose ends learn of a lost segment and send it again; a frame
+    #: dropped without a trace would also keep its mailbox's slot token for ever, and
+    #: the mission's net could never end (``comm.receive`` takes the notice).
+    on_loss = "notify"
 
     def __post_init__(self) -> None:
         self.world: Any = None
