@@ -471,8 +471,9 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_argument("--import-actions", action="store_true", help=import_help)
 
     simulate = net_command("simulate", "Play the random token game.", cmd_simulate)
-    simulate.add_argument("--steps", type=int, default=100, help="firings to make (default 100)")
-    simulate.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    simulate.add_argument("--steps", type=limits.integer_argument, default=100,
+                          help="firings to make (default 100)")
+    simulate.add_argument("--seed", type=limits.integer_argument, default=0, help="random seed (default 0)")
     simulate.add_argument("--marking", help='start marking as JSON, e.g. \'{"p1": 1}\'')
     simulate.add_argument("--json", action="store_true", help="print JSON")
 
@@ -511,9 +512,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--world", help="world description (YAML); overrides the configuration's")
     run.add_argument("--config", help="run configuration (YAML; default: the one the net names, else run.yaml"
                      " beside it)")
-    run.add_argument("--seed", type=int, help="random seed (overrides the configuration's)")
+    run.add_argument("--seed", type=limits.integer_argument,
+                     help="random seed (overrides the configuration's)")
     run.add_argument("--until", type=float, help="simulated-time limit in seconds")
-    run.add_argument("--max-firings", type=int, help="stop after this many firings")
+    run.add_argument("--max-firings", type=limits.integer_argument, help="stop after this many firings")
     run.add_argument("--trace", help="write the events as JSON Lines")
     run.add_argument("--xes", help="write the firings as an XES event log")
     run.add_argument("--db", help="SQLite run journal (new file; or the one to --resume)")
@@ -549,17 +551,17 @@ def build_parser() -> argparse.ArgumentParser:
     replay_cmd.add_argument("--net", help="the net, to draw markings")
     replay_cmd.add_argument("--draw", help="draw the marking (after --at, default: the end) to this"
                             " .svg/.png/.dot file; needs --net")
-    replay_cmd.add_argument("--at", type=int, help="event number to stop at")
+    replay_cmd.add_argument("--at", type=limits.integer_argument, help="event number to stop at")
     replay_cmd.set_defaults(handler=cmd_replay)
     check = net_command(
         "check", "Analyse a net: WF-net soundness, boundedness, deadlocks, liveness, invariants.",
         cmd_check)
     check.add_argument("--json", action="store_true", help="print JSON")
     check.add_argument("--import-actions", action="store_true", help=import_help)
-    check.add_argument("--max-states", type=int, default=None, metavar="N",
+    check.add_argument("--max-states", type=limits.integer_argument, default=None, metavar="N",
                        help="most markings to explore (default 2,000,000); beyond it the facts"
                        " found so far, and exit 2 (1 when one of them fails)")
-    check.add_argument("--max-coverability", type=int, default=None, metavar="N",
+    check.add_argument("--max-coverability", type=limits.integer_argument, default=None, metavar="N",
                        help="most nodes of the Karp-Miller search that decides boundedness before"
                        " the state space (default 100,000; 0: none)")
     check.add_argument("--method", choices=("auto", "explicit", "symmetry", "stubborn", "structural"),
@@ -567,7 +569,7 @@ def build_parser() -> argparse.ArgumentParser:
                        " (explicit), up to permutations of interchangeable agents (symmetry),"
                        " deadlocks by stubborn sets (stubborn), soundness of free-choice WF-nets"
                        " by the Rank Theorem (structural); auto (default) picks and reports which")
-    check.add_argument("--invariant-budget", type=int, default=None, metavar="N",
+    check.add_argument("--invariant-budget", type=limits.integer_argument, default=None, metavar="N",
                        help="work budget of each of the P- and T-semiflow computations (0: skip"
                        " them); default 100,000,000 steps (about 0.2 s) for P-semiflows and, for"
                        " T-semiflows, 100 steps per state and edge explored (10,000,000 to"

@@ -16,6 +16,7 @@ __all__ = [
     "UnknownElementError",
     "NotEnabledError",
     "MarkingError",
+    "NumberError",
     "DependencyNotInstalled",
     "did_you_mean",
 ]
@@ -125,6 +126,13 @@ class NotEnabledError(PetriflowError):
 
 class MarkingError(PetriflowError):
     """A marking is malformed: unknown place, negative or non-integer token count."""
+
+
+class NumberError(PetriflowError, ValueError):
+    """A whole number, as written in a file or an option, breaks petriflow's one rule for
+    them (:func:`petriflow.limits.parse_integer`): ASCII digits only, at most 2**60.
+
+    A :class:`ValueError` too, so that code expecting ``int()``'s error catches it."""
 
 
 class DependencyNotInstalled(PetriflowError):

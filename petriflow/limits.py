@@ -13,6 +13,10 @@ raising one takes effect at once:
 ``docs/limits.md`` lists every limit, the options that go with them, and what each
 one costs when raised.
 
+Beside the capacities, the fixed rules every reader shares: :func:`parse_integer` (the
+one rule for every whole number read from a file or an option: ASCII digits, at most
+:data:`MAX_INTEGER` = 2**60) and :func:`check_seconds` (simulated times).
+
 Examples:
     >>> from petriflow import limits
     >>> limits.parse("RUN_TOKENS=2e7, YAML_DEPTH=128")
@@ -26,10 +30,12 @@ Examples:
 from __future__ import annotations
 
 import os
+import re
 
-from petriflow.errors import PetriflowError, did_you_mean
+from petriflow.errors import NumberError, PetriflowError, did_you_mean
 
-__all__ = ["LIMITS", "ENVIRONMENT_VARIABLE", "MAX_SECONDS", "parse", "from_environment", "check_seconds"]
+__all__ = ["LIMITS", "ENVIRONMENT_VARIABLE", "MAX_SECONDS", "MAX_INTEGER", "parse", "from_environment",
+           "check_seconds", "parse_integer", "integer_argument"]
 
 #: Nesting depth of YAML collections (nets, worlds, run configurations).
 YAML_DEPTH = 64
@@ -63,6 +69,12 @@ SIMULATE_STEPS = 1_000_000
 #: a time divided by a world's step no longer fits a float's exact integers.
 MAX_SECONDS = 1e12
 
+#: The largest magnitude of a whole number petriflow reads, from any file or option:
+#: 2**60 = 1,152,921,504,606,846,976 (:func:`parse_integer`). A fixed rule, not a
+#: capacity: the analysis counts tokens in 64-bit integers, and counts and weights up to
+#: 2**60 keep every sum it makes exact.
+MAX_INTEGER = 2**60
+
 #: The names :func:`parse` accepts.
 LIMITS = ("YAML_DEPTH", "YAML_VALUES", "JSON_DEPTH", "PNML_PAGE_DEPTH", "INVARIANT_CELLS", "BASIS_ENTRIES",
           "RUN_TOKENS", "FIRINGS_PER_INSTANT", "WORLD_BODIES", "CAMERA_PIXELS", "SIMULATE_STEPS")
@@ -83,8 +95,8 @@ def parse(text: str) -> dict[str, int]:
         name, sep, value = (s.strip() for s in item.partition("="))
         if name not in LIMITS:
             raise PetriflowError(f"{ENVIRONMENT_VARIABLE}: unknown limit {name!r}{did_you_mean(name, LIMITS)}")
-        try:
-            number = float(value.replace("_", "")) if sep else float("nan")
+        try:  # float() reads any script's digits: ASCII ones only, as everywhere
+            number = float(value.replace("_", "")) if sep and value.isascii() else float("nan")
         except ValueError:
             number = float("nan")
         if not (1 <= number < 2**62 and number == int(number)):
@@ -120,6 +132,111 @@ def check_seconds(value: object, what: str) -> float:
         shown = repr(value) if not isinstance(value, int) or abs(value) < 10**30 else "a number of more than 30 digits"
         raise PetriflowError(f"{what} must be a time from 0 to {MAX_SECONDS:g} s, got {shown}")
     return seconds
+
+
+_INTEGER = re.compile(r"[+-]?[0-9]+")  # a range of code points: ASCII digits only, unlike \d
+_MAX_DIGITS = len(str(MAX_INTEGER))
+_XML_SPACE = " \t\r\n"
+
+
+def parse_integer(value: str | int, what: str = "the value", *, minimum: int | None = None) -> int:
+    """The whole number ``value`` is, by petriflow's one rule for them: every whole number
+    read from a file or an option goes through here (PNML counts, weights, priorities,
+    positions and tool data, YAML integers, ``--marking`` counts, ``--steps`` and the
+    other integer options).
+
+    The rule: an optional sign (``+`` or ``-``) and the ASCII digits ``0``-``9``,
+    decimal, nothing else (XSD's ``integer``: no other script's digits, no underscores,
+    no ``0x``); whitespace around it (space, tab, newline) is ignored; a magnitude of at
+    most :data:`MAX_INTEGER` (2**60). An ``int`` (a number JSON or YAML has already read)
+    is checked against the same bounds.
+
+    Args:
+        value: the text as written, or an ``int``.
+        what: what the number is, for the message (``"initial marking"``).
+        minimum: the smallest value allowed (``0`` for counts, ``1`` for weights).
+
+    Raises:
+        NumberError: one line naming ``what`` and the value (its start, when long);
+            callers add the file and line.
+
+    Examples:
+        >>> parse_integer(" 42\\n", "arc weight"), parse_integer("-7", "priority")
+        (42, -7)
+        >>> parse_integer("\\u0663", "initial marking")
+        Traceback (most recent call last):
+        ...
+        petriflow.errors.NumberError: initial marking must be written with the ASCII digits 0-9, got '\u0663' ('\u0663' is U+0663 ARABIC-INDIC DIGIT THREE)
+        >>> parse_integer("9" * 5000, "priority")
+        Traceback (most recent call last):
+        ...
+        petriflow.errors.NumberError: priority '999999999999...' (5000 digits) is beyond 2**60 = 1,152,921,504,606,846,976, the largest whole number petriflow reads
+        >>> parse_integer(-1, "tokens", minimum=0)
+        Traceback (most recent call last):
+        ...
+        petriflow.errors.NumberError: tokens must be a whole number >= 0, got -1
+    """
+    if isinstance(value, str):
+        text = value.strip(_XML_SPACE)
+        if not _INTEGER.fullmatch(text):
+            raise NumberError(_malformed(text, what))
+        digits = text.lstrip("+-").lstrip("0")
+        if len(digits) > _MAX_DIGITS:  # never int() thousands of digits (Python refuses 4,300)
+            shown = text if len(text) <= 30 else f"{_shown(text)} ({len(digits)} digits)"
+            raise NumberError(f"{what} {shown} is {_beyond(text.startswith('-'))}")
+        number = int(text)
+    elif isinstance(value, int) and not isinstance(value, bool):
+        number = value
+    else:
+        raise NumberError(f"{what} must be a whole number, got {_shown(value)}")
+    if not -MAX_INTEGER <= number <= MAX_INTEGER:
+        shown = str(number) if number.bit_length() <= 100 else "of more than 30 digits"
+        raise NumberError(f"{what} {shown} is {_beyond(number < 0)}")
+    if minimum is not None and number < minimum:
+        raise NumberError(f"{what} must be a whole number >= {minimum}, got {number}")
+    return number
+
+
+def _beyond(negative: bool) -> str:
+    if negative:
+        return f"below -2**60 = -{MAX_INTEGER:,}, the smallest whole number petriflow reads"
+    return f"beyond 2**60 = {MAX_INTEGER:,}, the largest whole number petriflow reads"
+
+
+def _shown(value: object) -> str:
+    """``value``'s repr, cut to its start when long."""
+    text = repr(value) if not isinstance(value, str) or len(value) <= 24 else repr(value[:12] + "...")
+    return text if len(text) <= 40 else text[:36] + "..."
+
+
+def _malformed(text: str, what: str) -> str:
+    import unicodedata
+
+    odd = next((c for c in text if not c.isascii() and unicodedata.decimal(c, None) is not None), None)
+    if odd is None:
+        odd = next((c for c in text if not c.isascii() and c.isdigit()), None)  # superscripts and the like
+    if odd is not None:
+        name = unicodedata.name(odd, "a digit")
+        return (f"{what} must be written with the ASCII digits 0-9, got {_shown(text)}"
+                f" ({odd!r} is U+{ord(odd):04X} {name})")
+    return f"{what} must be a whole number (ASCII digits 0-9, an optional sign), got {_shown(text)}"
+
+
+def integer_argument(text: str) -> int:
+    """The ``type`` of every whole-number command-line option (``--steps``, ``--seed``,
+    ``--max-states``, ``--workers``...): :func:`parse_integer`'s rule, its refusal an
+    argparse error (one line, exit 2). Each command checks its own option's range.
+
+    Examples:
+        >>> integer_argument("12")
+        12
+    """
+    import argparse
+
+    try:
+        return parse_integer(text)
+    except NumberError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def from_environment() -> None:

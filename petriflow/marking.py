@@ -119,8 +119,9 @@ def parse_marking(text: str, places: Any = None) -> Marking:
         places: if given, the place ids the marking may name.
 
     Raises:
-        MarkingError: the text is not a JSON object of place -> whole number, or names
-            an unknown place.
+        MarkingError: the text is not a JSON object of place -> whole number (by
+            :func:`petriflow.limits.parse_integer`'s rule: at most 2**60), or names an
+            unknown place.
 
     Examples:
         >>> parse_marking('{"p1": 2}')
@@ -129,7 +130,7 @@ def parse_marking(text: str, places: Any = None) -> Marking:
     from petriflow.io.files import parse_json
 
     try:
-        data = parse_json(text)
+        data = parse_json(text, integer=_Written)
     except ValueError as exc:
         raise MarkingError(f"marking is not valid JSON: {exc}") from None
     if not isinstance(data, dict):
@@ -141,4 +142,28 @@ def parse_marking(text: str, places: Any = None) -> Marking:
         for place in data:
             if place not in known:
                 raise MarkingError(f"marking names unknown place {place!r}{did_you_mean(place, known)}")
+    from petriflow.errors import NumberError
+    from petriflow.limits import parse_integer
+
+    for place, count in data.items():  # each count as written, by the one rule: at most 2**60
+        what = f"place {place!r}: token count"
+        try:
+            if isinstance(count, _Written):
+                data[place] = parse_integer(count, what, minimum=0)
+            elif isinstance(count, str):
+                parse_integer(count, what)  # not a number at all: the rule's own message
+                raise MarkingError(f"{what} must be a whole number, got the text {count!r}"
+                                   " (no quotes in JSON)")
+        except NumberError as exc:
+            raise MarkingError(str(exc)) from None
     return Marking(data)
+
+
+class _Written(str):
+    """A JSON integer as written, for :func:`~petriflow.limits.parse_integer` to read
+    (never ``int()`` of thousands of digits); shown without quotes, as in the JSON."""
+
+    __slots__ = ()
+
+    def __repr__(self) -> str:
+        return str.__str__(self)

@@ -291,9 +291,15 @@ def read_yaml_file(path: str | Path, *, lines: bool = False) -> Any:
                              line=mark.line + 1 if mark else None) from None
 
 
-def parse_json(text: str) -> Any:
+def parse_json(text: str, *, integer: Any = None) -> Any:
     """Parse JSON text from a file petriflow did not write itself (PNML data, traces,
     journals), refusing what would exhaust the machine or crash later.
+
+    Args:
+        text: the JSON.
+        integer: called with the text of each JSON integer, as ``json.loads``'s
+            ``parse_int`` (default ``int``); ``parse_marking`` keeps the text, so that
+            :func:`petriflow.limits.parse_integer` reads every count as written.
 
     Raises:
         ValueError: malformed JSON, nesting deeper than :data:`~petriflow.limits.JSON_DEPTH`, a number
@@ -314,7 +320,7 @@ def parse_json(text: str) -> Any:
         raise ValueError(f"{name} is not a JSON number")
 
     try:
-        value = json.loads(text, parse_constant=no_constant)
+        value = json.loads(text, parse_constant=no_constant, parse_int=integer)
     except RecursionError:
         raise ValueError(f"nested more than {limits.JSON_DEPTH} levels deep") from None
     except json.JSONDecodeError as exc:

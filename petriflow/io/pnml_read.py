@@ -36,6 +36,13 @@ two places or two transitions, reset/inhibitor arcs, counts and weights that are
 whole numbers (or are negative, or a zero weight), tokens of several colours, and
 reference cycles or dangling references.
 
+Every whole number in the file (initial and final markings, inscriptions, PIPE's
+``class,count`` pairs, SNAKES multiplicities, capacities, positions, WoPeD operator
+types, petriflow priorities and outcome weights) is read by one rule,
+:func:`petriflow.limits.parse_integer`: XSD's integer, an optional sign and the ASCII
+digits 0-9 (another script's digits, such as U+0663, are refused, not read as 3), at
+most 2**60; a refusal names the file and the line.
+
 Layout beyond node positions (arc bend points, label offsets, sizes, token graphics) is
 not kept and not reported: it has no meaning for the net. Everything else the model
 cannot hold is reported with one :class:`PnmlWarning` per kind of loss, naming the file
@@ -55,7 +62,7 @@ from defusedxml import DefusedXmlException
 from defusedxml.ElementTree import DefusedXMLParser
 
 from petriflow import limits
-from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
+from petriflow.errors import NetFormatError, NumberError, PetriflowError, did_you_mean
 from petriflow.io.files import parse_json
 from petriflow.net import OPERATOR_KINDS, OUTCOMES, Net, Operator
 
@@ -229,25 +236,18 @@ def _name_of(element: Element) -> str | None:
     return value.text.strip() or None
 
 
-def _number(text: str | None) -> int | float | None:
-    if text is None:
+#: A decimal number in ASCII (XSD's ``decimal`` or ``double``, without INF and NaN):
+#: ``float()`` alone would read any script's digits, and underscores.
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+
+
+def _decimal(text: str | None) -> float | None:
+    """``text`` as a finite float when it is an ASCII decimal number, else ``None``."""
+    text = (text or "").strip(" \t\r\n")
+    if not _DECIMAL.fullmatch(text):
         return None
-    text = text.strip()
-    if re.fullmatch(r"[+-]?\d+", text):
-        return int(text)
-    try:
-        value = float(text)
-    except ValueError:
-        return None
+    value = float(text)
     return value if math.isfinite(value) else None
-
-
-def _position(element: Element) -> list[int | float] | None:
-    position = _child(_child(element, "graphics"), "position")
-    if position is None:
-        return None
-    x, y = _number(position.get("x")), _number(position.get("y"))
-    return None if x is None or y is None else [x, y]
 
 
 def _plural(kind: str) -> str:
@@ -451,7 +451,7 @@ class _Reader:
             self.tokens[node] = tokens
         data = self.read_toolspecifics(element, "place", node, {})
         meta = dict(data.get("meta", {}))
-        position = _position(element)
+        position = self.position(element, node)
         if position is not None:
             meta["position"] = position
         capacity = _child(element, "capacity")
@@ -473,7 +473,7 @@ class _Reader:
         node = str(element.get("id"))
         data = self.read_toolspecifics(element, "transition", node, {})
         meta = dict(data.get("meta", {}))
-        position = _position(element)
+        position = self.position(element, node)
         if position is not None:
             meta["position"] = position
         guard = element.get("guard")
@@ -517,7 +517,10 @@ class _Reader:
         code, group, operator_element = found
         if not group:
             self.fail("WoPeD <operator> without an id", operator_element, node)
-        kinds = WOPED_OPERATOR_TYPES.get(int(code)) if code.strip().isdigit() else None
+        number = None
+        if re.search(r"\d", code):  # any script's digit: the one rule decides (ASCII, at most 2**60)
+            number = self.integer(code, "WoPeD operator type", operator_element, node)
+        kinds = WOPED_OPERATOR_TYPES.get(number) if number is not None else None
         if kinds is None:
             what = "OR-split" if code.strip() == "103" else f"of unknown type {code!r}"
             self.note("transition", node, f"WoPeD operator {what} has no AND/XOR equivalent; its "
@@ -612,7 +615,7 @@ class _Reader:
                 if text not in ("", "0"):
                     self.note(kind, node, "WoPeD service times are not representable; ignored")
             elif name == "probability" and kind == "arc":
-                if _number(text) != 1:
+                if _decimal(text) != 1:
                     self.note(kind, node, "WoPeD arc probabilities are not representable; ignored")
             elif name == "trigger":
                 self.note(kind, node, "WoPeD triggers (resource, message, time) are not "
@@ -638,11 +641,8 @@ class _Reader:
             elif name == "channel" and kind == "place":
                 found["channel"] = text
             elif name == "timeout" and kind == "transition":
-                try:
-                    timeout = float(text)
-                except ValueError:
-                    timeout = math.nan
-                if not timeout > 0:
+                timeout = _decimal(text)
+                if timeout is None or not timeout > 0:
                     self.fail(f"timeout must be a number of seconds > 0, got {text!r}", child, node)
                 found["timeout"] = timeout
             elif name == "cancel" and kind == "transition":
@@ -668,9 +668,7 @@ class _Reader:
                 found["run"] = run
                 found["run_line"] = _line(child)
             elif name == "priority" and kind == "transition":
-                if not re.fullmatch(r"\s*[+-]?\d+\s*", text):
-                    self.fail(f"priority must be a whole number, got {text!r}", child, node)
-                found["priority"] = int(text)
+                found["priority"] = self.integer(text, "priority", child, node)
             elif name == "operator" and kind == "transition":
                 found["operator"] = self.operator_of(child, node)
             elif name == "label":
@@ -722,17 +720,42 @@ class _Reader:
         else:
             value = self.whole(text, what, node, where)
         if value < minimum:
-            self.fail(f"{what} must be at least {minimum}, got {value}", where, node)
+            self.fail(f"{what} must be a whole number >= {minimum}, got {value}", where, node)
         return value
 
     def whole(self, text: str, what: str, node: str | None, where: Element | None) -> int:
-        if re.fullmatch(r"-\d+", text):
-            self.fail(f"{what} {text} is negative", where, node)
-        if re.fullmatch(r"\d{31,}", text):
-            self.fail(f"{what} has more than 30 digits ({text[:12]}...): too large to read", where, node)
-        if not re.fullmatch(r"\d{1,30}", text):
-            self.fail(f"{what} must be a whole number, got {text!r}", where, node)
-        return int(text)
+        """A count: a whole number >= 0 by the one rule (:func:`~petriflow.limits.parse_integer`)."""
+        return self.integer(text, what, where, node, minimum=0)
+
+    def integer(self, text: str, what: str, where: Element | None, node: str | None,
+                minimum: int | None = None) -> int:
+        """Every whole number the file holds is read here, by the one rule
+        (:func:`~petriflow.limits.parse_integer`: ASCII digits, at most 2**60); a refusal
+        names the file and the line."""
+        try:
+            return limits.parse_integer(text, what, minimum=minimum)
+        except NumberError as exc:
+            self.fail(str(exc), where, node)
+
+    def position(self, element: Element, node: str) -> list[int | float] | None:
+        """A node's ``<graphics><position x= y=>``: whole numbers by the one rule, decimals
+        (``120.0``) as floats; anything else is layout petriflow does not keep."""
+        position = _child(_child(element, "graphics"), "position")
+        if position is None:
+            return None
+        found: list[int | float] = []
+        for axis in ("x", "y"):
+            text = (position.get(axis) or "").strip(" \t\r\n")
+            # a whole number (\d: any script's digits), or another script's digit anywhere
+            # ('\u0663.5'): the rule reads it or says why not
+            if re.fullmatch(r"[+-]?\d+", text) or any(c.isdigit() and not c.isascii() for c in text):
+                found.append(self.integer(text, f"position {axis}", position, node))
+            else:
+                value = _decimal(text)
+                if value is None:
+                    return None
+                found.append(value)
+        return found
 
     def multiset_count(self, multiset: Element, node: str) -> int:
         """SNAKES' native marking: ``<multiset><item><value>…</value><multiplicity>n``.
@@ -865,7 +888,7 @@ class _Reader:
             weight_text = (element.get("weight") or "1").strip()
             weight = self.whole(weight_text, "arc weight", label, element)
             if weight < 1:
-                self.fail(f"arc weight must be at least 1, got {weight}", element, label)
+                self.fail(f"arc weight must be a whole number >= 1, got {weight}", element, label)
             try:
                 self.net.add_arc(transition, target, weight, element.get("id"), outcome=outcome)
             except PetriflowError as exc:

@@ -25,6 +25,7 @@ Examples:
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -32,7 +33,7 @@ import yaml
 
 from petriflow import limits
 from petriflow.collector import paused
-from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
+from petriflow.errors import NetFormatError, NumberError, PetriflowError, did_you_mean
 from petriflow.net import OPERATOR_KINDS, OUTCOMES, Net, Operator, Transition
 from petriflow.workflow import add_operator, operator_groups
 
@@ -64,6 +65,7 @@ class _LineList(list):
 
 _Composer = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _STR = "tag:yaml.org,2002:str"
+_INT = "tag:yaml.org,2002:int"
 _SEQ = "tag:yaml.org,2002:seq"
 _MAP = "tag:yaml.org,2002:map"
 _MERGE = "tag:yaml.org,2002:merge"
@@ -79,6 +81,12 @@ class _Builder:
     :data:`~petriflow.limits.YAML_DEPTH`, more than :data:`~petriflow.limits.YAML_VALUES`
     values once aliases are expanded
     (an "alias bomb"), an alias inside itself, and numbers too long to convert.
+
+    Integers follow petriflow's one rule (:func:`~petriflow.limits.parse_integer`):
+    decimal ASCII digits with an optional sign, at most 2**60. The other forms YAML 1.1
+    (PyYAML) reads as integers are refused with their line rather than guessed at:
+    ``0x1F``, ``0b101``, ``017`` (octal 15 in YAML 1.1, 17 in YAML 1.2), ``1_000``,
+    ``1:30`` (base 60: 90).
     """
 
     def __init__(self) -> None:
@@ -92,12 +100,34 @@ class _Builder:
         return NetFormatError(message, line=node.start_mark.line + 1)
 
     def scalar(self, node: yaml.Node) -> Any:
+        if node.tag == _INT:
+            return self.integer(node)
         try:
             return self.scalars.construct_object(node)
         except (ValueError, OverflowError) as exc:  # e.g. an integer of more than 4,300 digits
             why = "a number of more than 4,300 digits" if "digits" in str(exc) else str(exc)
             raise self.fail(f"value {node.value[:20]!r}{'...' if len(node.value) > 20 else ''} cannot be"
                             f" read: {why}", node) from None
+
+    def integer(self, node: yaml.Node) -> int:
+        """A YAML integer, by the one rule (its text, not PyYAML's reading of it)."""
+        text = node.value
+        if re.fullmatch(r"[-+]?0[0-9]+", text) or (not re.fullmatch(r"[-+]?[0-9]+", text)
+                                                   and re.fullmatch(r"[-+]?[0-9a-fA-FxXob_:]+", text)):
+            shown = text if len(text) <= 20 else text[:20] + "..."
+            meant = ""
+            if len(text) <= 20:
+                try:
+                    meant = f" (YAML 1.1 reads it as {self.scalars.construct_object(node)})"
+                except (ValueError, OverflowError):  # pragma: no cover - short texts convert
+                    pass
+            raise self.fail(f"integer {shown!r}{meant} is not plain decimal: petriflow reads whole numbers"
+                            " written with the digits 0-9 and no leading zero (no 0x, 0b, octal, _ or"
+                            " base 60); write it in decimal, or quote it to make it text", node)
+        try:
+            return limits.parse_integer(text, "integer")
+        except NumberError as exc:
+            raise self.fail(f"{exc} (quote it if it is text, such as an id)", node) from None
 
     def build(self, node: yaml.Node, depth: int = 0) -> Any:
         kind = node.__class__
@@ -269,9 +299,7 @@ class _Reader:
         if "id" not in item:
             self.fail("place without 'id'", item)
         pid = self.ident(item["id"], "a place id", item)
-        tokens = item.get("tokens", 0)
-        if isinstance(tokens, bool) or not isinstance(tokens, int) or tokens < 0:
-            self.fail(f"tokens must be a whole number >= 0, got {tokens!r}", item, pid)
+        tokens = self.whole(item.get("tokens", 0), "tokens", 0, item, pid)
         if pid in self.net.places or pid in self.net.transitions:
             self.fail("duplicate id", item, pid)
         channel = item.get("channel")
@@ -310,8 +338,29 @@ class _Reader:
         return branches
 
     def check_weight(self, weight: Any, item: Any, element: str | None) -> None:
-        if isinstance(weight, bool) or not isinstance(weight, int) or weight < 1:
-            self.fail(f"arc weight must be a whole number >= 1, got {weight!r}", item, element)
+        self.whole(weight, "arc weight", 1, item, element)
+
+    def whole(self, value: Any, what: str, minimum: int | None, item: Any = None, element: str | None = None,
+              line: int | None = None) -> int:
+        """A count, weight or priority: a YAML integer (the builder has applied the one rule
+        to how it is written: decimal ASCII digits, at most 2**60) of at least ``minimum``.
+        A number in quotes is text, and refused."""
+        if isinstance(value, str):
+            try:
+                limits.parse_integer(value, what)  # not a number at all: the rule's own message
+            except NumberError as exc:
+                self.fail(str(exc), item, element, line=line)
+            self.fail(f"{what} must be a whole number, got the text {value!r}: write it without quotes",
+                      item, element, line=line)
+        if isinstance(value, bool) or not isinstance(value, int):
+            shown = {True: "true", False: "false", None: "null"}.get(value, repr(value)) \
+                if isinstance(value, (bool, type(None))) else repr(value)
+            at_least = "" if minimum is None else f" >= {minimum}"
+            self.fail(f"{what} must be a whole number{at_least}, got {shown}", item, element, line=line)
+        try:
+            return limits.parse_integer(value, what, minimum=minimum)
+        except NumberError as exc:
+            self.fail(str(exc), item, element, line=line)
 
     def read_transition(self, item: Any, subnet: str | None, list_line: int | None = None) -> None:
         if not isinstance(item, dict):
@@ -327,9 +376,7 @@ class _Reader:
         if not isinstance(params, dict):
             self.fail("'params' must be a mapping", item, tid)
         self.record_lines(tid, item, params)
-        priority = item.get("priority", 0)
-        if isinstance(priority, bool) or not isinstance(priority, int):
-            self.fail(f"priority must be a whole number, got {priority!r}", item, tid)
+        priority = self.whole(item.get("priority", 0), "priority", None, item, tid)
         timeout = item.get("timeout")
         if timeout is not None and (isinstance(timeout, bool) or not isinstance(timeout, (int, float))
                                     or not timeout > 0):
@@ -432,9 +479,7 @@ class _Reader:
     def add_pending_arcs(self) -> None:
         for source, target, weight, line, arc_id, when in self.pending_arcs:
             element = f"{source} -> {target}"
-            if isinstance(weight, bool) or not isinstance(weight, int) or weight < 1:
-                self.fail(f"arc weight must be a whole number >= 1, got {weight!r}", line=line,
-                          element=element)
+            self.whole(weight, "arc weight", 1, line=line, element=element)
             nodes = list(self.net.places) + list(self.net.transitions)
             for end in (source, target):
                 if end not in self.net.places and end not in self.net.transitions:
@@ -453,9 +498,8 @@ class _Reader:
             place = self.ident(key, f"a place in the {what}", value)
             if place not in self.net.places:
                 self.fail(f"{what} names unknown place {place!r}{did_you_mean(place, self.net.places)}", value)
-            if isinstance(count, bool) or not isinstance(count, int) or count < 0:
-                self.fail(f"{what}: tokens of {place!r} must be a whole number >= 0", value)
-            marking[place] = count
+            marking[place] = self.whole(count, f"{what}: tokens of {place!r}", 0, value,
+                                        line=getattr(value, "key_lines", {}).get(key))
         return marking
 
     def ident(self, value: Any, what: str, item: Any, line: int | None = None) -> str:

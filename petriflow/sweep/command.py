@@ -25,6 +25,7 @@ __all__ = ["add_parser", "cmd_sweep"]
 
 def add_parser(sub) -> argparse.ArgumentParser:
     """Add the ``sweep`` command to the ``petriflow`` subcommands ``sub``."""
+    from petriflow.limits import integer_argument
     from petriflow.sweep.backends import BACKENDS, RETRIES
 
     sweep = sub.add_parser(
@@ -35,15 +36,16 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sweep.add_argument("spec", help="sweep file (YAML)")
     sweep.add_argument("--backend", choices=BACKENDS, default="local",
                        help="local worker processes (default) or a Ray cluster")
-    sweep.add_argument("--workers", type=int, help="processes (local; default: every CPU) or trials in"
-                       " flight at most (ray; default: the cluster's CPUs, as nodes come and go)")
-    sweep.add_argument("--trials", type=int, help="run seeds 1..K (overrides the file's trials or seeds)")
+    sweep.add_argument("--workers", type=integer_argument, help="processes (local; default: every CPU) or"
+                       " trials in flight at most (ray; default: the cluster's CPUs, as nodes come and go)")
+    sweep.add_argument("--trials", type=integer_argument,
+                       help="run seeds 1..K (overrides the file's trials or seeds)")
     sweep.add_argument("--db", help="SQLite results database (new file; or the one to --resume)")
     sweep.add_argument("--resume", action="store_true", help="run only the trials --db lacks, and again those"
                        " recorded crashed (their process or node died)")
     sweep.add_argument("--ray-address", help="Ray cluster address: HOST:6379 on a node of the cluster, or"
                        " ray://HOST:10001 with ray[client] (default: RAY_ADDRESS, else a local instance)")
-    sweep.add_argument("--retries", type=int, default=RETRIES, metavar="N",
+    sweep.add_argument("--retries", type=integer_argument, default=RETRIES, metavar="N",
                        help=f"ray: times a trial is tried again after its node or worker died (default {RETRIES})")
     sweep.add_argument("--ray-pip", action="append", metavar="REQUIREMENT",
                        help="ray: a package more for nodes that get petriflow's dependencies by pip (your action"

@@ -351,13 +351,13 @@ BROKEN = {
     "place-to-place": (iso('<place id="p"/><place id="q"/>\n<arc id="a" source="p" target="q"/>'),
                        "joins two places", 2),
     "negative-marking": (iso('<place id="p">\n<initialMarking><text>-1</text></initialMarking></place>'),
-                         "negative", 2),
+                         ">= 0, got -1", 2),
     "fraction-marking": (iso('<place id="p"><initialMarking>\n<text>1.5</text></initialMarking></place>'),
                          "whole number", 2),
     "word-weight": (iso('<place id="p"/><transition id="t"/><arc id="a" source="p" target="t">'
                         '\n<inscription><text>two</text></inscription></arc>'), "whole number", 2),
     "zero-weight": (iso('<place id="p"/><transition id="t"/><arc id="a" source="p" target="t">'
-                        '<inscription>\n<text>0</text></inscription></arc>'), "at least 1", 2),
+                        '<inscription>\n<text>0</text></inscription></arc>'), ">= 1, got 0", 2),
     "reference-self": (iso('<place id="p"/>\n<referencePlace id="r" ref="r"/>'), "cycle r -> r", 2),
     "reference-cycle": (iso('<place id="p"/>\n<referencePlace id="r3" ref="r7"/>\n'
                             '<referencePlace id="r7" ref="r3"/>'), "cycle r3 -> r7 -> r3", 3),
