@@ -208,6 +208,7 @@ def build_channel(name: str, spec: dict[str, Any], where: str = "channels", regi
     """
     spec = dict(spec)
     model = spec.pop("model", "ideal")
+    given = "on_loss" in spec  # written in the configuration: it overrides the model's own default
     on_loss = spec.pop("on_loss", "drop")
     if on_loss not in ("drop", "notify"):
         raise NetFormatError(f"on_loss is drop or notify, not {on_loss!r}", element=f"{where}.{name}")
@@ -231,7 +232,7 @@ def build_channel(name: str, spec: dict[str, Any], where: str = "channels", regi
     except (TypeError, ValueError) as exc:
         raise NetFormatError(f"bad parameters for channel model {model!r}: {exc}",
                              element=f"{where}.{name}") from None
-    if on_loss != "drop":
+    if given:
         built.on_loss = on_loss
     return built
 

@@ -245,3 +245,21 @@ def test_message_events_and_distances_only_for_whom_needs_them(channel, model, n
     assert all(m["distance"] == 5.0 for m in messages if m["fate"] == "sent")
     assert [e.seq for e in firings] == [e.seq for e in events if e.kind == "end"]  # the same numbering
     assert quiet.tokens.counts == listened.tokens.counts
+
+
+def test_on_loss_written_in_the_configuration_overrides_the_models_default():
+    """A model may default to notify (the comm radio does); ``on_loss: drop`` written in the
+    configuration is what the run gets."""
+    from dataclasses import dataclass
+
+    from petriflow.runtime.channels import IdealChannel, build_channel
+    from petriflow.runtime.registry import Registry
+
+    @dataclass
+    class Noticing(IdealChannel):
+        on_loss = "notify"
+
+    registry = Registry(load_plugins=False)
+    registry.register_channel("test.noticing", Noticing)
+    assert build_channel("c", {"model": "test.noticing"}, registry=registry).on_loss == "notify"
+    assert build_channel("c", {"model": "test.noticing", "on_loss": "drop"}, registry=registry).on_loss == "drop"
