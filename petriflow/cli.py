@@ -514,7 +514,7 @@ def build_parser() -> argparse.ArgumentParser:
                      " beside it)")
     run.add_argument("--seed", type=limits.integer_argument,
                      help="random seed (overrides the configuration's)")
-    run.add_argument("--until", type=float, help="simulated-time limit in seconds")
+    run.add_argument("--until", type=limits.number_argument, help="simulated-time limit in seconds")
     run.add_argument("--max-firings", type=limits.integer_argument, help="stop after this many firings")
     run.add_argument("--trace", help="write the events as JSON Lines")
     run.add_argument("--xes", help="write the firings as an XES event log")
@@ -534,7 +534,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--picture", metavar="OUT.png",
                      help="draw the world's top view with the robots' trajectories (.png, .svg or .pdf)")
     run.add_argument("--quiet", action="store_true", help="no progress on standard error")
-    run.add_argument("--progress-every", type=float, default=30.0, metavar="S",
+    run.add_argument("--progress-every", type=limits.number_argument, default=30.0, metavar="S",
                      help="off a terminal (a log, CI): a progress line every S wall seconds (default 30)")
     run.set_defaults(handler=cmd_run)
 

@@ -239,6 +239,27 @@ def integer_argument(text: str) -> int:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def number_argument(text: str) -> float:
+    """The ``type`` of every decimal command-line option (``--until``, ``--poses``,
+    ``--progress-every``, ``--max-mb``): a number written in ASCII (``2.5``, ``1e3``,
+    ``inf`` where the option allows it), never another script's digits; each command
+    checks its own option's range.
+
+    Examples:
+        >>> number_argument("2.5")
+        2.5
+    """
+    import argparse
+
+    stripped = text.strip()
+    if not stripped.isascii() or "_" in stripped:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number written in ASCII (digits 0-9, '.', 'e')")
+    try:
+        return float(stripped)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+
+
 def from_environment() -> None:
     """Apply :data:`ENVIRONMENT_VARIABLE` (if set) to this module's limits."""
     text = os.environ.get(ENVIRONMENT_VARIABLE)

@@ -261,3 +261,14 @@ def test_export_to_dash_writes_standard_output_and_no_file(tmp_path, monkeypatch
     assert main(["export", str(sequence_file), "-o", "-"]) == 2
     assert "give -f" in capfdbinary.readouterr().err.decode()
     assert [p.name for p in tmp_path.iterdir()] == ["sequence.yaml"]
+
+
+@pytest.mark.parametrize("argv", [["run", "{net}", "--until", "\u0663"], ["run", "{net}", "--until", "1_0"],
+                                  ["run", "{net}", "--poses", "\u0661"], ["view", "{net}", "--max-mb", "\u0662"],
+                                  ["run", "{net}", "--progress-every", "\uff15"]])
+def test_decimal_options_take_ascii_numbers_only(capsys, sequence_file, argv):
+    """Another script's digits are not read as a number (float() would read U+0663 as 3)."""
+    with pytest.raises(SystemExit) as exit:
+        main([a.format(net=sequence_file) for a in argv])
+    assert exit.value.code == 2
+    assert "not a number written in ASCII" in capsys.readouterr().err

@@ -54,6 +54,7 @@ from typing import Any
 
 import numpy as np
 
+from petriflow import limits
 from petriflow.analysis.coverability import (
     DEFAULT_MAX_COVERABILITY,
     CoverabilitySearch,
@@ -840,7 +841,7 @@ def format_report(result: dict[str, Any]) -> str:
 #: The largest arc weight or initial token count the analysis takes: counts are exact
 #: 64-bit integers inside the compiled exploration, and a weight this size keeps every
 #: sum exact (larger values are refused, never wrapped).
-MAX_EXACT = 2**60
+MAX_EXACT = limits.MAX_INTEGER
 
 
 def _check_range(net: Net) -> None:

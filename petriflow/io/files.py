@@ -122,7 +122,7 @@ def remove_stale(path: str | Path) -> None:
         except OSError:  # gone already, or not ours to read
             continue
         try:
-            gone = not (writer.isdigit() and _running(int(writer)))
+            gone = not (writer.isascii() and writer.isdigit() and len(writer) < 10 and _running(int(writer)))
             if fcntl is not None and not _lock(fd, wait=2.0 if gone else 0.0):
                 continue  # its writer lives
             if gone or os.fstat(fd).st_mtime < now - 60:

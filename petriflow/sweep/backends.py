@@ -269,7 +269,7 @@ def _unreachable(address: str | None, timeout: float = 5.0) -> str | None:
     if not address or address == "auto" or address.startswith("local"):
         return None
     host, _, port = address.removeprefix("ray://").rpartition(":")
-    if not host or not port.isdigit():
+    if not host or not (port.isascii() and port.isdigit()) or len(port) > 5:
         return None
     try:
         with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):

@@ -25,7 +25,7 @@ __all__ = ["add_parser", "cmd_sweep"]
 
 def add_parser(sub) -> argparse.ArgumentParser:
     """Add the ``sweep`` command to the ``petriflow`` subcommands ``sub``."""
-    from petriflow.limits import integer_argument
+    from petriflow.limits import integer_argument, number_argument
     from petriflow.sweep.backends import BACKENDS, RETRIES
 
     sweep = sub.add_parser(
@@ -55,7 +55,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     sweep.add_argument("--plot", metavar="OUT.png", help="plot each metric against the first parameter")
     sweep.add_argument("--metrics", metavar="NAMES", help="report only these metrics (comma-separated)")
     sweep.add_argument("--quiet", action="store_true", help="no progress on standard error")
-    sweep.add_argument("--progress-every", type=float, default=30.0, metavar="S",
+    sweep.add_argument("--progress-every", type=number_argument, default=30.0, metavar="S",
                        help="off a terminal: a progress line every S wall seconds (default 30)")
     sweep.set_defaults(handler=cmd_sweep)
     return sweep

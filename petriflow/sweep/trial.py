@@ -53,7 +53,7 @@ def set_path(data: Any, path: str, value: Any, root: str) -> None:
         last = depth == len(keys) - 1
         where = ".".join([root, *keys[:depth + 1]])
         if isinstance(node, list):
-            if not key.isdigit() or int(key) >= len(node):
+            if not (key.isascii() and key.isdigit()) or len(key) > 18 or int(key) >= len(node):
                 raise TrialError(f"set {root}.{path}: {where} is not an item of a list of {len(node)}")
             index = int(key)
             if last:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from petriflow.limits import number_argument
+
 __all__ = ["add_parser", "cmd_view", "DEFAULT_POSES"]
 
 #: Simulated seconds between pose samples when ``petriflow run --view`` records them
@@ -24,7 +26,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     view.add_argument("--net", help="the net the trace was recorded on (draws it)")
     view.add_argument("--sweep", help="a results database's sweep file (default: the one it names)")
     view.add_argument("-o", "--out", help="the page to write (default: SOURCE with the ending .html)")
-    view.add_argument("--max-mb", type=float, metavar="MB",
+    view.add_argument("--max-mb", type=number_argument, metavar="MB",
                       help="the most a run's page should weigh (default 20): past it, bulky event data the page"
                       " does not replay (token data in inputs and result) is left out, with the trace line")
     view.set_defaults(handler=cmd_view)
@@ -51,7 +53,7 @@ def add_run_options(run: argparse.ArgumentParser) -> None:
     run.add_argument("--view", metavar="OUT.html",
                      help="write the run's page at the end (as petriflow view does; records poses every"
                      f" {DEFAULT_POSES:g} s unless --poses says)")
-    run.add_argument("--poses", type=float, metavar="S",
+    run.add_argument("--poses", type=number_argument, metavar="S",
                      help="record the world's body poses as trace events every S simulated seconds")
 
 
