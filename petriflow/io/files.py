@@ -16,7 +16,7 @@ except ImportError:  # pragma: no cover - Windows
 
 from petriflow import limits
 
-__all__ = ["PartialFile", "write_atomic", "remove_stale", "read_yaml_file", "parse_json", "decode_text",
+__all__ = ["PartialFile", "make_database", "write_atomic", "remove_stale", "read_yaml_file", "parse_json", "decode_text",
            "read_text_file"]
 
 
@@ -165,6 +165,40 @@ def _running(pid: int) -> bool:
         return state not in (b"Z", b"X")
     except (OSError, IndexError):
         return True
+
+
+def make_database(path: str | Path, schema: str, fill: Any) -> int:
+    """Make a SQLite database (WAL) whole or not at all: its ``schema`` and what ``fill``
+    (called with the open connection, in one transaction) writes go to a
+    :class:`PartialFile`, linked into place only if nothing of that name exists. A kill at
+    any moment leaves no database or a complete one.
+
+    Returns:
+        The descriptor holding the database's lock (the caller's to close: while open, no
+        other writer takes the file).
+
+    Raises:
+        FileExistsError: ``path`` exists.
+        OSError, sqlite3.Error: it cannot be made (nothing is left behind).
+    """
+    import sqlite3
+
+    partial = PartialFile(path, opened=False)
+    try:
+        db = sqlite3.connect(str(partial.temporary), isolation_level=None)
+        try:
+            db.execute("PRAGMA journal_mode=WAL")
+            db.executescript(schema)
+            db.execute("BEGIN")
+            fill(db)
+            db.execute("COMMIT")
+        finally:
+            db.close()
+        partial.link()
+    except BaseException:
+        partial.finish(keep=False)
+        raise
+    return partial.detach()
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> None:

@@ -27,7 +27,7 @@ except ImportError:  # pragma: no cover - Windows
     fcntl = None
 
 from petriflow.errors import PetriflowError
-from petriflow.io.files import PartialFile, parse_json, remove_stale
+from petriflow.io.files import make_database, parse_json, remove_stale
 from petriflow.runtime.trace import Event
 
 __all__ = ["Journal", "JournalError", "ResumeMismatch"]
@@ -193,28 +193,13 @@ class Journal:
         if self.path.exists():
             raise JournalError(f"{self.path}: already exists; use --resume to continue it or pick a new file")
         try:
-            partial = PartialFile(self.path, opened=False)
-        except OSError as exc:
-            raise JournalError(f"{self.path}: cannot create: {exc.strerror or exc}") from None
-        try:
-            db = sqlite3.connect(str(partial.temporary), isolation_level=None)
-            try:
-                db.execute("PRAGMA journal_mode=WAL")
-                db.executescript(_SCHEMA)
-                with db:
-                    db.execute("BEGIN")
-                    db.execute("INSERT INTO run VALUES ('inputs', ?)", (json.dumps(inputs, sort_keys=True),))
-            finally:
-                db.close()
-            partial.link()
+            self._lock = make_database(self.path, _SCHEMA, lambda db: db.execute(
+                "INSERT INTO run VALUES ('inputs', ?)", (json.dumps(inputs, sort_keys=True),)))
         except FileExistsError:
-            partial.finish(keep=False)
             raise JournalError(f"{self.path}: already exists; use --resume to continue it or pick a new file") \
                 from None
         except (OSError, sqlite3.Error) as exc:
-            partial.finish(keep=False)
             raise JournalError(f"{self.path}: cannot create: {getattr(exc, 'strerror', None) or exc}") from None
-        self._lock = partial.detach()  # the lock of the journal now in place
 
     def events(self) -> list[Event]:
         """The events in the journal (committed ones only)."""

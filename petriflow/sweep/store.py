@@ -20,6 +20,7 @@ Examples:
 from __future__ import annotations
 
 import json
+import os
 import sqlite3
 import warnings
 from pathlib import Path
@@ -119,29 +120,16 @@ class Store:
         """Make the database whole or not at all: its tables and what it says it is are
         written to a temporary file beside it, linked into place only if nothing of that
         name exists, so a kill at any moment leaves no database or one that resumes."""
-        from petriflow.io.files import PartialFile
+        from petriflow.io.files import make_database
 
         assert self.path is not None
-        partial = PartialFile(self.path, opened=False)
         try:
-            db = sqlite3.connect(str(partial.temporary), isolation_level=None)
-            try:
-                db.execute("PRAGMA journal_mode=WAL")
-                db.executescript(_SCHEMA)
-                with db:
-                    db.executemany("INSERT OR REPLACE INTO sweep VALUES (?, ?)",
-                                   sorted({"format": FORMAT, **meta}.items()))
-            finally:
-                db.close()
-            partial.link()
+            lock = make_database(self.path, _SCHEMA, lambda db: db.executemany(
+                "INSERT OR REPLACE INTO sweep VALUES (?, ?)", sorted({"format": FORMAT, **meta}.items())))
         except FileExistsError:
-            partial.finish(keep=False)
             raise StoreError(f"{self.path}: already exists; use --resume to finish that sweep, or another --db") \
                 from None
-        except BaseException:
-            partial.finish(keep=False)
-            raise
-        partial.release()
+        os.close(lock)  # the sweep's driver is its one writer; SQLite's own locking suffices
 
     def _meta(self, meta: dict[str, str]) -> None:
         assert self.db is not None
