@@ -325,6 +325,7 @@ def test_limits_are_raised_and_lowered_from_the_environment(tmp_path, capsys, mo
     one_line_error(capsys, ["run", net, "--max-firings", "1"], "a run holds at most 10,000,000 in one place")
     monkeypatch.setenv("PETRIFLOW_LIMITS", "RUN_TOKENS=3e7")
     assert main(["run", str(net), "--max-firings", "1"]) == 1  # it runs: one firing, short of its sink q
+    capsys.readouterr()
     monkeypatch.setenv("PETRIFLOW_LIMITS", "RUN_TOKENS=3e7, YAML_DEPTH=2")
     one_line_error(capsys, ["info", net], "nested more than 2 levels deep")
     monkeypatch.setenv("PETRIFLOW_LIMITS", "RUN_TOKEN=1")
