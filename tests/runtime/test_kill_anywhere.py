@@ -22,6 +22,7 @@ import subprocess
 import sys
 import textwrap
 import time
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import closing
 from pathlib import Path
 
@@ -63,36 +64,35 @@ def _journaled(db: Path) -> int | None:
         return None
 
 
-def _kill_at(folder: Path, command: list[str], *, seconds: float | None = None, events: int | None = None) -> bool:
+def _kill_at(folder: Path, command: list[str], *, seconds: float | None = None,
+             events: int | None = None) -> tuple[bool, subprocess.Popen]:
     """Start ``command`` in ``folder`` and SIGKILL it after ``seconds``, or once its journal
     ``r.sqlite`` holds ``events`` events (0: once it exists with its inputs). Returns
-    whether the kill landed (else the run had ended first). The dead process is left
-    unreaped until the caller has resumed, as a shell's kill leaves it for a moment."""
+    whether the kill landed (else the run had ended first) and the dead process, which the
+    caller reaps only after it has resumed the run (as a shell's kill leaves it a moment)."""
     child = subprocess.Popen([*PETRIFLOW, *command], cwd=folder, stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL)
-    try:
-        started = time.monotonic()
-        while child.poll() is None:
-            if seconds is not None and time.monotonic() - started >= seconds:
+    started = time.monotonic()
+    while child.poll() is None:
+        if seconds is not None and time.monotonic() - started >= seconds:
+            break
+        if events is not None:
+            count = _journaled(folder / "r.sqlite")
+            if count is not None and count >= events:
                 break
-            if events is not None:
-                count = _journaled(folder / "r.sqlite")
-                if count is not None and count >= events:
-                    break
-            time.sleep(0.002)
-        landed = child.poll() is None
-        os.kill(child.pid, signal.SIGKILL)
-        return landed
+        time.sleep(0.002)
+    landed = child.poll() is None
+    child.kill()
+    return landed, child
+
+
+def _kill_and_resume(folder: Path, command: list[str], point: dict) -> tuple[bool, subprocess.CompletedProcess]:
+    folder.mkdir()
+    landed, child = _kill_at(folder, command, **point)
+    try:
+        return landed, _run(folder, *command, "--resume")
     finally:
-        _kill_at.unreaped.append(child)
-
-
-_kill_at.unreaped = []
-
-
-def _reap() -> None:
-    while _kill_at.unreaped:
-        _kill_at.unreaped.pop().wait()
+        child.wait()
 
 
 @pytest.mark.slow
@@ -112,15 +112,15 @@ def test_a_run_killed_anywhere_resumes_to_the_uninterrupted_run(tmp_path, scenar
     points = [("0.1 s", {"seconds": 0.1}), ("journal made", {"events": 0})]
     points += [(f"{k}/6 of the events", {"events": total * k // 6}) for k in range(1, 6)]
     points += [("the last event", {"events": total})]
+    # two kills at a time (one a core): each is a process of its own
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        done = {name: pool.submit(_kill_and_resume, tmp_path / name.replace("/", "-").replace(" ", "_"), command,
+                                  point) for name, point in points}
     landed = 0
-    for name, point in points:
+    for name, future in done.items():
+        hit, resumed = future.result()
+        landed += hit
         folder = tmp_path / name.replace("/", "-").replace(" ", "_")
-        folder.mkdir()
-        try:
-            landed += _kill_at(folder, command, **point)
-            resumed = _run(folder, *command, "--resume")
-        finally:
-            _reap()
         assert resumed.returncode == clean.returncode, f"killed at {name}: {resumed.stderr}"
         assert "Traceback" not in resumed.stderr
         assert (folder / "c.jsonl").read_bytes() == expected, f"killed at {name}: the trace differs"
