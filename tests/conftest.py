@@ -111,10 +111,11 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.slow)
 
 
-def pytest_terminal_summary(terminalreporter, config):
-    """Name the random test order's seed in the last lines, where ``-q`` leaves it (it
+def pytest_unconfigure(config):
+    """Name the random test order's seed on the very last line, where ``-q`` leaves it (it
     hides the header pytest-randomly prints it in): the same order runs again with it."""
     seed = getattr(config.option, "randomly_seed", None)
-    if config.pluginmanager.hasplugin("randomly") and isinstance(seed, int):
-        terminalreporter.write_line(f"random test order seed {seed}: rerun this order with"
-                                    f" bash scripts/test.sh --randomly-seed={seed}")
+    reporter = config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is not None and config.pluginmanager.hasplugin("randomly") and isinstance(seed, int):
+        reporter.write_line(f"random test order seed {seed}: rerun this order with"
+                            f" bash scripts/test.sh --randomly-seed={seed}")

@@ -34,4 +34,4 @@ def test_a_quiet_test_run_names_its_random_order_seed(tmp_path):
     done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "randomly", "--randomly-seed=7",
                            str(ROOT / "tests" / "test_marking.py")], cwd=ROOT, capture_output=True, text=True)
     assert done.returncode == 0, done.stdout[-2000:]
-    assert "--randomly-seed=7" in done.stdout.splitlines()[-2]
+    assert "--randomly-seed=7" in done.stdout.splitlines()[-1]
