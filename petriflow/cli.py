@@ -231,10 +231,10 @@ def cmd_export(args: argparse.Namespace) -> int:
         raise PetriflowError("-o -: standard output has no file ending to tell the format by; give -f")
     # a bad format or ending fails before any work
     format = format_of(f"net.{args.format}" if to_stdout else args.output, args.format)
-    from petriflow.runtime.session import _check_outputs
+    from petriflow.runtime.outputs import check_outputs
 
     if not to_stdout:
-        _check_outputs({"--output": args.output}, [args.net])
+        check_outputs({"--output": args.output}, [args.net])
     size = _size(args.size)
     net = load_net(args.net)
     marking = _start_marking(net, args.marking)
@@ -331,7 +331,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         "reason": result.reason,
         "time": result.time,
         "firings": result.firings,
-        "events": result.events,
+        "events": result.event_count,
         "wall_seconds": round(outcome.wall, 3),
         "realtime_factor": round(outcome.realtime_factor, 2) if outcome.wall > 0 and result.time > 0 else None,
         "seed": outcome.seed,

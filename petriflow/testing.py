@@ -36,6 +36,7 @@ from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 from petriflow.net import Net
 from petriflow.runtime.action import Action, ActionContext, Outcome, Param, Status
+from petriflow.runtime.services import RunServices
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.trace import Event
 
@@ -121,9 +122,9 @@ def fire_one(
 
 def _fire(net: Net, binding: Any, config: Any, world: Any, transition: str, marking: Mapping[str, int] | None,
           tokens: Mapping[str, Sequence[Any]] | None, seed: int, timeout: float) -> FiredTransition:
-    from petriflow.runtime.assembly import open_run
+    from petriflow.runtime.assembly import CheckedRun, open_run
 
-    with open_run(net, binding, config, seed=seed, world=world) as scheduler:
+    with open_run(CheckedRun(net, binding, config), seed=seed, world=world) as scheduler:
         if tokens is not None:
             scheduler.set_tokens({p: list(v) for p, v in tokens.items()})
         elif marking is not None:
@@ -188,8 +189,8 @@ def load(net: Net | str | Path, *, config: Any = None, world: Any = None,
     Raises:
         NetFormatError: a file is missing or malformed, or an action does not bind.
     """
-    from petriflow.runtime.assembly import validate
     from petriflow.runtime.config import RunConfig, load_config
+    from petriflow.runtime.validation import validate
 
     if isinstance(net, (str, Path)) or (config is None and getattr(net, "path", None)):
         from petriflow.runtime.session import prepare
@@ -289,8 +290,16 @@ class ScriptedAction(Action):
         self._count("teardown")
 
 
+class _NoTokens:
+    """The tokens of a context made outside a run: every place is empty."""
+
+    def read(self, place: str) -> list[Any]:
+        return []
+
+
 class StubWorld:
-    """A world with no physics: a clock, fixed agent positions, and a step counter."""
+    """A world with no physics: a clock, fixed agent positions, and a step counter (the
+    :class:`~petriflow.capabilities.Distances` an action or a radio channel asks of it)."""
 
     def __init__(self, dt: float = 0.01, positions: Mapping[str, tuple[float, float]] | None = None) -> None:
         self.dt = dt
@@ -334,10 +343,8 @@ def check_action(cls: type[Action], params: Mapping[str, Any] | None = None, wor
     except Exception as exc:
         return [f"parameters do not check: {exc}"]
     action = cls(checked)
-    from types import SimpleNamespace
-
     ctx = ActionContext(transition="check", agent=None, params=checked, inputs={}, world=world, seed=0,
-                        started=0.0, _run=SimpleNamespace(tokens=SimpleNamespace(read=lambda place: [])))
+                        started=0.0, services=RunServices(tokens=_NoTokens()), action=cls)
     hook = "setup"
     try:
         action.setup(world)

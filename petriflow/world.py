@@ -17,7 +17,7 @@ The description is plain data (a ``world.yaml`` beside a net)::
          yaw: 0, colour: red, agent: robot_red}
       # optional: z (base height), roll and pitch (rad, about the body's x and y
       # axes, applied after yaw): a robot that starts fallen on its side
-    meta: {}                 # free-form data the world keeps (``World.meta``) but never reads
+    meta: {}                 # scenario settings: sections the actions declare and read
     cameras:
       - {id: top, position: [0, 0, 6], target: [0, 0, 0], up: [0, 1, 0], fov: 60,
          width: 640, height: 480}
@@ -183,12 +183,32 @@ class RayRequest:
 class World:
     """A pybullet physics client built from a description.
 
+    It provides every capability of :mod:`petriflow.capabilities` (poses, bodies, ray
+    tests, cameras, kinematic drive, physics, a world file's ``meta``), so any action
+    may declare them for a run over a world file.
+
     Args:
         description: the world as plain data (see the module docstring).
         base: folder that relative URDF paths start from.
         gui: open pybullet's GUI instead of DIRECT mode.
         path: the description's file, named in errors.
     """
+
+    #: Seconds per physics step.
+    dt: float
+    #: The pybullet module, and this world's physics client.
+    p: Any
+    client: int
+    #: ``{body name: pybullet body id}`` and ``{agent: its robot's body name}``.
+    bodies: dict[str, int]
+    agents: dict[str, str]
+    #: ``{camera id: Camera}``.
+    cameras: dict[str, Camera]
+    #: The description's ``meta``: scenario settings, read through declared sections
+    #: (:mod:`petriflow.runtime.settings`).
+    meta: dict[str, Any]
+    #: The description's file (``None``: built in code).
+    path: str | None
 
     def __init__(self, description: dict[str, Any] | None = None, *, base: str | Path = ".",
                  gui: bool = False, path: str | None = None) -> None:
@@ -197,8 +217,7 @@ class World:
         description = check_world(description, path)  # every field, before pybullet is touched
         self.p = _pybullet()
         self.dt = description["dt"]
-        #: Free-form data from the description's ``meta`` (kept for other components, unread here).
-        self.meta: dict[str, Any] = dict(description["meta"])
+        self.meta = dict(description["meta"])
         p = self.p
         if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             # pybullet would end the whole process (exit 1, no message) without an X display

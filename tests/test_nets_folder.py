@@ -29,8 +29,8 @@ def test_shipped_net_loads_plays_and_round_trips(path):
 @pytest.mark.parametrize("path", NET_FILES, ids=lambda p: str(p.relative_to(NETS)))
 def test_shipped_net_binds_every_action(path):
     """Every action and guard a shipped net names is registered, with valid parameters."""
-    from petriflow.runtime.registry import default_registry
+    from petriflow.runtime.binding import bind
 
     net = load_net(path)
-    bound = default_registry.bind(net, str(path))
+    bound = bind(net, path=str(path))
     assert set(bound.actions()) == set(net.actions())

@@ -39,10 +39,11 @@ import inspect
 import math
 import random
 from dataclasses import dataclass, field
-from typing import Any, Callable, ClassVar, Generator
+from typing import Any, Callable, ClassVar, Generator, Mapping, TypeVar
 
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
 from petriflow.outcome import Outcome
+from petriflow.runtime.services import AgentStates, ChannelLookup, RunServices
 
 __all__ = [
     "Status",
@@ -53,9 +54,12 @@ __all__ = [
     "InstantAction",
     "ActionContext",
     "ActionFailure",
+    "StateChange",
     "generator_action",
     "REQUIRED",
 ]
+
+_S = TypeVar("_S")
 
 
 class Status(enum.Enum):
@@ -127,29 +131,34 @@ class Param:
             found = nxt
         return [f for f in found if f is not None]
 
-    def check(self, name: str, value: Any, where: str) -> Any:
+    def check(self, name: str, value: Any, where: str, what: str = "parameter") -> Any:
+        """``value`` checked (an int for a ``float`` becomes a float).
+
+        Raises:
+            NetFormatError: ``where``: ``{what} {name!r} must be ...``.
+        """
         types = self.type if isinstance(self.type, tuple) else (self.type,)
         if float in types and isinstance(value, int) and not isinstance(value, bool):
             try:
                 value = float(value)
             except OverflowError:
-                raise NetFormatError(f"parameter {name!r} is too large a number, got {value!r}",
+                raise NetFormatError(f"{what} {name!r} is too large a number, got {value!r}",
                                      element=where) from None
         if isinstance(value, float) and not math.isfinite(value):
-            raise NetFormatError(f"parameter {name!r} must be a finite number, got {value!r}", element=where)
+            raise NetFormatError(f"{what} {name!r} must be a finite number, got {value!r}", element=where)
         if self.type is not object and not isinstance(value, types):
             wanted = " or ".join(t.__name__ for t in types)
-            raise NetFormatError(f"parameter {name!r} must be {wanted}, got {value!r}", element=where)
+            raise NetFormatError(f"{what} {name!r} must be {wanted}, got {value!r}", element=where)
         if self.choices and value not in self.choices:
             raise NetFormatError(
-                f"parameter {name!r} must be one of {list(self.choices)}, got {value!r}", element=where
+                f"{what} {name!r} must be one of {list(self.choices)}, got {value!r}", element=where
             )
         if (self.low is not None or self.high is not None) and isinstance(value, (int, float)) \
                 and not isinstance(value, bool):
             if (self.low is not None and value < self.low) or (self.high is not None and value > self.high):
                 span = (f"from {self.low:g} to {self.high:g}" if self.low is not None and self.high is not None
                         else f">= {self.low:g}" if self.low is not None else f"<= {self.high:g}")
-                raise NetFormatError(f"parameter {name!r} must be {span}, got {value!r}", element=where)
+                raise NetFormatError(f"{what} {name!r} must be {span}, got {value!r}", element=where)
         return value
 
 
@@ -211,6 +220,42 @@ def first_data(inputs: dict[str, list[Any]]) -> Any:
     return None
 
 
+class StateChange:
+    """What a generator action yields to sleep until its agent's state changes.
+
+    ``yield StateChange("outbox", "step")`` resumes the generator when one of those keys
+    of its agent's state is touched (:meth:`~petriflow.runtime.agents.AgentState.touch`);
+    ``StateChange()`` (or ``"*"``) when anything of the state changes, or any firing of
+    the agent starts or ends; ``within=seconds`` also resumes it after that much
+    simulated time, whichever comes first. The generator then looks at the state again
+    (a change of a key is no promise about the value). Nothing polls it meanwhile (see
+    :attr:`Action.wake_on`).
+
+    Examples:
+        >>> StateChange("outbox", within=2.0)
+        StateChange('outbox', within=2.0)
+    """
+
+    __slots__ = ("keys", "within")
+
+    def __init__(self, *keys: str, within: float | None = None) -> None:
+        if not all(isinstance(k, str) and k for k in keys):
+            raise PetriflowError(f"StateChange takes state keys (text), got {keys!r}")
+        if within is not None and (isinstance(within, bool) or not isinstance(within, (int, float))
+                                   or not within >= 0):
+            raise PetriflowError(f"StateChange: within is a number of seconds >= 0, got {within!r}")
+        self.keys: tuple[str, ...] = keys or (ANY_KEY,)
+        self.within = within
+
+    def __repr__(self) -> str:
+        keys = ", ".join(repr(k) for k in self.keys)
+        return f"StateChange({keys}{'' if self.within is None else f', within={self.within!r}'})"
+
+
+#: The state key that stands for any change of an agent's state.
+ANY_KEY = "*"
+
+
 @dataclass(eq=False, slots=True)
 class ActionContext:
     """What an action sees during one firing.
@@ -220,7 +265,8 @@ class ActionContext:
         agent: the agent running it (its subnet's agent), or ``None``.
         params: the checked parameters.
         inputs: ``{place id: [token data, ...]}`` consumed by the firing.
-        world: the world the run steps (``None`` in a world-less run).
+        world: the world the run steps (``None`` in a world-less run); it provides the
+            capabilities the action declares (:attr:`Action.uses`).
         seed: seed of this firing's :attr:`rng` (the run seed and the firing number).
         started: simulated time the action started.
         now: current simulated time (updated by the scheduler before each call).
@@ -230,6 +276,10 @@ class ActionContext:
         outputs: ``{place: data}`` for output places whose tokens get other data than
             ``result`` (see :meth:`put`).
         reason: why the action failed, when it did.
+        emitted: the custom events recorded so far (:meth:`emit`).
+        services: the run's services (:class:`~petriflow.runtime.services.RunServices`);
+            ``None`` outside a run.
+        action: the bound action's class (what it declares: resources, settings).
     """
 
     transition: str
@@ -245,12 +295,12 @@ class ActionContext:
     outputs: dict[str, Any] | None = None
     reason: str = ""
     emitted: list[tuple[str, dict[str, Any]]] | None = None
+    services: RunServices | None = field(default=None, repr=False)
+    action: type[Action] | None = field(default=None, repr=False)
     _rng: random.Random | None = field(default=None, repr=False)
-    _run: Any = field(default=None, repr=False)  # the run's services (RunServices), None outside a run
-    _declared: dict[str, str] | None = field(default=None, repr=False)
 
-    def _service(self, name: str, what: str) -> Any:
-        service = getattr(self._run, name, None)
+    def _need(self, service: _S | None, what: str) -> _S:
+        """``service`` of the run, or the error that there is none."""
         if service is None:
             raise PetriflowError(f"{self.transition!r}: no run to {what}")
         return service
@@ -262,6 +312,9 @@ class ActionContext:
             self._rng = random.Random(self.seed)
         return self._rng
 
+    def _agents(self) -> AgentStates:
+        return self._need(None if self.services is None else self.services.agents, "keep an agent state in")
+
     @property
     def state(self) -> Any:
         """The state of this firing's agent (``None`` until one of its actions sets it).
@@ -270,12 +323,11 @@ class ActionContext:
         :mod:`petriflow.runtime.agents`); it must be of the type the agent's subnet
         declares, if it declares one.
         """
-        return self._service("agents", "keep an agent state in").state(self.agent)
+        return self._agents().state(self.agent)
 
     @state.setter
     def state(self, value: Any) -> None:
-        agents = self._service("agents", "keep an agent state in")
-        agents.set_state(self.agent, value, agents.index.state_type.get(self.agent))
+        self._agents().set_state(self.agent, value)
 
     def resource(self, name: str) -> Any:
         """The run's resource the action declares as ``name`` (its ``resources``).
@@ -283,11 +335,32 @@ class ActionContext:
         Raises:
             PetriflowError: the action declares no resource of that name, or no run.
         """
-        kind = (self._declared or {}).get(name)
+        declared = {} if self.action is None else self.action.resources
+        kind = declared.get(name)
         if kind is None:
             raise PetriflowError(f"{self.transition!r}: the action declares no resource {name!r}"
-                                 f"{did_you_mean(name, self._declared or {})}")
-        return self._service("resources", f"take resource {name!r} from").get(kind)
+                                 f"{did_you_mean(name, declared)}")
+        resources = None if self.services is None else self.services.resources
+        return self._need(resources, f"take resource {name!r} from").get(kind)
+
+    @property
+    def settings(self) -> Mapping[str, Any]:
+        """The world file's settings the action declares (:attr:`Action.settings`),
+        checked when the world was loaded, defaults filled in: ``{name: value}``.
+
+        Raises:
+            PetriflowError: the action declares no settings, or no run.
+        """
+        section = None if self.action is None else self.action.settings
+        if section is None:
+            raise PetriflowError(f"{self.transition!r}: the action declares no world settings (settings =)")
+        if self.services is None:
+            raise PetriflowError(f"{self.transition!r}: no run to read settings {section.name!r} from")
+        values = self.services.settings.get(section.name)
+        if values is None:
+            raise PetriflowError(f"{self.transition!r}: the run did not read the world's settings"
+                                 f" {section.name!r} (bind the net with its actions first)")
+        return values
 
     @property
     def elapsed(self) -> float:
@@ -305,17 +378,22 @@ class ActionContext:
         (oldest first; empty when the port names no place or the place is empty).
 
         Raises:
-            PetriflowError: ``port`` is not a port the action declares.
+            PetriflowError: no run to read from.
         """
         place = self.params.get(port)
         if place is None:
             return []
-        return self._service("tokens", f"read port {port!r} from").read(place)
+        tokens = None if self.services is None else self.services.tokens
+        return self._need(tokens, f"read port {port!r} from").read(place)
 
     def latest(self, port: str, default: Any = None) -> Any:
         """The data of the newest token in the port's place, or ``default``."""
         tokens = self.read(port)
         return tokens[-1] if tokens else default
+
+    def _channels(self, place: str) -> ChannelLookup:
+        channels = None if self.services is None else self.services.channels
+        return self._need(channels, f"look up channel place {place!r} in")
 
     def link(self, place: str) -> tuple[Any, str | None]:
         """The channel model that carries the channel place ``place`` and the agent that
@@ -324,7 +402,7 @@ class ActionContext:
         Raises:
             PetriflowError: no run, or ``place`` is not a channel place.
         """
-        return self._service("channels", f"look up channel place {place!r} in").model_for(place)
+        return self._channels(place).model_for(place)
 
     def medium(self, place: str) -> Any:
         """What the medium carrying the channel place ``place`` lets this firing's agent
@@ -335,12 +413,13 @@ class ActionContext:
             PetriflowError: no run, ``place`` is not a channel place, or its model offers
                 no view.
         """
-        return self._service("channels", f"look up channel place {place!r} in").view(place, self.agent)
+        return self._channels(place).view(place, self.agent)
 
     def running(self, agent: str | None) -> bool:
         """Whether ``agent`` runs now: not killed, not waiting to join (what a radio
         learns from an agent's beacon). ``True`` outside a run."""
-        return True if self._run is None else self._run.faults.alive(agent)
+        liveness = None if self.services is None else self.services.liveness
+        return True if liveness is None else liveness.alive(agent)
 
     def put(self, place: str, data: Any) -> None:
         """Give the tokens this firing produces in ``place`` the data ``data`` instead
@@ -367,17 +446,35 @@ class Action:
         params: class attribute ``{name: Param}`` declaring the parameters (and
             :class:`Port`\\ s); on an instance, the checked values.
         needs_world: whether the action must be polled at every world step (True) or
-            only at the times it asks for through :attr:`wake_at` (False).
+            only at the times it asks for through :attr:`wake_at` and :attr:`wake_on`
+            (False).
         wake_at: for ``needs_world = False``: the simulated time of the next poll
-            (``None``: the next tick).
+            (``None``: the next tick, or, with :attr:`wake_on`, no time).
     """
 
     params: ClassVar[dict[str, Param]] = {}
     needs_world: ClassVar[bool] = True
+    #: The world capabilities the action uses (protocols of :mod:`petriflow.capabilities`:
+    #: ``(Poses, RayTests)``), checked when the net is bound: the run must have a world
+    #: that provides each one (``file:line`` and what it lacks). What an action declares
+    #: here it calls on ``ctx.world`` without probing it.
+    uses: ClassVar[tuple[type, ...]] = ()
+    #: The world file's settings the action reads: a
+    #: :class:`~petriflow.runtime.settings.Section` (its name under the world's ``meta``
+    #: and the settings it holds), checked when the world is loaded, read with
+    #: ``ctx.settings``; ``None``: none.
+    settings: ClassVar[Any] = None
+    #: For an action that does not step with the world: the keys of its agent's state
+    #: whose change wakes it (``("*",)``: any change), set before :meth:`poll` (or
+    #: :meth:`start`) returns; ``None``: it does not wait on its state. It is then polled
+    #: when one of those keys changes (or at :attr:`wake_at`, whichever comes first),
+    #: and never in between (see :mod:`petriflow.runtime.agents`, "Waiting on state").
+    wake_on: tuple[str, ...] | None = None
     #: What a transition bound to this action must have, checked when the net is bound
     #: (exit 2, ``file:line``) instead of failing when it fires: ``"agent"`` (the
     #: transition is in an agent subnet), ``"robot"`` (a ``robot`` parameter, or an agent
-    #: subnet whose agent is the robot), ``"world"`` (the run has a world). Override
+    #: subnet whose agent is the robot), ``"world"`` (the run has a world; declaring
+    #: capabilities in :attr:`uses` implies it). Override
     #: :meth:`requirements` when they depend on the parameters.
     requires: ClassVar[frozenset[str]] = frozenset()
     #: The type of agent state the action reads and writes through ``ctx.state`` (a class
@@ -459,9 +556,11 @@ class Action:
 
         Called right after :meth:`start` (in the same instant; for an action with
         ``needs_world`` unset whose :meth:`start` set :attr:`wake_at` ahead, first at
-        that time), then at every world step while ``needs_world`` is set, else when
-        :attr:`wake_at` comes (or the next tick if it is ``None``). ``ctx.now`` is the
-        current simulated time. Never block or sleep: command the world and return.
+        that time, or whose start set :attr:`wake_on`, first when that comes), then at
+        every world step while ``needs_world`` is set, else when :attr:`wake_at` comes
+        or a key of :attr:`wake_on` changes (or the next tick if neither is set).
+        ``ctx.now`` is the current simulated time. Never block or sleep: command the
+        world and return.
 
         Returns:
             ``Status.RUNNING`` to be polled again, ``Status.OK`` when done (set
@@ -538,7 +637,8 @@ def generator_action(
 
     A plain function finishes at once with its return value as result. A generator
     function runs across ticks: ``yield`` waits one world step, ``yield seconds`` waits
-    that much simulated time, ``return value`` finishes; raising
+    that much simulated time, ``yield StateChange(keys)`` sleeps until its agent's
+    state changes (:class:`StateChange`), ``return value`` finishes; raising
     :class:`ActionFailure` (or any exception) fails the action.
 
     Examples:
@@ -566,7 +666,7 @@ class _FunctionAction(Action):
 
     def start(self, ctx: ActionContext) -> None:
         self._done = False
-        self.wake_at = None
+        self.wake_at = self.wake_on = None
         if not self.is_generator:
             ctx.result = self.function(ctx)
             self._done = True
@@ -581,15 +681,21 @@ class _FunctionAction(Action):
             ctx.result = stop.value
             self._done = True
             return
+        self.wake_on = None
         if wait is None:
             self.wake_at = None
+        elif isinstance(wait, StateChange):
+            self.wake_on = wait.keys
+            self.wake_at = None if wait.within is None else ctx.now + float(wait.within)
         else:
             if isinstance(wait, bool) or not isinstance(wait, (int, float)) or wait < 0:
-                raise ActionFailure(f"yielded {wait!r}; yield nothing or a number of seconds")
+                raise ActionFailure(f"yielded {wait!r}; yield nothing, a number of seconds or a StateChange")
             self.wake_at = ctx.now + float(wait)
 
     def poll(self, ctx: ActionContext) -> Status:
-        if not self._done and (self.wake_at is None or ctx.now >= self.wake_at - 1e-12):
+        # asleep on its state, it is polled only when woken (a change, or its time)
+        if not self._done and (self.wake_on is not None or self.wake_at is None
+                               or ctx.now >= self.wake_at - 1e-12):
             self._advance(ctx, None)
         return Status.OK if self._done else Status.RUNNING
 

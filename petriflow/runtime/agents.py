@@ -20,6 +20,20 @@ the guards whose inputs changed run again. A state says what changed with
 :meth:`AgentState.touch`; anything one of the agent's own transitions does (a firing
 starting or ending) counts as a change of ``"*"``.
 
+**Waiting on state.** An action that has nothing to do until its agent's state changes
+(a message arrives, a step is decided) sleeps on keys of that state instead of
+polling it every tick: it sets :attr:`~petriflow.runtime.action.Action.wake_on` (a
+generator action yields a :class:`~petriflow.runtime.action.StateChange`) and the run
+registers its firing here (:class:`Sleepers`). A :meth:`AgentState.touch` of one of
+those keys wakes it; a wait on ``"*"`` wakes on any touch, and on anything its agent's
+transitions do (as a guard reading ``"*"`` is checked again). The woken firing is
+polled at the tick a firing polled at every tick would first see the change: in the
+same instant when its poll there is still to come (the change happened in a timed
+event, or in the poll of an earlier firing), else at the next tick. So a sleeping
+action gives the same events, at the same times, as its polled twin, and costs
+nothing while it sleeps; a run in which nothing but sleepers is left ends ``dead``
+(a polled twin would step on until its time or stall limit).
+
 Examples:
     >>> class Counter(AgentState):
     ...     def __init__(self): super().__init__(); self.n = 0
@@ -32,18 +46,20 @@ Examples:
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Callable, Iterable
+from typing import TYPE_CHECKING, Any, Callable, Iterable, MutableMapping, Protocol
 
 from petriflow.errors import PetriflowError
+from petriflow.runtime.action import ANY_KEY
 
 if TYPE_CHECKING:
     from petriflow.runtime.enabling import EnabledSet
     from petriflow.runtime.index import RunIndex
 
-__all__ = ["AgentState", "Agents", "ANY"]
+__all__ = ["AgentState", "Agents", "ANY", "Sleepers", "Sleeper"]
 
-#: The key a guard reads to be re-checked after anything its agent does.
-ANY = "*"
+#: The key a guard reads (or a sleeping action waits on) to be re-checked after
+#: anything its agent does.
+ANY = ANY_KEY
 
 
 class AgentState:
@@ -72,18 +88,93 @@ class AgentState:
         return {"state": type(self).__name__}
 
 
+class Sleeper(Protocol):
+    """A firing asleep on its agent's state (the run's
+    :class:`~petriflow.runtime.lifecycle.Firing`): it says whether a registration is
+    still its current sleep, and wakes."""
+
+    def asleep_on(self, nap: int) -> bool:
+        """Whether the sleep ``nap`` is still the firing's current one."""
+
+    def rouse(self) -> None:
+        """Its state changed: have it polled when a polled firing would see the change."""
+
+
+class Sleepers:
+    """The firings asleep until keys of their agent's state change (see the module).
+
+    Registrations are kept by agent and key; one whose firing has been polled since
+    (woken by its time, cancelled) is dropped the next time its key changes or its
+    list is pruned, so a sleep costs nothing but its entry.
+
+    Examples:
+        >>> class Nap:
+        ...     def __init__(self): self.naps = 1; self.woken = 0
+        ...     def asleep_on(self, nap): return nap == self.naps
+        ...     def rouse(self): self.woken += 1; self.naps += 1
+        >>> sleepers, nap = Sleepers(), Nap()
+        >>> sleepers.add("r1", ("outbox",), nap, 1)
+        >>> sleepers.touched("r1", ("step",)); nap.woken
+        0
+        >>> sleepers.touched("r1", ("outbox",)); sleepers.touched("r1", ("outbox",)); nap.woken
+        1
+    """
+
+    def __init__(self) -> None:
+        self._keyed: dict[str, dict[str, list[tuple[Sleeper, int]]]] = {}
+        #: ``{agent: [(firing, nap), ...]}`` of the firings asleep on any change (``"*"``).
+        self.any: dict[str, list[tuple[Sleeper, int]]] = {}
+
+    def add(self, agent: str, keys: Iterable[str], firing: Sleeper, nap: int) -> None:
+        """``firing`` sleeps (its sleep ``nap``) until one of ``keys`` of ``agent``'s state changes."""
+        for key in keys:
+            entries = (self.any.setdefault(agent, []) if key == ANY
+                       else self._keyed.setdefault(agent, {}).setdefault(key, []))
+            entries.append((firing, nap))
+            if len(entries) >= 16 and not len(entries) & (len(entries) - 1):  # at 16, 32, 64...: prune
+                entries[:] = [(f, n) for f, n in entries if f.asleep_on(n)]
+
+    def touched(self, agent: str, keys: Iterable[str]) -> None:
+        """Keys of ``agent``'s state changed: wake the firings asleep on them (and on ``"*"``)."""
+        keyed = self._keyed.get(agent)
+        woken: list[tuple[Sleeper, int]] = []
+        if keyed:
+            for key in keys:
+                woken.extend(keyed.pop(key, ()))
+        woken.extend(self.any.pop(agent, ()))
+        self._wake(woken)
+
+    def acted(self, agent: str) -> None:
+        """A firing of ``agent`` started or ended: wake the firings asleep on ``"*"``."""
+        self._wake(self.any.pop(agent, ()))
+
+    @staticmethod
+    def _wake(entries: Iterable[tuple[Sleeper, int]]) -> None:
+        for firing, nap in entries:
+            if firing.asleep_on(nap):  # once, even when it slept on several of the keys
+                firing.rouse()
+
+
 class Agents:
-    """A run's agent states and the guard answers they decide (see the module).
+    """A run's agent states, the guard answers they decide and the firings asleep on
+    them (see the module).
 
     Args:
         index: the run's net index (per transition: agent, guard reads).
         enabled: the run's enabled set (whose guard answers this invalidates).
+        states: where the states are kept, ``{agent: state}`` (shared with the enabled
+            set, whose state guards read it).
+
+    Attributes:
+        sleepers: the firings asleep until their agent's state changes.
     """
 
-    def __init__(self, index: "RunIndex", enabled: "EnabledSet") -> None:
+    def __init__(self, index: "RunIndex", enabled: "EnabledSet",
+                 states: MutableMapping[str, Any] | None = None) -> None:
         self.index = index
         self.enabled = enabled
-        self.states: dict[str, Any] = {}
+        self.states: MutableMapping[str, Any] = {} if states is None else states
+        self.sleepers = Sleepers()
         self._any: dict[str, list[int]] = {}  # agent -> transitions whose guard reads "*"
         self._readers: dict[str, dict[str, list[int]]] = {}  # agent -> key -> transitions
         for t, reads in enumerate(index.reads):
@@ -105,7 +196,8 @@ class Agents:
         return None if agent is None else self.states.get(agent)
 
     def set_state(self, agent: str | None, state: Any, expected: type | tuple | None = None) -> None:
-        """Make ``state`` the state of ``agent``.
+        """Make ``state`` the state of ``agent`` (of the type ``expected``, by default
+        the one the agent's subnet declares).
 
         Raises:
             PetriflowError: no agent (the transition is outside every agent's subnet),
@@ -113,6 +205,8 @@ class Agents:
         """
         if agent is None:
             raise PetriflowError("an agent state needs an agent: put the transition in an agent subnet")
+        if expected is None:
+            expected = self.index.state_type.get(agent)
         if expected is not None and state is not None and not isinstance(state, expected):
             raise PetriflowError(f"agent {agent!r}: its state must be a {_names(expected)}, not"
                                  f" {type(state).__name__}")
@@ -125,21 +219,27 @@ class Agents:
         self.acted(agent)
 
     def touched(self, agent: str, keys: Iterable[str]) -> None:
-        """Keys of the state of ``agent`` changed: forget the answers of the guards reading them."""
+        """Keys of the state of ``agent`` changed: forget the answers of the guards
+        reading them, wake the firings asleep on them."""
+        keys = keys if isinstance(keys, tuple) else tuple(keys)
         readers = self._readers.get(agent)
         if readers:
             forget = self.enabled.forget
             for key in keys:
                 for t in readers.get(key, ()):
                     forget(t)
+        self.sleepers.touched(agent, keys)
 
     def acted(self, agent: str | None) -> None:
-        """``agent`` did something (a firing of its started or ended): forget the
-        answers of its guards that read anything."""
+        """``agent`` did something (a firing of its started or ended, a new state):
+        forget the answers of its guards that read anything, wake its firings asleep
+        on any change."""
         if agent is not None:
             forget = self.enabled.forget
             for t in self._any.get(agent, ()):
                 forget(t)
+            if self.sleepers.any:
+                self.sleepers.acted(agent)
 
 
 def _names(kinds: type | tuple) -> str:

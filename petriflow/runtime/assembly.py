@@ -1,17 +1,13 @@
-"""One place that checks a run's inputs and puts a run together.
+"""Putting a checked run together: the third step of a run (checked run -> scheduler).
 
 Everything that runs a net (``petriflow run`` and ``--resume``, the Python
-:func:`~petriflow.runtime.session.run`, sweep trials, the test kit, scenario scripts)
-goes through two functions:
-
-* :func:`validate`: the net bound to the registry, the run configuration checked
-  against the net, the counts a run can hold, and the world an action needs: once.
-  The :class:`~petriflow.runtime.binding.Binding` it returns says it was checked, so
-  nothing checks it again.
-* :func:`open_run`: the world (a :class:`~petriflow.world.World`, or its checked
-  description, loaded here and closed when the run is over) and the
-  :class:`~petriflow.runtime.scheduler.Scheduler` with its clock; observers subscribe
-  to what it yields.
+:func:`~petriflow.runtime.session.run`, the test kit, scenario scripts) reads its
+files (:mod:`~petriflow.runtime.loading`), checks them
+(:mod:`~petriflow.runtime.validation`) and then comes here: :func:`open_run` builds
+the world from its checked description (or takes the one the caller made) and the
+:class:`~petriflow.runtime.scheduler.Scheduler` with its clock, the world's settings
+and the checked binding; observers subscribe to what it yields. When the block ends
+the actions are torn down and a world built here is closed, whatever happened.
 
 Examples:
     >>> from petriflow.io.yaml import loads_net
@@ -21,95 +17,56 @@ Examples:
     ... places: [{id: i, tokens: 1}, o]
     ... transitions: [{id: rest, action: core.wait, params: {seconds: 2}, in: [i], out: [o]}]
     ... ''')
-    >>> binding = validate(net, RunConfig())
-    >>> with open_run(net, binding, RunConfig(), seed=1) as scheduler:
+    >>> checked = CheckedRun(net, validate(net, RunConfig()), RunConfig())
+    >>> with open_run(checked, seed=1) as scheduler:
     ...     scheduler.run().time
     2.0
 """
 
 from __future__ import annotations
 
-import dataclasses
 from contextlib import contextmanager
-from pathlib import Path
 from typing import Any, Iterator
 
-from petriflow.errors import NetFormatError
 from petriflow.net import Net
-from petriflow.runtime.binding import Binding, bind, check_sizes, check_world
+from petriflow.runtime.binding import Binding
 from petriflow.runtime.clock import Clock, RealtimeClock, SimulatedClock
 from petriflow.runtime.config import RunConfig
-from petriflow.runtime.registry import Registry
+from petriflow.runtime.scheduler import Scheduler
+from petriflow.runtime.validation import CheckedRun, validate
 
-__all__ = ["validate", "open_run"]
-
-
-def validate(net: Net, config: RunConfig, *, binding: Binding | None = None, registry: Registry | None = None,
-             path: str | None = None, has_world: bool | None = None) -> Binding:
-    """Check a run's inputs once; returns the binding, marked checked.
-
-    Args:
-        net: the net.
-        config: its run configuration.
-        binding: the net already bound (else it is bound to ``registry`` here).
-        registry: where names are looked up when binding here.
-        path: the net's file, named in errors.
-        has_world: whether the run has a world (``None``: not known yet, not checked).
-
-    Raises:
-        NetFormatError: ``file:line`` for what does not bind, a fault or channel naming
-            nothing in the net, counts a run cannot hold, an action needing a world
-            the run lacks.
-    """
-    if binding is not None and binding.checked and has_world is None:
-        return binding
-    if binding is None:
-        try:
-            binding = bind(net, registry, path=path)
-        except NetFormatError as exc:
-            raise config.blame(exc) from None
-    config.check(net)
-    check_sizes(net, path or net.path)
-    if has_world is not None:
-        check_world(binding, has_world, path or net.path)
-    return dataclasses.replace(binding, checked=True)
+__all__ = ["open_run", "CheckedRun", "validate"]
 
 
 @contextmanager
-def open_run(net: Net, binding: Binding, config: RunConfig, *, seed: int | None = None, world: Any = None,
-             world_data: dict[str, Any] | None = None, world_file: str | Path | None = None,
-             world_base: str | Path | None = None, gui: bool = False, realtime: bool = False,
-             clock: Clock | None = None) -> Iterator[Any]:
+def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunConfig | None = None, *,
+             seed: int | None = None, world: Any = None, gui: bool = False, realtime: bool = False,
+             clock: Clock | None = None) -> Iterator[Scheduler]:
     """A run put together: yields its :class:`~petriflow.runtime.scheduler.Scheduler`.
 
-    The world is ``world`` (an object made by the caller, left open), or loaded here
-    from its checked description ``world_data`` (relative files resolved beside
-    ``world_file``, or in ``world_base``) or from ``world_file``, and closed when the
-    block ends. The
-    scheduler's actions are torn down when the block ends, whatever happened.
-
     Args:
+        run: the checked run (or, as older code calls it, the net, with its checked
+            ``binding`` and ``config``).
         seed: the run seed (default: the configuration's).
-        gui: open pybullet's GUI for a world loaded here.
+        world: a world the caller made (left open); default: the checked run's world
+            file, built here and closed when the block ends.
+        gui: open pybullet's GUI for a world built here.
         realtime: pace the run to the wall clock (a :class:`RealtimeClock`).
         clock: the clock (overrides ``realtime``).
     """
-    from petriflow.runtime.scheduler import Scheduler
-
+    if isinstance(run, Net):
+        run = CheckedRun(run, binding, config or RunConfig())
     opened = None
-    if world is None and (world_data is not None or world_file is not None):
-        from petriflow.world import World, load_world
+    settings = run.settings
+    if world is None and run.world is not None:
+        from petriflow.world import World
 
-        if world_data is not None:
-            base = world_base if world_base is not None else (
-                Path(world_file).resolve().parent if world_file is not None else Path("."))
-            opened = World(world_data, base=base, gui=gui, path=None if world_file is None else str(world_file))
-        else:
-            opened = load_world(world_file, gui=gui)
-        world = opened
+        opened = world = World(run.world.description, base=run.world.base, gui=gui, path=run.world.path)
+    elif world is not None:
+        settings = None  # read from the world given (its meta), by the scheduler
     try:
-        scheduler = Scheduler(net, world=world, config=config, seed=seed, binding=binding,
-                              clock=clock or (RealtimeClock() if realtime else SimulatedClock()))
+        scheduler = Scheduler(run.net, world=world, config=run.config, seed=seed, binding=run.binding,
+                              clock=clock or (RealtimeClock() if realtime else SimulatedClock()), settings=settings)
         with scheduler:
             yield scheduler
     finally:

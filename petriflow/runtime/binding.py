@@ -51,15 +51,17 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from petriflow import limits
+from petriflow.capabilities import missing, name_of
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, Port
 from petriflow.runtime.declared import ActionDeclaration, Declarations, GuardDeclaration, read_declarations
 from petriflow.runtime.registry import Predicate, Registry, UnknownActionError, default_registry
+from petriflow.runtime.settings import Section
 
 __all__ = ["Binding", "BoundTransition", "Unchecked", "bind", "check_sizes", "check_world", "closed_namespaces"]
 
@@ -123,15 +125,19 @@ class Binding:
         net: the net.
         registry: where the names were resolved.
         transitions: ``{transition id: BoundTransition}`` for every transition.
+        unchecked: what a static command could not check (see :class:`Unchecked`).
+        checked: whether :func:`petriflow.runtime.validation.validate` checked the run's
+            inputs against this binding (so nothing checks them again).
+        sections: ``{name: Section}``: the world file's settings the bound actions read
+            (:mod:`petriflow.runtime.settings`), read when the world is loaded.
     """
 
     net: Net
     registry: Registry
     transitions: dict[str, BoundTransition]
     unchecked: tuple["Unchecked", ...] = ()
-    #: Whether :func:`petriflow.runtime.assembly.validate` checked the run's inputs
-    #: against this binding (so nothing checks them again).
     checked: bool = False
+    sections: dict[str, Section] = field(default_factory=dict)
 
     def actions(self) -> dict[str, type[Action]]:
         """``{transition id: Action class}`` of the bound transitions."""
@@ -189,7 +195,7 @@ def bind(net: Net, registry: Registry | None = None, *, path: str | None = None,
     """
     binder = _Binder(net, registry or default_registry, path or net.path, unimported)
     bound = {t.id: binder.transition(t) for t in net.transitions.values()}
-    return Binding(net, binder.registry, bound, tuple(binder.unchecked))
+    return Binding(net, binder.registry, bound, tuple(binder.unchecked), sections=binder.sections)
 
 
 class _Binder:
@@ -199,6 +205,8 @@ class _Binder:
                  unimported: bool | Sequence[str]) -> None:
         self.net, self.registry, self.path, self.unimported = net, registry, path, unimported
         self.unchecked: list[Unchecked] = []
+        self.sections: dict[str, Section] = {}
+        self._sections_by: dict[str, str] = {}  # section name -> the transition that declared it first
         self.cache: dict[tuple[str, str], tuple[Any, str | None]] = {}
         self._declared: Declarations | None = None
         self.noted: set[tuple[str, str, bool]] = set()
@@ -244,8 +252,8 @@ class _Binder:
             closed = "." in name and name.partition(".")[0] in closed_namespaces()
             reason = None if closed else self.declared.missing(kind, name)
             if reason is None:
-                known = [*_registered(self.registry, kind), *self.declared.names(kind)]
-                raise self.registry._unknown(kind, name, known) from exc
+                known = [*self.registry.names_of(kind), *self.declared.names(kind)]
+                raise self.registry.unknown(kind, name, known) from exc
             self.cache[kind, name] = (None, reason)
         return self.cache[kind, name]
 
@@ -287,6 +295,7 @@ class _Binder:
         ports = self.ports(tid, cls, params)
         self.requirements(tid, transition.action, cls.requirements(params), params)
         self.state(tid, transition.action, cls)
+        self.settings(tid, transition.action, cls)
         for name, kind in getattr(cls, "resources", {}).items():
             try:
                 self.find("resource", kind)
@@ -339,6 +348,20 @@ class _Binder:
                             f" the subnet (state: ...)" if subnet else f"action {action} reads an agent state:"
                             " put the transition in an agent subnet", f"{tid}/action")
 
+    def settings(self, tid: str, action: str, cls: type[Action]) -> None:
+        """The world settings section the action reads: one declaration per name."""
+        section = getattr(cls, "settings", None)
+        if section is None:
+            return
+        if not isinstance(section, Section):
+            raise self.fail(tid, f"action {action} declares settings {section!r}: a Section"
+                            " (petriflow.runtime.settings) is expected", f"{tid}/action")
+        known = self.sections.setdefault(section.name, section)
+        first = self._sections_by.setdefault(section.name, tid)
+        if known != section:
+            raise self.fail(tid, f"action {action} reads the world's settings {section.name!r} declared otherwise"
+                            f" by the action of {first!r}: one section, one declaration", f"{tid}/action")
+
     def ports(self, tid: str, cls: type[Action], params: dict[str, Any]) -> dict[str, str]:
         """``{port: place}`` of the action's ports that name a place; each must exist."""
         ports = {}
@@ -375,23 +398,8 @@ def closed_namespaces() -> frozenset[str]:
     entry points), loaded by any registry. A name under one of them that they lack is an
     error even when action modules were not imported."""
     installed = Registry()  # the core and the entry points only, whatever this process imported
-    names = [*installed.names(), *_registered(installed, "guard"), *_registered(installed, "agent state")]
+    names = [*installed.names(), *installed.names_of("guard"), *installed.names_of("agent state")]
     return frozenset({"core"} | {name.partition(".")[0] for name in names if "." in name})
-
-
-def _registered(registry: Registry, kind: str) -> list[str]:
-    """The names ``registry`` knows of ``kind`` (``action``, ``guard``, ``agent state``,
-    ``resource``): what a run's error offers as close matches."""
-    if kind == "action":
-        return registry.names()
-    registry._load_plugins()
-    table = {"guard": "_predicates", "agent state": "_states", "resource": "_resources"}[kind]
-    names = list(getattr(registry, table, {}))
-    if kind == "resource":
-        from petriflow.runtime.resources import LIVENESS
-
-        names.append(LIVENESS)  # made by the run itself
-    return names
 
 
 def _type_names(kinds: Any) -> str:
@@ -406,17 +414,41 @@ def _agent_of(net: Net, tid: str) -> str | None:
     return net.subnets[subnet].agent or subnet
 
 
-def check_world(binding: Binding, has_world: bool, path: str | None = None) -> None:
-    """Refuse a run without a world when a bound action needs one.
+def check_world(binding: Binding, world: Any, path: str | None = None) -> None:
+    """Refuse a run whose world lacks what a bound action needs: a world at all
+    (:attr:`Action.requires` ``"world"``), or a capability it uses (:attr:`Action.uses`).
+
+    Args:
+        binding: the net bound.
+        world: the world the run will have: an object, or its class; ``True`` for a
+            world file (a :class:`petriflow.world.World`); ``False`` or ``None`` for none.
+        path: the net's file, named in errors.
 
     Raises:
-        NetFormatError: ``file:line: 'transition': action X needs a world ...``.
+        NetFormatError: ``file:line: 'transition': action X needs a world ...``, or
+            ``... uses the world's cameras (Cameras), which ... lacks: camera``.
     """
-    if has_world:
-        return
+    if world is True:
+        from petriflow.world import World
+
+        world = World
+    elif world is False:
+        world = None
     net = binding.net
     for tid, bound in binding.transitions.items():
-        if bound.action is not None and "world" in bound.action.requirements(bound.params):
-            raise NetFormatError(f"action {net.transitions[tid].action} needs a world: run with --world or name"
-                                 " one in the run configuration (world: FILE)", path=path or net.path,
-                                 line=_line(net, f"{tid}/action", tid), element=tid)
+        cls = bound.action
+        if cls is None:
+            continue
+        where = {"path": path or net.path, "line": _line(net, f"{tid}/action", tid), "element": tid}
+        if world is None:
+            if cls.uses or "world" in cls.requirements(bound.params):
+                raise NetFormatError(f"action {net.transitions[tid].action} needs a world: run with --world or"
+                                     " name one in the run configuration (world: FILE)", **where)
+            continue
+        for capability in cls.uses:
+            lacking = missing(world, capability)
+            if lacking:
+                kind = world if isinstance(world, type) else type(world)
+                raise NetFormatError(f"action {net.transitions[tid].action} uses the world's {name_of(capability)}"
+                                     f" ({capability.__name__}), which this run's world ({kind.__name__}) lacks:"
+                                     f" {', '.join(lacking)}", **where)

@@ -40,7 +40,7 @@ from typing import Any, Callable
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.outcome import Name
-from petriflow.runtime.channels import ChannelModel, build_channel
+from petriflow.runtime.channel_models import ChannelModel, build_channel
 from petriflow.runtime.metrics import MetricRef, parse_refs
 
 __all__ = ["RunConfig", "Fault", "FaultKind", "load_config"]

@@ -3,19 +3,28 @@
 The run configuration lists faults (:class:`~petriflow.runtime.config.Fault`);
 :class:`Faults` schedules each one as an event on the run's kernel and keeps the state
 they change: which agents run and which links are down. When a fault's time comes it
-records a ``fault`` event and tells the scheduler what changed (an agent stopped or
-started), so the scheduler never branches on fault kinds.
+records a ``fault`` event and says what changed (an agent stopped or started) to
+the callbacks it was made with, so the scheduler never branches on fault kinds.
+
+Examples:
+    >>> from petriflow.runtime.config import Fault
+    >>> from petriflow.runtime.kernel import Kernel
+    >>> from petriflow.runtime.recorder import Recorder
+    >>> kernel, stopped = Kernel(dt=1.0), []
+    >>> faults = Faults(kernel, Recorder(kernel), [Fault("kill", 2.0, "r1")], ["r1", "r2"],
+    ...                 stopped=stopped.append, started=print)
+    >>> kernel.tick = kernel.peek(); kernel.run_due()
+    >>> stopped, faults.running
+    (['r1'], {'r1': False, 'r2': True})
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Callable, Iterable
+from typing import Callable, Iterable
 
 from petriflow.runtime.config import Fault, FaultKind
-from petriflow.runtime.kernel import APPLY, Scheduled
-
-if TYPE_CHECKING:
-    from petriflow.runtime.host import RunHost
+from petriflow.runtime.kernel import APPLY, Kernel, Scheduled
+from petriflow.runtime.recorder import Recorder
 
 __all__ = ["Faults", "FaultEvent"]
 
@@ -39,19 +48,24 @@ class Faults:
     """Which agents run and which links work, changed by scheduled faults.
 
     Args:
-        run: the run (:class:`~petriflow.runtime.host.RunHost`: its ``kernel``,
-            ``emit``, ``agent_stopped`` and ``agent_started``).
+        kernel: the run's kernel (each fault is an event on it).
+        recorder: the run's events (each fault is one).
         faults: the faults to inject.
         agents: the run's agents (all running at the start, except late joiners).
+        stopped: called with an agent that stops (killed): the run cancels its actions.
+        started: called with an agent that starts (a late joiner): its transitions may fire.
     """
 
-    def __init__(self, run: "RunHost", faults: Iterable[Fault], agents: Iterable[str]) -> None:
-        self.run = run
+    def __init__(self, kernel: Kernel, recorder: Recorder, faults: Iterable[Fault], agents: Iterable[str], *,
+                 stopped: Callable[[str], None], started: Callable[[str], None]) -> None:
+        self.kernel = kernel
+        self.recorder = recorder
+        self.on_stopped = stopped
+        self.on_started = started
         self.agents = list(agents)
         #: The agents not running now (killed, or not yet joined): every other agent runs.
         self.stopped: set[str] = set()
         self.down: set[frozenset[str]] = set()
-        kernel = run.kernel
         for fault in faults:
             kernel.schedule(kernel.ticks_at(fault.at), FaultEvent(self.apply, fault))
             if fault.kind == FaultKind.JOIN:
@@ -72,22 +86,22 @@ class Faults:
 
     def apply(self, fault: Fault) -> None:
         """Inject ``fault`` now."""
-        run = self.run
+        emit = self.recorder.emit
         if fault.kind == FaultKind.KILL:
             self.stopped.add(fault.agent)
-            run.emit("fault", None, fault.agent, fault=FaultKind.KILL.value)
-            run.agent_stopped(fault.agent)
+            emit("fault", None, fault.agent, fault=FaultKind.KILL.value)
+            self.on_stopped(fault.agent)
         elif fault.kind == FaultKind.JOIN:
             self.stopped.discard(fault.agent)
-            run.emit("fault", None, fault.agent, fault=FaultKind.JOIN.value)
-            run.agent_started(fault.agent)
+            emit("fault", None, fault.agent, fault=FaultKind.JOIN.value)
+            self.on_started(fault.agent)
         elif fault.kind == FaultKind.DROP_LINK:
             self.down.add(frozenset(fault.link))
-            run.emit("fault", None, None, fault=FaultKind.DROP_LINK.value, link=list(fault.link))
+            emit("fault", None, None, fault=FaultKind.DROP_LINK.value, link=list(fault.link))
             if fault.until is not None:
-                run.kernel.schedule(run.kernel.ticks_at(fault.until), FaultEvent(self.restore, fault))
+                self.kernel.schedule(self.kernel.ticks_at(fault.until), FaultEvent(self.restore, fault))
 
     def restore(self, fault: Fault) -> None:
         """The link ``fault`` dropped works again."""
         self.down.discard(frozenset(fault.link))
-        self.run.emit("fault", None, None, fault=FaultKind.RESTORE_LINK.value, link=list(fault.link))
+        self.recorder.emit("fault", None, None, fault=FaultKind.RESTORE_LINK.value, link=list(fault.link))

@@ -25,11 +25,11 @@ from petriflow.runtime.action import ActionContext, ActionFailure
 from petriflow.runtime.agents import Agents
 from petriflow.runtime.channels import Channels
 from petriflow.runtime.enabling import EnabledSet
-from petriflow.runtime.faults import Faults
 from petriflow.runtime.index import RunIndex
 from petriflow.runtime.kernel import Kernel
-from petriflow.runtime.lifecycle import ActionRunner
+from petriflow.runtime.lifecycle import ActionRunner, Firing
 from petriflow.runtime.recorder import Recorder
+from petriflow.runtime.services import RunServices
 from petriflow.runtime.tokens import TokenStore
 from petriflow.runtime.trace import EventKind, summarize
 
@@ -54,6 +54,20 @@ class Unrouted(Exception):
 class Firer:
     """Fires a run's transitions and produces their outputs (see the module).
 
+    Args:
+        net: the net run.
+        index: the net by integer indices.
+        kernel: the run's event kernel.
+        tokens: the run's tokens.
+        enabled: the transitions that may fire.
+        recorder: the run's events.
+        agents: the agents' states (a firing of an agent is news for its guards).
+        channels: where tokens put into channel places go.
+        services: what the firings' contexts reach (:class:`~.services.RunServices`).
+        world: the run's world (``None``: a world-less run).
+        seed: the run seed.
+        running: the dictionary of running firings (shared with ``enabled``).
+
     Attributes:
         count: transitions fired so far (a firing's number is the count when it fired).
         progress: the tick of the last firing start or end (the stall watchdog reads it).
@@ -61,17 +75,14 @@ class Firer:
         runner: the action runner the firings' actions run in.
     """
 
-    def __init__(self, net: Net, index: RunIndex, kernel: Kernel, tokens: TokenStore, enabled: EnabledSet,
-                 recorder: Recorder, faults: Faults, world: Any, seed: Any) -> None:
+    def __init__(self, net: Net, index: RunIndex, kernel: Kernel, tokens: TokenStore, enabled: EnabledSet, *,
+                 recorder: Recorder, agents: Agents, channels: Channels, services: RunServices, world: Any,
+                 seed: Any, running: dict[int, Firing]) -> None:
         self.net, self.index, self.kernel, self.tokens = net, index, kernel, tokens
-        self.enabled, self.recorder, self.faults, self.world = enabled, recorder, faults, world
-        self.agents = Agents(index, enabled)
-        enabled.states = self.agents.states
-        self.runner = ActionRunner(index, kernel, enabled, self.finish, self.context)
-        enabled.running = self.runner.running
-        self.channels: Channels | None = None  # set by the run once made (channels need the run)
-        self.resources: Any = None  # set by the run (petriflow.runtime.resources.Resources)
-        self._declared = [getattr(cls, "resources", None) or None for cls in index.action_class]
+        self.enabled, self.recorder, self.agents, self.channels = enabled, recorder, agents, channels
+        self.services, self.world = services, world
+        self.runner = ActionRunner(index, kernel, enabled, agents.sleepers, self.finish, self.context, running)
+        self._sleepers = agents.sleepers
         self._delay = self.runner.delay  # per transition: the seconds its action only waits, or None
         compiled, consumers = index.compiled, index.consumers
         self._running = self.runner.running
@@ -137,7 +148,7 @@ class Firer:
         taking = enabled.taking[t]
         if taking:
             enabled.changed.update(taking)
-        if self._acts[t]:
+        if self._acts[t] or self._sleepers.any:
             self.agents.acted(index.agent[t])
         recorder = self.recorder
         if recorder.by_kind[_START]:
@@ -166,8 +177,8 @@ class Firer:
         if inputs is None:
             inputs = self.tokens.black(index.row[t])
         return ActionContext(index.ids[t], index.agent[t], index.params[t], inputs, self.world,
-                             self._seed_prefix + str(number), now, now, None, False, None, "", None, None, self,
-                             self._declared[t])
+                             self._seed_prefix + str(number), now, now, services=self.services,
+                             action=index.action_class[t])
 
     def _cancel_region(self, t: int, number: int, withdrawn: dict[str, int]) -> None:
         cancelled = self.runner.cancel(list(self.index.cancels[t]))
@@ -190,7 +201,7 @@ class Firer:
         row = self.index.ok_row[t] if outcome is Outcome.OK else self.index.route[t][outcome]
         if row is None and outcome is not Outcome.CANCELLED and outcome is not Outcome.OK:
             self.progress = self.kernel.tick
-            if self._acts[t]:
+            if self._acts[t] or self._sleepers.any:
                 self.agents.acted(ctx.agent)
             reason = ctx.reason or outcome.value
             recorder.emit(_END, tid, ctx.agent, firing=number, outcome=outcome.value, produced={}, reason=reason)
@@ -215,7 +226,7 @@ class Firer:
         (showing ``shown`` and ``reason``), then its messages."""
         recorder, agent = self.recorder, self.index.agent[t]
         self.progress = self.kernel.tick
-        if self._acts[t]:
+        if self._acts[t] or self._sleepers.any:
             self.agents.acted(agent)
         sent: list[tuple[str, Any]] | None = None
         if row is not None:  # the outputs: tokens here, messages once the end is recorded

@@ -40,9 +40,9 @@ Examples:
 
 from __future__ import annotations
 
+import bisect
 import heapq
 import math
-from typing import Iterator
 
 __all__ = ["Kernel", "Scheduled", "Deadline", "POLL", "APPLY", "TIMED"]
 
@@ -109,6 +109,9 @@ class Kernel:
         tick: the current tick (the scheduler advances it).
         pending: the :data:`APPLY` events not yet applied (deliveries, faults): a run
             is not over while one is.
+        phase: what :meth:`run_due` applies now: :data:`TIMED` events, :data:`POLL`
+            events or :data:`APPLY` events; ``None`` between (the firings of an instant).
+        polling: the key of the poll being applied (``None`` outside the polls).
     """
 
     def __init__(self, dt: float) -> None:
@@ -117,6 +120,8 @@ class Kernel:
         self.dt = float(dt)
         self.tick = 0
         self.pending = 0
+        self.phase: int | None = None
+        self.polling: int | None = None
         self._ticks: list[int] = []
         self._buckets: dict[int, tuple[list[tuple[int, int, Scheduled]], list[Scheduled],
                                        list[tuple[float, int, int, Scheduled]]]] = {}
@@ -149,12 +154,35 @@ class Kernel:
     def schedule_poll(self, tick: int, event: Scheduled, key: int) -> None:
         """Schedule a :data:`POLL` ``event`` at ``tick`` (not before the current tick),
         ordered among the polls of that tick by ``key``: :meth:`schedule` for the
-        commonest event of a run, without its checks."""
+        commonest event of a run, without its checks. One scheduled for the current
+        tick while its polls are applied, with a key after the poll being applied,
+        takes its place among the polls still to come."""
         bucket = self._buckets.get(tick)
         if bucket is None:
             bucket = self._bucket(tick)
         self._order += 1
-        bucket[0].append((key, self._order, event))
+        polling = self.polling
+        if polling is not None and tick == self.tick and key > polling:
+            bisect.insort(bucket[0], (key, self._order, event))
+        else:
+            bucket[0].append((key, self._order, event))
+
+    def poll_tick(self, key: int, polled: int) -> int:
+        """The first tick at which a poll of ``key``, made at every tick (the last one at
+        ``polled``), comes after now: this tick while its poll here is still to come
+        (timed events are being applied, or polls of earlier keys), else the next.
+
+        Examples:
+            >>> kernel = Kernel(dt=1.0); kernel.tick = 5
+            >>> kernel.poll_tick(3, polled=4), kernel.poll_tick(3, polled=5)
+            (6, 6)
+            >>> kernel.phase = TIMED; kernel.poll_tick(3, polled=4)
+            5
+        """
+        tick = self.tick
+        if polled < tick and (self.phase == TIMED or (self.polling is not None and self.polling < key)):
+            return tick
+        return tick + 1
 
     def _bucket(self, tick: int) -> tuple[list, list, list]:
         bucket = self._buckets.get(tick)
@@ -213,25 +241,34 @@ class Kernel:
         if bucket is None:
             return
         polls, applies, timed = bucket
-        while timed:
-            event = heapq.heappop(timed)[3]
-            if event.live(tick):  # a cancelled one was counted off by its canceller
+        try:
+            if timed:
+                self.phase = TIMED
+                while timed:
+                    event = heapq.heappop(timed)[3]
+                    if event.live(tick):  # a cancelled one was counted off by its canceller
+                        self.pending -= 1
+                        event.apply(tick)
+            if polls:
+                self.phase = POLL
+                polls.sort()
+                for key, _, event in polls:  # a poll inserted after this one is still reached
+                    self.polling = key
+                    if event.live(tick):
+                        event.apply(tick)
+                self.polling = None
+                polls.clear()
+            self.phase = APPLY
+            index = 0
+            while index < len(applies):
+                event = applies[index]
+                index += 1
                 self.pending -= 1
-                event.apply(tick)
-        if polls:
-            polls.sort()
-            for _, _, event in polls:
                 if event.live(tick):
                     event.apply(tick)
-            polls.clear()
-        index = 0
-        while index < len(applies):
-            event = applies[index]
-            index += 1
-            self.pending -= 1
-            if event.live(tick):
-                event.apply(tick)
-        applies.clear()
+            applies.clear()
+        finally:
+            self.phase = self.polling = None
 
     def __len__(self) -> int:
         """Events scheduled (live or not)."""

@@ -8,6 +8,12 @@ cancellation region, a fault killing its agent) or a timeout calls
 is done. When the action ends, the runner hands its outcome to the run
 (:class:`Finisher`), which produces the outputs.
 
+An action that sleeps on its agent's state (:attr:`~petriflow.runtime.action.Action.wake_on`)
+is registered with the agent's :class:`~petriflow.runtime.agents.Sleepers` and polled
+when a key it sleeps on changes (at the tick its polled twin would see the change,
+:meth:`~petriflow.runtime.kernel.Kernel.poll_tick`) or at its ``wake_at``, whichever
+comes first; never in between.
+
 An action that only waits (:meth:`~petriflow.runtime.action.Action.delay`, e.g.
 ``core.wait``) on a transition without a timeout is not polled: :meth:`ActionRunner.wait`
 schedules its end, which comes at the tick its poll would have ended it, with no
@@ -24,6 +30,7 @@ from typing import Any, Callable, Protocol
 
 from petriflow.outcome import Outcome
 from petriflow.runtime.action import Action, ActionContext, Status, first_data
+from petriflow.runtime.agents import Sleepers
 from petriflow.runtime.enabling import EnabledSet, reason_of
 from petriflow.runtime.index import RunIndex
 from petriflow.runtime.kernel import POLL, Deadline, Kernel, Scheduled
@@ -57,7 +64,7 @@ class Firing(Scheduled):
     is cancelled; it keeps its ``inputs`` and ``started`` time."""
 
     __slots__ = ("runner", "number", "index", "action", "ctx", "deadline", "cancelling", "wake", "polled",
-                 "running", "inputs", "started")
+                 "running", "inputs", "started", "nap")
     phase = POLL
 
     def __init__(self, runner: "ActionRunner", index: int, action: Action) -> None:
@@ -73,6 +80,7 @@ class Firing(Scheduled):
         self.wake = -1
         self.polled = -1
         self.running = False
+        self.nap = 0  # the sleep on its state it is in (0: awake)
 
     def live(self, tick: int) -> bool:
         return self.running and self.wake == tick
@@ -80,6 +88,16 @@ class Firing(Scheduled):
     def apply(self, tick: int) -> None:
         if self.polled != tick:  # once per tick, whichever entry comes first
             self.runner.poll(self)
+
+    def asleep_on(self, nap: int) -> bool:
+        """Whether the sleep ``nap`` is the one this firing is still in."""
+        return self.running and self.nap == nap
+
+    def rouse(self) -> None:
+        """Its agent's state changed under its sleep: it is polled when a polled firing
+        would first see that (:meth:`~petriflow.runtime.kernel.Kernel.poll_tick`)."""
+        self.nap = 0
+        self.runner.wake(self)
 
 
 class ActionRunner:
@@ -89,8 +107,11 @@ class ActionRunner:
         index: the run's net index.
         kernel: the run's event kernel.
         enabled: the run's enabled set (a transition whose action stops may fire again).
+        sleepers: where firings asleep on their agent's state are registered.
         finish: called when a firing ends, with its outcome.
         contexts: makes a firing's context (for a delay's firing being cancelled).
+        running: the dictionary to keep the running firings in (shared with the
+            enabled set, for which a running transition may not fire).
 
     Attributes:
         running: ``{transition index: Firing}`` of the actions running now.
@@ -98,14 +119,16 @@ class ActionRunner:
             it), or ``None`` (:meth:`start`); known once :meth:`setup` ran.
     """
 
-    def __init__(self, index: RunIndex, kernel: Kernel, enabled: EnabledSet, finish: Finisher,
-                 contexts: Contexts) -> None:
+    def __init__(self, index: RunIndex, kernel: Kernel, enabled: EnabledSet, sleepers: Sleepers, finish: Finisher,
+                 contexts: Contexts, running: dict[int, Firing] | None = None) -> None:
         self.index = index
         self.kernel = kernel
         self.enabled = enabled
+        self.sleepers = sleepers
         self.finish = finish
         self.contexts = contexts
-        self.running: dict[int, Firing] = {}
+        self.running: dict[int, Firing] = {} if running is None else running
+        self._naps = 0  # sleeps begun so far (each sleep's number)
         self.delay: list[float | None] = [None] * len(index.ids)
         self.actions: list[Action | None] = [None] * len(index.ids)
         self._slot: list[Firing | None] = [None] * len(index.ids)
@@ -176,7 +199,11 @@ class ActionRunner:
             tick = max(kernel.tick + 1, kernel.ticks_at(firing.deadline))
             kernel.schedule(tick, Deadline(firing, number), key=number)
         wake = action.wake_at
-        if wake is not None and not action.needs_world and wake > now + 1e-12:
+        if not action.needs_world and action.wake_on is not None:  # asleep on its state from the start
+            firing.polled = kernel.tick  # as if polled now: a change of this instant wakes it at the next tick
+            if self._sleep(firing, ctx, action.wake_on) and wake is not None:
+                self._wake(firing, max(kernel.tick + 1, kernel.ticks_at(wake)))
+        elif wake is not None and not action.needs_world and wake > now + 1e-12:
             self._wake(firing, max(kernel.tick + 1, kernel.ticks_at(wake)))  # first poll when it asked
         else:
             self.poll(firing)
@@ -198,6 +225,7 @@ class ActionRunner:
         """Poll one running action (or drive its cancellation); end it if it ended."""
         kernel = self.kernel
         firing.polled = tick = kernel.tick
+        firing.nap = 0  # polled: awake, whatever it slept on
         ctx, action = firing.ctx, firing.action
         if ctx is None:  # a delay's firing: its time has come, or it is cancelled
             if firing.cancelling is None:
@@ -225,6 +253,12 @@ class ActionRunner:
                 self._wake(firing, tick + 1)
             else:
                 wake = action.wake_at
+                if action.wake_on is not None:  # asleep on its state (and at most until wake_at)
+                    if not self._sleep(firing, ctx, action.wake_on):
+                        return
+                    if wake is None:
+                        firing.wake = -1  # no time wakes it: its entries ahead are dead
+                        return
                 self._wake(firing, tick + 1 if wake is None else max(tick + 1, kernel.ticks_at(wake)))
             return
         else:
@@ -247,8 +281,29 @@ class ActionRunner:
         self._stop(firing)
         self.finish(firing.number, firing.index, ctx, outcome)
 
+    def _sleep(self, firing: Firing, ctx: ActionContext, keys: tuple[str, ...]) -> bool:
+        """Register ``firing`` asleep on ``keys`` of its agent's state; ``False`` (and the
+        firing failed) when its transition has no agent."""
+        agent = self.index.agent[firing.index]
+        if agent is None:
+            ctx.reason = f"it waits on its agent's state ({', '.join(keys)}), and {ctx.transition!r} is in no" \
+                         " agent subnet"
+            self._stop(firing)
+            self.finish(firing.number, firing.index, ctx, Outcome.FAILED)
+            return False
+        self._naps += 1
+        firing.nap = self._naps
+        self.sleepers.add(agent, keys, firing, self._naps)
+        return True
+
+    def wake(self, firing: Firing) -> None:
+        """``firing``'s agent state changed under its sleep: poll it at the tick a firing
+        polled every tick would first see the change."""
+        self._wake(firing, self.kernel.poll_tick(firing.number, firing.polled))
+
     def _stop(self, firing: Firing) -> None:
         firing.running = False
+        firing.nap = 0
         del self.running[firing.index]
         self.enabled.dirty.add(firing.index)
 

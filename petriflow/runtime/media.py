@@ -1,7 +1,7 @@
 """Contended media as processes on the run's kernel.
 
 A simple channel model answers, when a message is sent, after how long it arrives
-(:class:`~petriflow.runtime.channels.ChannelModel`). A shared medium cannot: whether a
+(:class:`~petriflow.runtime.channel_models.ChannelModel`). A shared medium cannot: whether a
 frame gets through depends on frames sent after it (a collision, an overwritten
 receive buffer, a lost arbitration). A :class:`Medium` is a channel model that runs as
 a process instead, in SimPy's resource shape: the run hands it each message when it
@@ -26,7 +26,7 @@ Examples:
     A toy medium that carries one message at a time, 1 ms each, and loses a message
     sent while another is on it:
 
-    >>> from petriflow.runtime.channels import Message
+    >>> from petriflow.runtime.channel_models import Message
     >>> from petriflow.runtime.kernel import Kernel
     >>> class Wire(Medium):
     ...     def attach(self, port):
@@ -54,7 +54,7 @@ from __future__ import annotations
 import math
 from typing import Any, Callable
 
-from petriflow.runtime.channels import ChannelModel, Message
+from petriflow.runtime.channel_models import ChannelModel, Message
 from petriflow.runtime.kernel import TIMED, Kernel, Scheduled
 
 __all__ = ["Medium", "MediumPort", "ProcessClock", "Timer"]

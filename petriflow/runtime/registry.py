@@ -35,7 +35,6 @@ from importlib.metadata import entry_points
 from typing import Any, Callable, Iterable
 
 from petriflow.errors import PetriflowError, did_you_mean
-from petriflow.net import Net
 from petriflow.runtime.action import Action, Param, generator_action
 from petriflow.runtime.trace import EventKind
 
@@ -229,7 +228,7 @@ class Registry:
     def channel_model(self, name: str) -> type | None:
         """The channel model class registered as ``name``, or ``None``."""
         if name not in self._channels:
-            self._load_plugins()
+            self.load_plugins()
         target = self._channels.get(name)
         if isinstance(target, str):
             module_name, _, attribute = target.partition(":")
@@ -241,7 +240,7 @@ class Registry:
 
     def channel_names(self) -> list[str]:
         """Registered channel model names, sorted."""
-        self._load_plugins()
+        self.load_plugins()
         return sorted(self._channels)
 
     def metric(self, name: str, *, events: bool | Iterable[str] = False, replace: bool = False) -> Callable:
@@ -255,7 +254,9 @@ class Registry:
         return decorate
 
     # Looking up ---------------------------------------------------------------------
-    def _load_plugins(self) -> None:
+    def load_plugins(self) -> None:
+        """Load the installed plugins (the ``petriflow.actions`` entry points), once; a
+        name not registered in code loads them the first time it is looked up."""
         if not self._plugins_pending:
             return
         self._plugins_pending = False
@@ -266,9 +267,10 @@ class Registry:
                 self.broken[entry.name] = f"{type(exc).__name__}: {exc}"
                 log.warning("action plugin %s failed to load: %s", entry.name, exc)
 
-    def _unknown(self, kind: str, name: str, known) -> UnknownActionError:
-        """The error for an unknown name: close matches, and any plugin that failed to
-        load (its names may be the one asked for)."""
+    def unknown(self, kind: str, name: str, known: Iterable[str]) -> UnknownActionError:
+        """The error for an unknown ``name`` of ``kind`` (``action``, ``guard``...): close
+        matches among ``known``, and any plugin that failed to load (its names may be the
+        one asked for)."""
         message = f"unknown {kind} {name!r}{did_you_mean(name, known)}"
         if self.broken:
             failed = "; ".join(f"plugin {plugin!r} failed to load: {why}" for plugin, why in self.broken.items())
@@ -277,12 +279,30 @@ class Registry:
 
     def names(self) -> list[str]:
         """Registered action names, sorted."""
-        self._load_plugins()
+        self.load_plugins()
         return sorted(self._actions)
+
+    def names_of(self, kind: str) -> list[str]:
+        """The names registered of ``kind``: ``action``, ``guard``, ``agent state``,
+        ``resource`` (the built-in ``core.liveness`` included), ``metric`` or
+        ``channel model``; what an error offers as close matches.
+
+        Examples:
+            >>> Registry(False).names_of("resource")
+            ['core.liveness']
+        """
+        self.load_plugins()
+        if kind == "resource":
+            from petriflow.runtime.resources import LIVENESS
+
+            return [*self._resources, LIVENESS]  # made by the run itself
+        table = {"action": self._actions, "guard": self._predicates, "agent state": self._states,
+                 "metric": self._metrics, "channel model": self._channels}[kind]
+        return list(table)
 
     def specs(self) -> list[ActionSpec]:
         """Registered actions, sorted by name."""
-        self._load_plugins()
+        self.load_plugins()
         return [self._actions[n] for n in sorted(self._actions)]
 
     def resolve(self, name: str) -> type[Action]:
@@ -292,31 +312,31 @@ class Registry:
             UnknownActionError: nothing is registered under that name (with close matches).
         """
         if name not in self._actions:  # the plugins load when a name is not known without them
-            self._load_plugins()
+            self.load_plugins()
         spec = self._actions.get(name)
         if spec is None:
-            raise self._unknown("action", name, self._actions)
+            raise self.unknown("action", name, self._actions)
         return spec.load()
 
     def metric_spec(self, name: str) -> MetricSpec:
         """The metric registered as ``name`` (UnknownActionError with hints if none)."""
         if name not in self._metrics:
-            self._load_plugins()
+            self.load_plugins()
         if name not in self._metrics:
-            raise self._unknown("metric", name, self._metrics)
+            raise self.unknown("metric", name, self._metrics)
         return self._metrics[name]
 
     def metric_specs(self) -> list[MetricSpec]:
         """Registered metrics, sorted by name."""
-        self._load_plugins()
+        self.load_plugins()
         return [self._metrics[n] for n in sorted(self._metrics)]
 
     def guard(self, name: str) -> Predicate:
         """The predicate registered as ``name`` (UnknownActionError with hints if none)."""
         if name not in self._predicates:
-            self._load_plugins()
+            self.load_plugins()
         if name not in self._predicates:
-            raise self._unknown("guard", name, self._predicates)
+            raise self.unknown("guard", name, self._predicates)
         return self._predicates[name]
 
     def guard_reads(self, name: str) -> tuple[str, ...] | None:
@@ -337,13 +357,13 @@ class Registry:
 
     def resource_factory(self, name: str) -> Callable[..., Any]:
         """The factory of the resource type ``name`` (UnknownActionError with hints if none)."""
-        self._load_plugins()
+        self.load_plugins()
         if name not in self._resources:
             from petriflow.runtime.resources import LIVENESS
 
             if name == LIVENESS:  # made by the run itself
                 return lambda context: context.liveness
-            raise self._unknown("resource", name, [*self._resources, LIVENESS])
+            raise self.unknown("resource", name, [*self._resources, LIVENESS])
         factory = self._resources[name]
         if isinstance(factory, str):
             module_name, _, attribute = factory.partition(":")
@@ -363,17 +383,10 @@ class Registry:
 
     def state_type(self, name: str) -> type:
         """The agent-state type registered as ``name`` (UnknownActionError with hints if none)."""
-        self._load_plugins()
+        self.load_plugins()
         if name not in self._states:
-            raise self._unknown("agent state", name, self._states)
+            raise self.unknown("agent state", name, self._states)
         return self._states[name]
-
-    def bind(self, net: Net, path: str | None = None):
-        """Bind ``net``'s transitions to this registry (:func:`petriflow.runtime.binding.bind`)."""
-        from petriflow.runtime.binding import bind
-
-        return bind(net, self, path=path)
-
 
 def _register_core(registry: "Registry") -> None:
     """Register the core actions and metrics (every registry has them)."""

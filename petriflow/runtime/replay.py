@@ -107,9 +107,9 @@ def replay(trace: str | Path, *, net_path: str | Path | None = None, draw: str |
         from petriflow.io import load_net
 
         format_of(draw)  # the picture's format from its ending, before any work
-        from petriflow.runtime.session import _check_outputs
+        from petriflow.runtime.outputs import check_outputs
 
-        _check_outputs({"--draw": draw}, [trace, net_path])
+        check_outputs({"--draw": draw}, [trace, net_path])
         net = load_net(net_path)
     elif net_path is not None:
         raise PetriflowError("--net is only used with --draw")

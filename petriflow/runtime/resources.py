@@ -28,8 +28,8 @@ Examples:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Callable, Iterable
+from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable, Mapping
 
 from petriflow.errors import PetriflowError
 
@@ -72,11 +72,14 @@ class ResourceContext:
         world: the run's world (``None`` in a world-less run).
         liveness: the run's :class:`Liveness`.
         config: the run configuration.
+        settings: ``{section: {name: value}}``, the world file's settings the bound
+            actions declare (:mod:`petriflow.runtime.settings`), checked.
     """
 
     world: Any
     liveness: Liveness | None
     config: Any = None
+    settings: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
 
 
 class Resources:

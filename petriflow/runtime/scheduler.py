@@ -34,10 +34,12 @@ marking with data), the :class:`~petriflow.runtime.enabling.EnabledSet` (which
 transitions may fire), the :class:`~petriflow.runtime.firing.Firer` (firing and
 producing), the :class:`~petriflow.runtime.lifecycle.ActionRunner` (each firing's
 action), the :class:`~petriflow.runtime.recorder.Recorder` (events and observers),
-and the components :class:`~petriflow.runtime.channels.Channels` and
-:class:`~petriflow.runtime.faults.Faults`, which see the run only through
-:class:`~petriflow.runtime.host.RunHost`. The scheduler puts them together, steps
-from instant to instant and decides when the run stops.
+the components :class:`~petriflow.runtime.channels.Channels` and
+:class:`~petriflow.runtime.faults.Faults`, and the
+:class:`~petriflow.runtime.services.RunServices` the actions' contexts reach. Each
+part is made with its collaborators named and typed; none holds the scheduler. The
+scheduler puts them together, steps from instant to instant and decides when the run
+stops.
 
 Time is an integer count of ticks, so the same net, world, configuration and seed
 give the same events bit for bit. Each transition runs one action at a time (a robot
@@ -61,18 +63,16 @@ Examples:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any, Iterable
+from typing import Any, Iterable, Mapping
 
 from petriflow import limits
 from petriflow.collector import paused, relaxed
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 from petriflow.net import Net
-from petriflow.workflow import final_marking_of
 from petriflow.outcome import StopReason
 from petriflow.runtime.action import Action
-from petriflow.runtime.assembly import validate
+from petriflow.runtime.agents import Agents
 from petriflow.runtime.binding import Binding
 from petriflow.runtime.channels import Channels
 from petriflow.runtime.clock import Clock, SimulatedClock
@@ -82,11 +82,16 @@ from petriflow.runtime.faults import Faults
 from petriflow.runtime.firing import Firer, Unrouted, ZenoError
 from petriflow.runtime.index import RunIndex
 from petriflow.runtime.kernel import Kernel
+from petriflow.runtime.lifecycle import Firing
 from petriflow.runtime.recorder import EventHandler, Recorder
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.resources import Liveness, ResourceContext, Resources
+from petriflow.runtime.result import RunResult
+from petriflow.runtime.services import RunServices
 from petriflow.runtime.tokens import TokenStore
 from petriflow.runtime.trace import EventKind
+from petriflow.runtime.validation import UNKNOWN, settings_of, validate
+from petriflow.workflow import final_marking_of
 
 __all__ = ["Scheduler", "RunResult", "ZenoError", "EmptySchedule"]
 
@@ -95,35 +100,6 @@ _RUN, _STOP = EventKind.RUN.value, EventKind.STOP.value
 
 class EmptySchedule(PetriflowError):
     """:meth:`Scheduler.step` was asked for an instant but nothing more can happen."""
-
-
-@dataclass
-class RunResult:
-    """How a run ended.
-
-    Attributes:
-        reason: why it ended (:class:`~petriflow.outcome.StopReason`): ``final`` (the
-            net's final marking was reached with nothing running or pending),
-            ``dead`` (nothing can fire, run or arrive any more), ``until`` (the time
-            limit), ``firings`` (the firing limit), ``failed`` (an action failed with
-            no failure route; see ``error``), ``stalled`` (actions stepped tick by tick
-            for the configuration's ``stall`` seconds with no firing starting or
-            ending; see ``error``) or ``fired`` (:meth:`Scheduler.fire_one`).
-        time: simulated seconds at the end.
-        firings: transitions fired.
-        marking: token counts at the end.
-        events: number of events recorded.
-        error: the unrouted failure, if any.
-        tokens: ``{place: [data, ...]}`` at the end.
-    """
-
-    reason: StopReason
-    time: float
-    firings: int
-    marking: Marking
-    events: int
-    error: str | None = None
-    tokens: dict[str, list[Any]] = field(default_factory=dict)
 
 
 class Scheduler:
@@ -141,38 +117,52 @@ class Scheduler:
         binding: the net already bound (:func:`~petriflow.runtime.binding.bind`).
         clock: how time moves between instants (default
             :class:`~petriflow.runtime.clock.SimulatedClock`).
+        settings: the world file's settings the actions read, checked
+            (:class:`~petriflow.runtime.validation.CheckedRun`); default: read from the
+            world's ``meta`` (:func:`~petriflow.runtime.validation.settings_of`).
 
     Raises:
         NetFormatError: an action, parameter, port or guard does not bind; a fault or
-            channel of the configuration names nothing in the net.
+            channel of the configuration names nothing in the net; the world lacks a
+            capability an action uses, or a setting it reads is bad.
     """
 
     @paused()  # indexing a large net makes no cycles (petriflow.collector)
     def __init__(self, net: Net, *, world: Any = None, config: RunConfig | dict | None = None, seed: int | None = None,
                  registry: Registry | None = None, path: str | None = None, binding: Binding | None = None,
-                 clock: Clock | None = None) -> None:
+                 clock: Clock | None = None, settings: Mapping[str, Mapping[str, Any]] | None = None) -> None:
         self.net = net
         self.world = world
-        self.config = RunConfig.from_dict(config) if isinstance(config, dict) else config or RunConfig()
-        self.seed = self.config.seed if seed is None else seed
-        self.binding = validate(net, self.config, binding=binding, registry=registry, path=path)
+        self.config = config = RunConfig.from_dict(config) if isinstance(config, dict) else config or RunConfig()
+        self.seed = seed = config.seed if seed is None else seed
+        # the world given is checked for the capabilities the actions use (a world-less
+        # run for its need of a world only where a file run is: by validation)
+        self.binding = validate(net, config, binding=binding, registry=registry, path=path,
+                                world=UNKNOWN if world is None else world)
         self.registry = self.binding.registry
         self.clock = clock or SimulatedClock()
-        kernel = self.kernel = Kernel(float(getattr(world, "dt", None) or self.config.dt))
+        self.settings = settings_of(world, self.binding) if settings is None else settings
+        kernel = self.kernel = Kernel(float(getattr(world, "dt", None) or config.dt))
         index = self.index = RunIndex(net, self.binding)
         self.compiled = index.compiled
         self.final = final_marking_of(net)  # declared, else a WF-net's sink (the rule check uses)
-        self.tokens = TokenStore(index.compiled, net.initial_marking, self.final)
-        self.recorder = Recorder(kernel)
-        self.faults = Faults(self, self.config.faults, index.agents)
-        self.enabled_set = EnabledSet(index, self.tokens, self.faults.stopped, {})
-        self.firer = Firer(net, index, kernel, self.tokens, self.enabled_set, self.recorder, self.faults, world,
-                           self.seed)
+        tokens = self.tokens = TokenStore(index.compiled, net.initial_marking, self.final)
+        recorder = self.recorder = Recorder(kernel)
+        faults = self.faults = Faults(kernel, recorder, config.faults, index.agents, stopped=self.agent_stopped,
+                                      started=self.agent_started)
+        running: dict[int, Firing] = {}  # the firings running now (the runner's; enabling reads it)
+        states: dict[str, Any] = {}  # the agents' states (the agents'; state guards read them)
+        enabled = self.enabled_set = EnabledSet(index, tokens, faults.stopped, running, states)
+        agents = Agents(index, enabled, states)
+        self.channels = Channels(net, config.channel_models(self.registry), seed, kernel=kernel, recorder=recorder,
+                                 links=faults, world=world, deliver=self.deliver)
+        self.resources = Resources(self.registry, ResourceContext(world, Liveness(faults.alive, index.agents), config,
+                                                                  self.settings))
+        services = RunServices(agents=agents, tokens=tokens, channels=self.channels, resources=self.resources,
+                               liveness=faults, settings=self.settings)
+        self.firer = Firer(net, index, kernel, tokens, enabled, recorder=recorder, agents=agents,
+                           channels=self.channels, services=services, world=world, seed=seed, running=running)
         self.runner = self.firer.runner
-        self.channels = self.firer.channels = Channels(self, self.config.channel_models(self.registry),
-                                                        self.seed)
-        self.resources = self.firer.resources = Resources(
-            self.registry, ResourceContext(world, Liveness(self.faults.alive, index.agents), self.config))
         self._started = self._closed = self._opened = False  # _opened: the instant at tick 0 was processed
         self._watchers: list[Any] = []
         self._finished: RunResult | None = None
@@ -346,7 +336,8 @@ class Scheduler:
             return self._end(StopReason.FAILED, str(exc.failure))
 
     def _stop_reason(self, limit: int | None) -> RunResult | None:
-        """The run's end if it ends before the next instant (see :class:`RunResult`)."""
+        """The run's end if it ends before the next instant (see
+        :class:`~petriflow.runtime.result.RunResult`)."""
         kernel, stall = self.kernel, self.config.stall
         if self.firer.limit is not None and self.firings >= self.firer.limit:
             return self._end(StopReason.FIRINGS)
@@ -428,5 +419,5 @@ class Scheduler:
             data["teardown_errors"] = problems
         self.emit(_STOP, None, None, **data)
         self._finished = RunResult(reason, round(self.now, 9), self.firings, self.marking(), self.recorder.count, error,
-                                   self.tokens.tokens())
+                                   self.tokens.tokens(), net=self.net, seed=self.seed)
         return self._finished

@@ -76,7 +76,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     sweep = load_sweep(args.spec)
     if args.trials is not None:
         sweep = sweep.with_seeds(args.trials)
-    from petriflow.runtime.session import _check_outputs
+    from petriflow.runtime.outputs import check_outputs
 
     if _job_working_dir() is not None:
         for flag, value in (("--db", args.db), ("--csv", args.csv), ("--plot", args.plot)):
@@ -85,7 +85,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                                      " lands in Ray's temporary copy of the working directory, which Ray may"
                                      f" remove; give an absolute path on the head node ({flag} /data/"
                                      f"{Path(value).name})")
-    _check_outputs({"--db": args.db, "--csv": args.csv, "--plot": args.plot},
+    check_outputs({"--db": args.db, "--csv": args.csv, "--plot": args.plot},
                    [Path(sweep.path)] + ([Path(sweep.run)] if sweep.run else []))
     if not args.progress_every > 0:
         raise PetriflowError(f"--progress-every must be a number of seconds > 0, got {args.progress_every}")

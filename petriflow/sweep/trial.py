@@ -72,8 +72,9 @@ def set_path(data: Any, path: str, value: Any, root: str) -> None:
 
 
 def _build_net(spec: dict[str, Any], params: dict[str, Any], values: dict[str, Any]):
+    from petriflow.io.files import read_text_file
     from petriflow.net import Net
-    from petriflow.runtime.session import _net_from_text, _read_text
+    from petriflow.runtime.loading import net_from_text
 
     net_spec = spec["net"]
     if isinstance(net_spec, dict):
@@ -97,12 +98,12 @@ def _build_net(spec: dict[str, Any], params: dict[str, Any], values: dict[str, A
     path = Path(substitute(net_spec, values))
     if not path.is_file():
         raise NetFormatError("no such file", path=str(path))
-    return _net_from_text(_read_text(path), str(path)), path
+    return net_from_text(read_text_file(path), str(path)), path
 
 
 def _config(spec: dict[str, Any], net, net_path: Path, sets: dict[str, Any]):
     from petriflow.runtime.config import RunConfig, load_config
-    from petriflow.runtime.session import net_config
+    from petriflow.runtime.loading import net_config
 
     if spec["run"] is not None:
         config = load_config(spec["run"])

@@ -10,7 +10,7 @@ import time
 import pytest
 
 from petriflow.cli import main
-from petriflow.runtime import session
+from petriflow.runtime.scheduler import Scheduler
 from petriflow.runtime.journal import Journal, JournalError
 from petriflow.runtime.session import resume, run_files
 from petriflow.runtime.trace import read_trace
@@ -77,7 +77,7 @@ def test_crash_mid_run_then_resume_gives_the_uninterrupted_trace(tmp_path, monke
     class Crash(Exception):
         pass
 
-    original = session.Scheduler.on_event
+    original = Scheduler.on_event
 
     def crash_after(self, handler, kinds=None):
         original(self, handler, kinds)
@@ -90,7 +90,7 @@ def test_crash_mid_run_then_resume_gives_the_uninterrupted_trace(tmp_path, monke
 
             original(self, crash)
 
-    monkeypatch.setattr(session.Scheduler, "on_event", crash_after)
+    monkeypatch.setattr(Scheduler, "on_event", crash_after)
     with pytest.raises(Crash):
         run_files(PASSAGE, db=tmp_path / "run.sqlite", seed=2)
     monkeypatch.undo()
@@ -200,7 +200,7 @@ def test_resume_writes_the_outputs_the_run_was_started_with(tmp_path, ticker, mo
     class Crash(Exception):
         pass
 
-    original = session.Scheduler.on_event
+    original = Scheduler.on_event
 
     def crash_after(self, handler, kinds=None):
         original(self, handler, kinds)
@@ -208,7 +208,7 @@ def test_resume_writes_the_outputs_the_run_was_started_with(tmp_path, ticker, mo
             self._crash_installed = True
             original(self, lambda event: (_ for _ in ()).throw(Crash()) if event.seq == 9 else None)
 
-    monkeypatch.setattr(session.Scheduler, "on_event", crash_after)
+    monkeypatch.setattr(Scheduler, "on_event", crash_after)
     out = tmp_path / "out"
     with pytest.raises(Crash):
         run_files(ticker, max_firings=12, trace=out / "t.jsonl", xes=out / "t.xes", db=out / "t.sqlite")

@@ -66,11 +66,11 @@ def test_actions_name_only_declared_places_and_no_state_place():
         if t.action in ("bidding.send", "bidding.receive"):
             assert t.params["box"] in net.places and net.places[t.params["box"]].channel == "lan"
     from petriflow.errors import NetFormatError
-    from petriflow.runtime.registry import default_registry
+    from petriflow.runtime.binding import bind
 
     net.transitions["robot1_send_robot2"].params["box"] = "box_robot9"
     with pytest.raises(NetFormatError, match="box_robot9"):
-        default_registry.bind(net)
+        bind(net)
 
 
 def fire(net, transition, tokens, *, states=None, world=None, config=None):

@@ -16,6 +16,7 @@ from petriflow.agents.legged.control import LeggedRobot
 from petriflow.errors import NetFormatError
 from petriflow.io.yaml import loads_net
 from petriflow.runtime.registry import default_registry
+from petriflow.runtime.binding import bind
 from petriflow.runtime.scheduler import Scheduler
 from petriflow.testing import check_action, fire_one
 
@@ -64,7 +65,7 @@ def test_plugin_registers_the_gait_actions():
 def test_walk_parameters_are_checked_when_the_net_is_bound(net_for, params, match):
     """A bad combination of parameters fails when the net is bound, before anything moves."""
     with pytest.raises(NetFormatError, match=match):
-        default_registry.bind(net_for("gait.walk", params))
+        bind(net_for("gait.walk", params))
 
 
 @pytest.mark.parametrize("cls, params", [

@@ -14,6 +14,7 @@ from petriflow.agents.planning.maps import OBSTACLE, ROBOT_LABELS, GridFrame, co
 from petriflow.errors import PetriflowError
 from petriflow.io.yaml import loads_net
 from petriflow.runtime.registry import Registry, default_registry
+from petriflow.runtime.binding import bind
 from petriflow.testing import StubWorld, check_action, fire_one
 
 MPP = 0.01  # a 64 x 48 pixel map of 0.64 m x 0.48 m
@@ -172,7 +173,7 @@ def test_unknown_variant_is_refused_when_the_net_loads():
     """A misspelt variant fails at binding time, naming the transition."""
     net = loads_net(PLAN_NET.replace("cell: 2}", "cell: 2, variant: fastest}"))
     with pytest.raises(PetriflowError, match="'plan'.*variant"):
-        Registry().bind(net)
+        bind(net, Registry())
 
 
 @pytest.mark.parametrize("pose, decision, route", [

@@ -15,6 +15,7 @@ from petriflow.agents.smart.messages import ActionId, Command
 from petriflow.errors import NetFormatError
 from petriflow.io.yaml import loads_net
 from petriflow.runtime.registry import default_registry
+from petriflow.runtime.binding import bind
 from petriflow.runtime.scheduler import Scheduler
 from petriflow.testing import check_action, fire_one
 from tests.agents.smart.conftest import place
@@ -66,7 +67,7 @@ def test_send_encodes_its_commands():
                                              ("[[MOVE_TO, red, 300, 1]]", "one byte")])
 def test_send_rejects_bad_commands_when_the_net_is_bound(commands, match):
     with pytest.raises(NetFormatError, match=match):
-        default_registry.bind(loads_net(one("smart.send", f"{{commands: {commands}}}")))
+        bind(loads_net(one("smart.send", f"{{commands: {commands}}}")))
 
 
 def test_simplify_keeps_the_corners():
@@ -196,10 +197,10 @@ transitions:
 def test_follow_port_must_name_a_place_of_the_net():
     """The orders and scene ports are checked when the net is bound."""
     with pytest.raises(NetFormatError, match="port 'orders' names unknown place 'order'"):
-        default_registry.bind(loads_net(one("smart.follow", "{orders: order}")))
+        bind(loads_net(one("smart.follow", "{orders: order}")))
 
 
 def test_follow_checks_its_parameters():
     with pytest.raises(NetFormatError, match="must be > 0"):
-        default_registry.bind(loads_net(one("smart.follow", "{step: 0}")))
+        bind(loads_net(one("smart.follow", "{step: 0}")))
     assert Follow.check_params({}, "t")["localise"] == "vision"

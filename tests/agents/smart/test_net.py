@@ -10,7 +10,7 @@ import pytest
 
 from petriflow.engine import enabled, fire
 from petriflow.io import load_net
-from petriflow.runtime.registry import default_registry
+from petriflow.runtime.binding import bind
 from petriflow.workflow import sink_places, source_places
 from tests.agents.smart.conftest import SMART
 
@@ -58,7 +58,7 @@ def sound(net) -> bool:
 def test_net_loads_and_binds_to_registered_actions(name):
     """Every transition's action and guard resolve and its parameters check."""
     net = load_net(SMART / name)
-    bound = default_registry.bind(net, name)
+    bound = bind(net, path=name)
     assert set(bound.actions()) == {t for t, tr in net.transitions.items() if tr.action}
 
 
