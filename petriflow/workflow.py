@@ -1,7 +1,7 @@
 """WF-net operators: AND/XOR split and join as plain P/T structure.
 
-WoPeD and the SMART net (seed 003) draw operators such as an AND-split or an XOR-join
-as one box. Their meaning is plain P/T structure:
+Workflow editors (WoPeD, YAWL) and nets drawn in their style draw operators such as an
+AND-split or an XOR-join as one box. Their meaning is plain P/T structure:
 
 * an AND side is one transition touching every branch place;
 * an XOR side is one transition per branch place.

@@ -43,12 +43,32 @@ import math
 from typing import Any
 
 from petriflow.agents.slam.agent import Air, Base, Central, Robot, Wireless, frame, merge_seen
-from petriflow.agents.slam.corridors import to_map
+from petriflow.agents.slam.corridors import HALF_WIDTH, to_map
 from petriflow.agents.slam.history import choose, exchange_role, read_node, update
+from petriflow.capabilities import Bodies, Physics, Poses
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
+from petriflow.runtime.settings import Section, Setting
 
-__all__ = ["GUARDS", "AIR", "Boot", "Explore", "Install", "Finish", "Scan", "SwitchOff", "Send", "Receive",
+__all__ = ["GUARDS", "AIR", "SLAM", "Boot", "Explore", "Install", "Finish", "Scan", "SwitchOff", "Send", "Receive",
            "CentralBoot", "Serve", "Dispatch"]
+
+_POINT = Setting(list, doc="x, y (m)", items=Setting(float))
+
+#: A corridor world's ``meta.slam`` (:func:`petriflow.agents.slam.corridors.world_description`
+#: writes it): the map frame, the corridors' ground truth the metrics score the built
+#: map against, the centralised system's nodes.
+SLAM = Section("slam", {
+    "origin": Setting((list, type(None)), None, "world x, y of the map's origin (default: the RA's start)",
+                      items=Setting(float)),
+    "size": Setting((list, type(None)), None, "the world's extent x, y (m)", items=Setting(float)),
+    "half_width": Setting(float, HALF_WIDTH, "half a corridor's width (m)", low=0),
+    "vertices": Setting(dict, {}, "the ground-truth graph's vertices: id -> map x, y (m)"),
+    "edges": Setting(list, [], "the ground-truth graph's corridors: [vertex, vertex]"),
+    "nodes": Setting(list, [], "the centralised system's pre-installed nodes (world x, y)", items=_POINT),
+    "starts": Setting(list, [], "the RAs' starts in the map frame (a generated maze)", items=_POINT),
+    "maze_seed": Setting((int, type(None)), None, "the seed of a generated maze"),
+    "paper": Setting(dict, {}, "the vertices as published, for comparison (the Fig. 6 world)"),
+}, doc="a corridor world: the map frame and the ground truth")
 
 #: The resource type of the beacons.
 AIR = "slam.air"
@@ -60,6 +80,7 @@ def _radio(ctx: ActionContext, air_place: str) -> Any:
 
 
 def _meta(ctx: ActionContext) -> dict[str, Any]:
+    # the actions that do not declare SLAM yet (the second wave migrates them: ctx.settings)
     return (getattr(ctx.world, "meta", None) or {}).get("slam", {})
 
 
@@ -74,10 +95,17 @@ def _publish(ctx: ActionContext, state: Robot | Wireless) -> None:
 
 
 class Boot(InstantAction):
-    """Make the RA's state (body, calibrated wheels, history); ask a WA for its map."""
+    """Make the RA's state (body, calibrated wheels, history); ask a WA for its map.
+
+    It declares what it needs of its run: the world's poses, bodies and physics (its
+    body drives the pybullet robot) and the world file's ``meta.slam`` (:data:`SLAM`),
+    read and checked when the world is loaded.
+    """
 
     agent_state = Robot
     resources = {"air": AIR}
+    uses = (Poses, Bodies, Physics)
+    settings = SLAM
     params = {
         "slot": Param(int, 0, "the RA's slot: its vertex ids are slot * 1000 + n", low=0),
         "mode": Param(str, "decentralised", "decentralised or centralised", choices=("decentralised", "centralised")),
@@ -109,7 +137,7 @@ class Boot(InstantAction):
         if ctx.world is None:
             raise ActionFailure("slam.boot: an RA needs a world")
         name = ctx.agent or ctx.transition
-        meta = _meta(ctx)
+        layout = ctx.settings
         nominal = Wheels.nominal(p["wheel_radius"], p["track"])
         true = nominal.with_errors(p["ed"], p["eb"])
         believed, passes = (calibrate(true, nominal, p["ppr"], passes=p["passes"]) if p["umbmark"]
@@ -119,12 +147,12 @@ class Boot(InstantAction):
 
             passes = [umbmark(true, nominal, p["ppr"])]
         x, y = ctx.world.position(name)
-        origin = tuple(meta.get("origin", (x, y)))
+        origin = (x, y) if layout["origin"] is None else tuple(layout["origin"])
         start = to_map((x, y), origin)
-        radios = sorted(n for n in getattr(ctx.world, "bodies", {}) if n.startswith(("wa_", "node")))
+        radios = sorted(n for n in ctx.world.bodies if n.startswith(("wa_", "node")))
         body = Body(ctx.world, name, true=true, believed=believed, ppr=p["ppr"], start=start,
                     compass=Compass(p["compass_deg"]), sensor_range=p["sensor_range"], ignore=radios)
-        half = float(meta.get("half_width", 0.6))
+        half = layout["half_width"]
         state = Robot(name, slot=p["slot"], mode=p["mode"], radius=p["match"])
         state.body = body
         state.origin = origin

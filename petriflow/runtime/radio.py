@@ -1,7 +1,7 @@
 """Radio propagation: one log-distance path-loss model, with walls counted by ray test.
 
-Every radio channel of petriflow (the core ``range`` channel, seed 000's Wi-Fi, seed
-002's ZigBee bus) computes received power the same way::
+Every radio channel of petriflow (the core ``range`` channel, a scenario's Wi-Fi link
+between robots, a ZigBee bus) computes received power the same way::
 
     RSSI(d, walls) = tx_power_dbm - reference_loss_db - 10 * exponent * log10(max(d, min_distance) / 1 m)
                      - walls_db
