@@ -190,7 +190,7 @@ def load(net: Net | str | Path, *, config: Any = None, world: Any = None,
         NetFormatError: a file is missing or malformed, or an action does not bind.
     """
     from petriflow.runtime.config import RunConfig, load_config
-    from petriflow.runtime.validation import validate
+    from petriflow.runtime.validation import UNKNOWN, validate
 
     if isinstance(net, (str, Path)) or (config is None and getattr(net, "path", None)):
         from petriflow.runtime.session import prepare
@@ -208,9 +208,9 @@ def load(net: Net | str | Path, *, config: Any = None, world: Any = None,
         net = config.bound(net)
         config.import_actions()
         binding, world_file = None, None
-    binding = validate(net, config, binding=None if binding is None or binding.net is not net else binding,
-                       registry=registry)
     owned = world is None and world_file is not None
+    binding = validate(net, config, binding=None if binding is None or binding.net is not net else binding,
+                       registry=registry, world=True if owned else UNKNOWN if world is None else world)
     if owned:
         from petriflow.world import load_world
 

@@ -62,7 +62,7 @@ from pathlib import Path
 from typing import Any
 
 from petriflow.errors import DependencyNotInstalled, NetFormatError, PetriflowError, did_you_mean
-from petriflow.worldfile import COLOURS, DRIVES, check_box, check_world
+from petriflow.worldfile import COLOURS, DRIVES, WorldDescription, check_box, check_world
 
 __all__ = ["World", "Camera", "RayRequest", "load_world", "COLOURS", "DRIVES", "ROBOT_GROUP"]
 
@@ -214,7 +214,8 @@ class World:
                  gui: bool = False, path: str | None = None) -> None:
         self.path = path
         self.base = Path(base)
-        description = check_world(description, path)  # every field, before pybullet is touched
+        if not isinstance(description, WorldDescription):  # every field, before pybullet is touched
+            description = check_world(description, path)
         self.p = _pybullet()
         self.dt = description["dt"]
         self.meta = dict(description["meta"])
@@ -247,7 +248,7 @@ class World:
         if description["plane"]:
             self.bodies["plane"] = self._load_urdf("pybullet_data:plane.urdf", (0, 0, 0), 0.0, fixed=True)
         for box in description["boxes"]:
-            self.add_box(**box)
+            self._box(box)
         if description["grid"]:
             self._add_grid(description["grid"])
         for robot in description["robots"]:
@@ -290,8 +291,12 @@ class World:
                 mass: float = 0.0) -> int:
         """Add a box of full extents ``size`` centred at ``position`` (checked as a
         world file's box is; ``colour`` is a name or ``[r, g, b(, a)]``)."""
-        box = check_box({"id": id, "size": size, "position": position, "yaw": yaw, "colour": colour,
-                         "mass": mass}, self.path)
+        return self._box(check_box({"id": id, "size": size, "position": position, "yaw": yaw, "colour": colour,
+                                    "mass": mass}, self.path))
+
+    def _box(self, box: dict[str, Any]) -> int:
+        """Add a checked box (:func:`~petriflow.worldfile.check_box`'s output)."""
+        id = box["id"]
         if id in self.bodies:
             self._fail("duplicate body id", id)
         p = self.p
@@ -319,8 +324,9 @@ class World:
                 while c < len(row) and row[c] == "#":
                     c += 1
                 x = ox + (start + c) / 2 * cell
-                self.add_box(f"grid_{r}_{start}", ((c - start) * cell, cell, height), (x, y, height / 2),
-                             colour=grid["colour"])
+                self._box({"id": f"grid_{r}_{start}", "size": (float((c - start) * cell), float(cell), float(height)),
+                           "position": (float(x), float(y), float(height / 2)), "yaw": 0.0, "colour": grid["colour"],
+                           "mass": 0.0})
 
     def _add_robot(self, robot: dict[str, Any]) -> None:
         x, y = robot["position"]

@@ -29,7 +29,7 @@ from typing import Any, Mapping
 from petriflow import limits
 from petriflow.errors import NetFormatError, did_you_mean
 
-__all__ = ["check_world", "check_box", "COLOURS", "MIN_DT", "MAX_DT", "MODES", "DRIVES"]
+__all__ = ["check_world", "check_box", "WorldDescription", "COLOURS", "MIN_DT", "MAX_DT", "MODES", "DRIVES"]
 
 #: Named colours (RGBA) a description may use.
 COLOURS = {
@@ -61,6 +61,11 @@ MODES = ("dynamic", "kinematic")
 #: and a turn rate, ``holonomic`` also a sideways speed.
 DRIVES = ("diff", "unicycle", "holonomic")
 _CAMERA_KEYS = {"id", "position", "target", "up", "fov", "width", "height"}
+
+
+class WorldDescription(dict):
+    """A world description :func:`check_world` checked: every field typed, defaults
+    filled in (a :class:`petriflow.world.World` builds one without checking it again)."""
 
 
 class _Checker:
@@ -158,7 +163,7 @@ def check_box(box: Mapping[str, Any], path: str | None = None) -> dict[str, Any]
     return _box(check, box, check.text(box.get("id"), "id", box, None))
 
 
-def check_world(data: Any, path: str | None = None) -> dict[str, Any]:
+def check_world(data: Any, path: str | None = None) -> WorldDescription:
     """Check a world description and return it with every number as a float and every
     vector as a tuple, defaults filled in (what :class:`petriflow.world.World` builds).
 
@@ -268,4 +273,4 @@ def check_world(data: Any, path: str | None = None) -> dict[str, Any]:
         if math.hypot(*cross) < 1e-9:
             check.fail("the camera's up is along its line of sight", camera, name)
         out["cameras"].append(entry)
-    return out
+    return WorldDescription(out)

@@ -57,6 +57,7 @@ __all__ = [
     "StateChange",
     "generator_action",
     "REQUIRED",
+    "type_names",
 ]
 
 _S = TypeVar("_S")
@@ -75,6 +76,17 @@ class Status(enum.Enum):
 
 REQUIRED = object()
 """Default of a :class:`Param` that a net must give."""
+
+
+def type_names(kinds: Any) -> str:
+    """A type or a tuple of types in words, as errors name them.
+
+    Examples:
+        >>> type_names((int, type(None)))
+        'int or NoneType'
+    """
+    kinds = kinds if isinstance(kinds, tuple) else (kinds,)
+    return " or ".join(getattr(k, "__name__", repr(k)) for k in kinds)
 
 
 @dataclass(frozen=True)
@@ -147,8 +159,7 @@ class Param:
         if isinstance(value, float) and not math.isfinite(value):
             raise NetFormatError(f"{what} {name!r} must be a finite number, got {value!r}", element=where)
         if self.type is not object and not isinstance(value, types):
-            wanted = " or ".join(t.__name__ for t in types)
-            raise NetFormatError(f"{what} {name!r} must be {wanted}, got {value!r}", element=where)
+            raise NetFormatError(f"{what} {name!r} must be {type_names(types)}, got {value!r}", element=where)
         if self.choices and value not in self.choices:
             raise NetFormatError(
                 f"{what} {name!r} must be one of {list(self.choices)}, got {value!r}", element=where

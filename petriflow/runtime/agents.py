@@ -49,7 +49,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Callable, Iterable, MutableMapping, Protocol
 
 from petriflow.errors import PetriflowError
-from petriflow.runtime.action import ANY_KEY
+from petriflow.runtime.action import ANY_KEY, type_names
 
 if TYPE_CHECKING:
     from petriflow.runtime.enabling import EnabledSet
@@ -208,7 +208,7 @@ class Agents:
         if expected is None:
             expected = self.index.state_type.get(agent)
         if expected is not None and state is not None and not isinstance(state, expected):
-            raise PetriflowError(f"agent {agent!r}: its state must be a {_names(expected)}, not"
+            raise PetriflowError(f"agent {agent!r}: its state must be a {type_names(expected)}, not"
                                  f" {type(state).__name__}")
         old = self.states.get(agent)
         if isinstance(old, AgentState) and old is not state:
@@ -241,7 +241,3 @@ class Agents:
             if self.sleepers.any:
                 self.sleepers.acted(agent)
 
-
-def _names(kinds: type | tuple) -> str:
-    kinds = kinds if isinstance(kinds, tuple) else (kinds,)
-    return " or ".join(k.__name__ for k in kinds)

@@ -58,7 +58,7 @@ from petriflow import limits
 from petriflow.capabilities import missing, name_of
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
-from petriflow.runtime.action import Action, Port
+from petriflow.runtime.action import Action, Port, type_names
 from petriflow.runtime.declared import ActionDeclaration, Declarations, GuardDeclaration, read_declarations
 from petriflow.runtime.registry import Predicate, Registry, UnknownActionError, default_registry
 from petriflow.runtime.settings import Section
@@ -337,14 +337,14 @@ class _Binder:
             self.note(tid, "agent state", declared, reason, once=True)
             if not isinstance(kind, type):  # declared in a module's source: what it is is not known
                 if wanted is not None:
-                    self.note(tid, "agent state", declared, f"action {action} reads a {_type_names(wanted)}"
+                    self.note(tid, "agent state", declared, f"action {action} reads a {type_names(wanted)}"
                               f" state, and what {declared!r} is cannot be known without importing the module"
                               " that registers it", partly=True, once=True)
             elif wanted is not None and not issubclass(kind, wanted):
-                raise self.fail(tid, f"action {action} reads a {_type_names(wanted)} state, but subnet"
+                raise self.fail(tid, f"action {action} reads a {type_names(wanted)} state, but subnet"
                                 f" {subnet!r} declares state {declared!r} ({kind.__name__})", f"{tid}/action")
         elif wanted is not None:
-            raise self.fail(tid, f"action {action} reads its agent's {_type_names(wanted)} state: declare it on"
+            raise self.fail(tid, f"action {action} reads its agent's {type_names(wanted)} state: declare it on"
                             f" the subnet (state: ...)" if subnet else f"action {action} reads an agent state:"
                             " put the transition in an agent subnet", f"{tid}/action")
 
@@ -401,10 +401,6 @@ def closed_namespaces() -> frozenset[str]:
     names = [*installed.names(), *installed.names_of("guard"), *installed.names_of("agent state")]
     return frozenset({"core"} | {name.partition(".")[0] for name in names if "." in name})
 
-
-def _type_names(kinds: Any) -> str:
-    kinds = kinds if isinstance(kinds, tuple) else (kinds,)
-    return " or ".join(k.__name__ for k in kinds)
 
 
 def _agent_of(net: Net, tid: str) -> str | None:

@@ -60,7 +60,7 @@ from importlib.machinery import PathFinder
 from pathlib import Path
 from typing import Any
 
-from petriflow.runtime.action import REQUIRED, Action, ActionFailure, Param, Port
+from petriflow.runtime.action import REQUIRED, Action, ActionFailure, Param, Port, type_names
 
 __all__ = ["ActionDeclaration", "Declarations", "GuardDeclaration", "find_source", "read_declarations"]
 
@@ -114,15 +114,11 @@ class _Declared(Action):
 
     declaration: ActionDeclaration
 
-    def _refuse(self) -> None:
+    def _refuse(self, *args: Any) -> None:
         raise ActionFailure(f"action {self.declaration.name!r} was checked from its source"
                             f" ({self.declaration.where}) without importing it: import its module to run it")
 
-    def setup(self, world: Any) -> None:
-        self._refuse()
-
-    def start(self, ctx: Any) -> None:
-        self._refuse()
+    setup = start = _refuse  # nothing of it can run
 
 
 @dataclass
@@ -190,11 +186,15 @@ class Declarations:
             return f"no module read declares it, but {'; '.join(_capped(self.unread))}"
         return None
 
+    def put(self, kind: str, name: str, found: Any) -> None:
+        """Record ``found`` as ``name`` of ``kind`` (a name declared twice keeps a gap)."""
+        mine = self.names(kind)
+        mine[name] = _twice(mine[name], found) if name in mine else found
+
     def add(self, other: Declarations) -> None:
         for kind in ("action", "guard", "agent state", "resource"):
-            mine = self.names(kind)
             for name, found in other.names(kind).items():
-                mine[name] = _twice(mine[name], found) if name in mine else found
+                self.put(kind, name, found)
         for kind, reasons in other.hidden.items():
             self.hidden.setdefault(kind, []).extend(reasons)
         self.unread.extend(other.unread)
@@ -669,9 +669,7 @@ class _Reader:
                     reads = None
                 elif reads is not None:
                     reads = tuple(reads)
-            declared = GuardDeclaration(name, self.at(call), reads, gaps)
-            guards = self.found.guards
-            guards[name] = _twice(guards[name], declared) if name in guards else declared
+            self.found.put("guard", name, GuardDeclaration(name, self.at(call), reads, gaps))
             return None
         if not isinstance(name, str):
             return self.hidden("action", call, written)
@@ -682,15 +680,12 @@ class _Reader:
             self.cls(declared, target, set())
         elif isinstance(target, ast.Name) and len(self.classes.get(target.id, [])) == 1:
             self.cls(declared, self.classes[target.id][0], set())
-        elif isinstance(target, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Name, ast.Lambda, ast.Attribute)):
+        else:  # a function; or a decorator made, then applied elsewhere: params from it, the target unseen
             params = call.args[1] if len(call.args) > 1 else _keyword(call, "params")
             declared.params = self.params(params, declared.gaps)
-        else:  # a decorator made, then applied elsewhere: params from it, the target unseen
-            params = call.args[1] if len(call.args) > 1 else _keyword(call, "params")
-            declared.params = self.params(params, declared.gaps)
-            declared.gaps.append(f"what {self.at(call)} is applied to is not seen")
-        actions = self.found.actions
-        actions[name] = _twice(actions[name], declared) if name in actions else declared
+            if not isinstance(target, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Name, ast.Lambda, ast.Attribute)):
+                declared.gaps.append(f"what {self.at(call)} is applied to is not seen")
+        self.found.put("action", name, declared)
         return None
 
     def target(self, declared: ActionDeclaration, target: ast.AST | None) -> None:
@@ -733,7 +728,7 @@ class _Reader:
                 declared.requires = real.requires
                 declared.resources = dict(getattr(real, "resources", {}))
                 if real.agent_state is not None:
-                    declared.gaps.append(f"the agent state it reads ({_type_name(real.agent_state)}) is not"
+                    declared.gaps.append(f"the agent state it reads ({type_names(real.agent_state)}) is not"
                                          " checked against its subnet's")
             elif not (isinstance(real, type) or (isinstance(base, ast.Name) and base.id == "object")):
                 declared.params = None  # a petriflow mixin or object declare nothing; anything else may
@@ -778,10 +773,8 @@ def _node_value(node: ast.stmt) -> ast.expr | None:
 
 
 def _keyword(call: ast.Call, name: str) -> ast.expr | None:
-    for keyword in call.keywords:
-        if keyword.arg == name:
-            return keyword.value
-    return None
+    """The value of the call's keyword argument ``name`` (``None``: not given)."""
+    return next((keyword.value for keyword in call.keywords if keyword.arg == name), None)
 
 
 def _callee(call: ast.Call) -> str | None:
@@ -796,10 +789,6 @@ def _is_main_guard(node: ast.stmt) -> bool:
             and test.left.id == "__name__" and len(test.comparators) == 1
             and isinstance(test.comparators[0], ast.Constant) and test.comparators[0].value == "__main__")
 
-
-def _type_name(kinds: Any) -> str:
-    kinds = kinds if isinstance(kinds, tuple) else (kinds,)
-    return " or ".join(getattr(k, "__name__", repr(k)) for k in kinds)
 
 
 def _module_file(base: Path) -> Path | None:

@@ -135,10 +135,12 @@ class Scheduler:
         self.world = world
         self.config = config = RunConfig.from_dict(config) if isinstance(config, dict) else config or RunConfig()
         self.seed = seed = config.seed if seed is None else seed
-        # the world given is checked for the capabilities the actions use (a world-less
-        # run for its need of a world only where a file run is: by validation)
+        # a binding not checked yet is checked here, for the capabilities the actions use
+        # of the world given too (a world-less run is refused for an action that needs a
+        # world where a file run is: by validation, before anything is made)
+        checked = binding is not None and binding.checked
         self.binding = validate(net, config, binding=binding, registry=registry, path=path,
-                                world=UNKNOWN if world is None else world)
+                                world=UNKNOWN if world is None or checked else world)
         self.registry = self.binding.registry
         self.clock = clock or SimulatedClock()
         self.settings = settings_of(world, self.binding) if settings is None else settings
