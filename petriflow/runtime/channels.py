@@ -16,12 +16,8 @@ Examples:
     >>> from petriflow.io.yaml import loads_net
     >>> from petriflow.runtime.kernel import Kernel
     >>> from petriflow.runtime.recorder import Recorder
-    >>> net = loads_net('''
-    ... petriflow: 1
-    ... subnets:
-    ...   - {id: a, places: [{id: out, channel: radio}], transitions: [{id: send, out: [out]}]}
-    ...   - {id: b, transitions: [{id: take, in: [out]}]}
-    ... ''')
+    >>> pair = "{id: a, places: [{id: out, channel: radio}], transitions: [{id: send, out: [out]}]}"
+    >>> net = loads_net(f"{{petriflow: 1, subnets: [{pair}, {{id: b, transitions: [{{id: take, in: [out]}}]}}]}}")
     >>> class Everyone:
     ...     def alive(self, agent): return True
     ...     def link_down(self, sender, receiver): return False

@@ -43,7 +43,7 @@ from petriflow.outcome import Name
 from petriflow.runtime.channel_models import ChannelModel, build_channel
 from petriflow.runtime.metrics import MetricRef, parse_refs
 
-__all__ = ["RunConfig", "Fault", "FaultKind", "load_config"]
+__all__ = ["RunConfig", "Fault", "FaultKind", "load_config", "plain_data"]
 
 _KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall", "metrics", "bind"}
 
@@ -377,16 +377,22 @@ def _bindings(given: Any, fail: Callable[..., Any]) -> dict[str, tuple[str, dict
         params = entry.get("params") or {}
         if not isinstance(params, dict) or not all(isinstance(k, str) for k in params):
             fail(f"bind: {name!r}: params must map parameter names to values, got {params!r}", key=str(name))
-        out[str(name)] = (entry["action"], {k: _plain(v) for k, v in params.items()})
+        out[str(name)] = (entry["action"], {k: plain_data(v) for k, v in params.items()})
     return out
 
 
-def _plain(value: Any) -> Any:
-    """Parsed YAML (mappings and lists that know their lines) as plain data."""
+def plain_data(value: Any) -> Any:
+    """Parsed YAML (mappings and lists that know their lines) as plain data.
+
+    Examples:
+        >>> from petriflow.io.yaml import parse_yaml
+        >>> type(plain_data(parse_yaml("{a: [1]}"))["a"])
+        <class 'list'>
+    """
     if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
+        return {k: plain_data(v) for k, v in value.items()}
     if isinstance(value, list):
-        return [_plain(v) for v in value]
+        return [plain_data(v) for v in value]
     return value
 
 

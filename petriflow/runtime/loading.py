@@ -21,15 +21,12 @@ into the same :class:`RunFiles`.
 Examples:
     >>> import tempfile, pathlib
     >>> folder = pathlib.Path(tempfile.mkdtemp())
-    >>> _ = (folder / "net.yaml").write_text('''
-    ... petriflow: 1
-    ... run: {until: 10}
-    ... places: [{id: i, tokens: 1}, o]
-    ... transitions: [{id: rest, action: core.wait, params: {seconds: 1.5}, in: [i], out: [o]}]
-    ... ''')
-    >>> files = read_run(folder / "net.yaml")
-    >>> files.net.id, files.config.until, files.world is None
-    ('net', 10.0, True)
+    >>> _ = (folder / "run.yaml").write_text("{seed: 7, world: world.yaml}")
+    >>> _ = (folder / "world.yaml").write_text("{dt: 0.05, plane: false}")
+    >>> _ = (folder / "cell.yaml").write_text("{petriflow: 1, places: [{id: idle, tokens: 1}]}")
+    >>> files = read_run(folder / "cell.yaml")
+    >>> files.net.id, files.config.seed, files.world.description["dt"]
+    ('cell', 7, 0.05)
 """
 
 from __future__ import annotations

@@ -11,14 +11,10 @@ dropped when it raises.
 Examples:
     >>> from petriflow.io.yaml import loads_net
     >>> from petriflow.runtime.scheduler import Scheduler
-    >>> net = loads_net('''
-    ... petriflow: 1
-    ... places: [{id: i, tokens: 1}, o]
-    ... transitions: [{id: rest, action: core.wait, params: {seconds: 2}, in: [i], out: [o]}]
-    ... ''')
-    >>> result = run_observed(Scheduler(net), keep_events=True)
-    >>> result.time, [e.kind for e in result.events]
-    (2.0, ['run', 'start', 'end', 'stop'])
+    >>> nap = "{petriflow: 1, places: [{id: i, tokens: 1}, o], transitions: [{id: nap, action: core.wait, in: [i], out: [o]}]}"
+    >>> result = run_observed(Scheduler(loads_net(nap)), keep_events=True)
+    >>> result.time, [e.kind for e in result.events], result.written
+    (1.0, ['run', 'start', 'end', 'stop'], [])
 """
 
 from __future__ import annotations

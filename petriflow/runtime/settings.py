@@ -42,6 +42,7 @@ from typing import Any, Iterable, Mapping
 
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.runtime.action import REQUIRED, Param
+from petriflow.runtime.config import plain_data
 
 __all__ = ["Setting", "Section", "read_settings", "sections_of"]
 
@@ -72,7 +73,7 @@ class Setting(Param):
             at = getattr(value, "line", None) or line
             return [self.items.read(f"{name}[{i}]", item, where, path, getattr(item, "line", None) or at)
                     for i, item in enumerate(value)]
-        return _plain(value)
+        return plain_data(value)
 
 
 def _read_fields(fields: Mapping[str, Setting], given: Mapping[str, Any], where: str,
@@ -94,15 +95,6 @@ def _read_fields(fields: Mapping[str, Setting], given: Mapping[str, Any], where:
         else:
             out[name] = copy.deepcopy(setting.default)
     return out
-
-
-def _plain(value: Any) -> Any:
-    """Parsed YAML (mappings and lists that know their lines) as plain data."""
-    if isinstance(value, Mapping):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_plain(v) for v in value]
-    return value
 
 
 @dataclass(frozen=True)

@@ -17,12 +17,12 @@ nothing checks it again.
 Examples:
     >>> from petriflow.io.yaml import loads_net
     >>> from petriflow.runtime.config import RunConfig
-    >>> net = loads_net('''
-    ... petriflow: 1
-    ... places: [{id: i, tokens: 1}, o]
-    ... transitions: [{id: rest, action: core.wait, params: {seconds: 2}, in: [i], out: [o]}]
-    ... ''')
-    >>> validate(net, RunConfig(), world=None).checked
+    >>> typo = "{petriflow: 1, places: [{id: i, tokens: 1}], transitions: [{id: t, action: core.wiat, in: [i]}]}"
+    >>> validate(loads_net(typo, path="n.yaml"), RunConfig())
+    Traceback (most recent call last):
+    ...
+    petriflow.errors.NetFormatError: n.yaml:1: 't': unknown action 'core.wiat' (did you mean 'core.wait' or 'core.set' or 'core.fail'?)
+    >>> validate(loads_net(typo.replace("wiat", "wait")), RunConfig(), world=None).checked
     True
 """
 
