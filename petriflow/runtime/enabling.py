@@ -38,7 +38,7 @@ Examples:
 
 from __future__ import annotations
 
-from typing import Any, Callable, Collection, Iterable, Mapping
+from typing import Any, Callable, Collection, Container, Iterable, Mapping
 
 from petriflow.errors import PetriflowError
 from petriflow.runtime.index import RunIndex
@@ -66,11 +66,12 @@ class EnabledSet:
         tokens: the run's tokens.
         stopped: the agents not running now, kept up to date by its owner (every other
             agent runs; while it is empty no transition's agent is looked up).
-        running: the transitions whose action is running (anything with ``in``).
+        running: the transitions whose action is running (the action runner's firings,
+            by transition index).
         states: ``{agent: state}``, what state guards read.
     """
 
-    def __init__(self, index: RunIndex, tokens: TokenStore, stopped: Collection[str], running: Any,
+    def __init__(self, index: RunIndex, tokens: TokenStore, stopped: Collection[str], running: Container[int],
                  states: Mapping[str, Any] | None = None) -> None:
         self.index = index
         self.tokens = tokens

@@ -34,6 +34,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, Iterable
 
+from petriflow.capabilities import Bodies, Physics, Poses, missing
+
 __all__ = ["LogDistance", "WallCounter", "walls_between", "pairs_within", "walls_along", "RadioIndex"]
 
 
@@ -95,12 +97,16 @@ class WallCounter:
     """Distance and walls between two agents of a world (see the module).
 
     Args:
-        world: a :class:`petriflow.world.World` (positions by agent, ray tests).
+        world: a world with :class:`~petriflow.capabilities.Poses`,
+            :class:`~petriflow.capabilities.Bodies` and
+            :class:`~petriflow.capabilities.Physics` (a :class:`petriflow.world.World`);
+            with another (or ``None``) no pair is measured.
         z: the antennas' height (metres).
     """
 
     def __init__(self, world: Any, z: float = 0.1) -> None:
-        self.world = world
+        self.world = world if world is not None and not any(missing(world, c) for c in (Poses, Bodies, Physics)) \
+            else None
         self.z = z
         self._walls: dict[tuple, int] = {}
 
@@ -108,7 +114,7 @@ class WallCounter:
         """``(distance in metres, walls crossed)`` between agents ``a`` and ``b`` now, or
         ``None`` when the world does not know where one of them is."""
         world = self.world
-        if world is None or not hasattr(world, "position"):
+        if world is None:
             return None
         pa, pb = world.position(a), world.position(b)
         if pa is None or pb is None:
@@ -116,7 +122,7 @@ class WallCounter:
         key = tuple(sorted(((round(pa[0], 2), round(pa[1], 2)), (round(pb[0], 2), round(pb[1], 2)))))
         walls = self._walls.get(key)
         if walls is None:
-            robots = [world.body(name) for name in getattr(world, "agents", {})] or [world.body(a), world.body(b)]
+            robots = [world.body(name) for name in world.agents] or [world.body(a), world.body(b)]
             walls = self._walls[key] = walls_between(world, pa, pb, z=self.z, ignore=robots)
         return math.dist(pa, pb), walls
 

@@ -29,7 +29,7 @@ Examples:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any, Callable, Iterable, Mapping, Protocol
 
 from petriflow.errors import PetriflowError
 
@@ -82,6 +82,13 @@ class ResourceContext:
     settings: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
 
 
+class Factories(Protocol):
+    """Where resource types are registered (a :class:`~petriflow.runtime.registry.Registry`)."""
+
+    def resource_factory(self, name: str) -> Callable[..., Any]:
+        """The factory of the resource type ``name``."""
+
+
 class Resources:
     """The resources of one run, made once each (see the module).
 
@@ -90,7 +97,7 @@ class Resources:
         context: what their factories get.
     """
 
-    def __init__(self, registry: Any, context: ResourceContext) -> None:
+    def __init__(self, registry: Factories, context: ResourceContext) -> None:
         self.registry = registry
         self.context = context
         self._made: dict[str, Any] = {}
