@@ -9,8 +9,9 @@ fixed bodies (walls, furniture) as polygons in the ground plane, so a trace alon
 enough to draw the world from above (``petriflow view``).
 
 The world is anything with ``agents`` (``{agent: body name}``) and ``pose(name)``
-(``(x, y, yaw)``); a pybullet :class:`petriflow.world.World` also gives its other
-movable bodies and its fixed outlines. A run without a world records nothing. Like
+(``(x, y, yaw)``): a :class:`Posed` one; a pybullet :class:`petriflow.world.World`
+(:class:`~petriflow.capabilities.Bodies`, :class:`~petriflow.capabilities.Physics`) also
+gives its other movable bodies and its fixed outlines. A run without a world records nothing. Like
 every event, a pose event takes its number whether or not anyone listens, so a run
 with a trace and one without still number their events the same.
 
@@ -28,7 +29,9 @@ Examples:
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Protocol
+
+from petriflow.capabilities import Bodies, Physics, missing
 
 __all__ = ["PoseSampler", "outlines"]
 
@@ -77,14 +80,31 @@ class PoseSampler:
         scheduler.emit("pose", None, None, **data)
 
 
+class Posed(Protocol):
+    """What a sampler reads of a world: its agents' robots and their poses."""
+
+    agents: dict[str, str]
+    """``{agent: body name}``."""
+
+    def pose(self, name: str) -> tuple[float, float, float]:
+        """``(x, y, yaw)`` of a body or an agent's robot."""
+
+
+def _has(world: Any, *capabilities: type) -> bool:
+    return world is not None and not any(missing(world, capability) for capability in capabilities)
+
+
 def _movable(world: Any) -> dict[str, str]:
-    """``{shown name: body name}``: the agents' robots, then any other body that can move."""
-    agents = dict(getattr(world, "agents", {}) or {})
-    named = {agent: body for agent, body in agents.items()}
-    p, client, bodies = getattr(world, "p", None), getattr(world, "client", None), getattr(world, "bodies", None)
-    if p is not None and isinstance(bodies, dict):
-        robots = set(agents.values())
-        for name, body in bodies.items():
+    """``{shown name: body name}``: the agents' robots (a :class:`Posed` world), then any
+    other body that can move (with :class:`~petriflow.capabilities.Bodies` and
+    :class:`~petriflow.capabilities.Physics`)."""
+    if not _has(world, Posed):
+        return {}
+    named = dict(world.agents)
+    if _has(world, Bodies, Physics):
+        p, client = world.p, world.client
+        robots = set(named.values())
+        for name, body in world.bodies.items():
             if name in robots or name == "plane":
                 continue
             try:
@@ -99,13 +119,14 @@ def _movable(world: Any) -> dict[str, str]:
 def outlines(world: Any) -> list[dict[str, Any]]:
     """The fixed bodies of a pybullet world as ``{"id", "points": [[x, y], ...], "colour"}``
     (a box as its rotated rectangle, anything else as its bounding box; the ground plane
-    and the robots left out); ``[]`` for a world that is not a pybullet one."""
-    p, client, bodies = getattr(world, "p", None), getattr(world, "client", None), getattr(world, "bodies", None)
-    if p is None or not isinstance(bodies, dict):
+    and the robots left out); ``[]`` for a world that is not a pybullet one (without
+    :class:`~petriflow.capabilities.Bodies` and :class:`~petriflow.capabilities.Physics`)."""
+    if not _has(world, Bodies, Physics):
         return []
-    robots = set((getattr(world, "agents", None) or {}).values())
+    p, client = world.p, world.client
+    robots = set(world.agents.values())
     shapes = []
-    for name, body in bodies.items():
+    for name, body in world.bodies.items():
         if name in robots or name == "plane":
             continue
         try:

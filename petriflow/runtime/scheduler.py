@@ -66,6 +66,7 @@ from __future__ import annotations
 from typing import Any, Iterable, Mapping
 
 from petriflow import limits
+from petriflow.capabilities import Stepped, missing
 from petriflow.collector import paused, relaxed
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
@@ -107,8 +108,9 @@ class Scheduler:
 
     Args:
         net: the net to run.
-        world: a :class:`petriflow.world.World` or any object with ``dt``,
-            ``step()`` and optionally ``distance(a, b)``; ``None`` for a world-less run.
+        world: a :class:`petriflow.world.World` or any object with ``dt`` and
+            ``step()`` (:class:`~petriflow.capabilities.Stepped`) and the capabilities
+            the actions use; ``None`` for a world-less run.
         config: faults, channel models, limits (:class:`RunConfig`, or its mapping).
         seed: seed of conflict resolution, action randomness and channel losses
             (overrides ``config.seed`` when given).
@@ -144,7 +146,8 @@ class Scheduler:
         self.registry = self.binding.registry
         self.clock = clock or SimulatedClock()
         self.settings = settings_of(world, self.binding) if settings is None else settings
-        kernel = self.kernel = Kernel(float(getattr(world, "dt", None) or config.dt))
+        stepped = world is not None and not missing(world, Stepped)  # else the configuration's dt
+        kernel = self.kernel = Kernel(float((world.dt if stepped else None) or config.dt))
         index = self.index = RunIndex(net, self.binding)
         self.compiled = index.compiled
         self.final = final_marking_of(net)  # declared, else a WF-net's sink (the rule check uses)
