@@ -295,13 +295,14 @@ class _Binder:
         ports = self.ports(tid, cls, params)
         self.requirements(tid, transition.action, cls.requirements(params), params)
         self.state(tid, transition.action, cls)
-        self.settings(tid, transition.action, cls)
+        self.settings(tid, transition.action, getattr(cls, "settings", None))
         for name, kind in getattr(cls, "resources", {}).items():
             try:
                 self.find("resource", kind)
             except UnknownActionError as exc:
                 raise self.fail(tid, f"action {transition.action} uses resource {name!r}: {exc}",
                                 f"{tid}/action") from None
+            self.settings(tid, f"{transition.action} (its resource {kind})", self.registry.resource_settings(kind))
         return BoundTransition(tid, cls, params, guard, ports, self.reads(transition, guard, params))
 
     def reads(self, transition: Any, guard: Any, params: dict[str, Any]) -> tuple[str, ...] | None:
@@ -348,9 +349,9 @@ class _Binder:
                             f" the subnet (state: ...)" if subnet else f"action {action} reads an agent state:"
                             " put the transition in an agent subnet", f"{tid}/action")
 
-    def settings(self, tid: str, action: str, cls: type[Action]) -> None:
-        """The world settings section the action reads: one declaration per name."""
-        section = getattr(cls, "settings", None)
+    def settings(self, tid: str, action: str, section: Any) -> None:
+        """A world settings section the action (or a resource it uses) reads: one
+        declaration per name."""
         if section is None:
             return
         if not isinstance(section, Section):

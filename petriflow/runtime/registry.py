@@ -139,6 +139,7 @@ class Registry:
         self._reads: dict[str, tuple[str, ...]] = {}
         self._states: dict[str, type] = {}
         self._resources: dict[str, Callable[..., Any]] = {}
+        self._resource_settings: dict[str, Any] = {}
         self._metrics: dict[str, MetricSpec] = {}
         self._channels: dict[str, Any] = {}
         self._plugins_pending = load_plugins
@@ -343,10 +344,13 @@ class Registry:
         """The state keys the guard ``name`` declares it reads (``None``: it reads tokens)."""
         return self._reads.get(name)
 
-    def register_resource(self, name: str, factory: Callable[..., Any] | str, *, replace: bool = False) -> None:
+    def register_resource(self, name: str, factory: Callable[..., Any] | str, *, replace: bool = False,
+                          settings: Any = None) -> None:
         """Register a resource type: ``factory(context) -> object`` (or a lazy
         ``"module:function"``) makes the run's one instance (see
-        :mod:`petriflow.runtime.resources`)."""
+        :mod:`petriflow.runtime.resources`); ``settings``: the world file's settings
+        section it reads (a :class:`~petriflow.runtime.settings.Section`), read as the
+        actions' are for a run whose actions use it (``context.settings``)."""
         old = self._resources.get(name)
         if old is not None and not replace and _identity(old) != _identity(factory):
             raise PetriflowError(f"resource {name!r} is already registered")
@@ -354,6 +358,11 @@ class Registry:
             raise PetriflowError(f"resource {name!r}: the factory must be callable or 'module:function',"
                                  f" got {factory!r}")
         self._resources[name] = factory
+        self._resource_settings[name] = settings
+
+    def resource_settings(self, name: str) -> Any:
+        """The settings section the resource type ``name`` reads (``None``: none)."""
+        return self._resource_settings.get(name)
 
     def resource_factory(self, name: str) -> Callable[..., Any]:
         """The factory of the resource type ``name`` (UnknownActionError with hints if none)."""

@@ -177,3 +177,16 @@ def test_a_context_outside_a_run_says_what_it_lacks():
         with pytest.raises(PetriflowError, match="'t': no run to"):
             use()
     assert ctx.running("anyone") is True
+
+
+def test_a_resource_reads_the_settings_it_declares():
+    """A scenario's resource declares its section: a run whose actions use the resource
+    reads and checks it, and the factory gets the values."""
+    made = Registry(load_plugins=False)
+    made.register_resource("demo.arena", lambda context: context.settings["arena"]["floor"], settings=ARENA)
+    made.register("demo.look", type("Floor", (InstantAction,), {"resources": {"arena": "demo.arena"},
+                                                              "run": lambda self, ctx: ctx.resource("arena")}))
+    result = Scheduler(loads_net(NET), registry=made, world=Flatland({"arena": {"floor": "grey"}})).run()
+    assert result.tokens["o"] == ["grey"]
+    with pytest.raises(NetFormatError, match="'meta.arena': setting 'floor' must be one of"):
+        Scheduler(loads_net(NET), registry=made, world=Flatland({"arena": {"floor": "pink"}}))
