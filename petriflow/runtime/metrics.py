@@ -69,7 +69,7 @@ class RunRecord:
     """What a metric sees of a finished run.
 
     Attributes:
-        result: how the run ended (:class:`~petriflow.runtime.scheduler.RunResult`).
+        result: how the run ended (:class:`~petriflow.runtime.result.RunResult`).
         events: the run's events (kept only when a metric asked for them).
         world: the world at the end (still open), or ``None``.
         config: the run configuration.
@@ -95,6 +95,13 @@ class RunRecord:
     wall: float = 0.0
     scheduler: Any = None
     cpu: float | None = None
+
+    @property
+    def settings(self) -> Any:
+        """``{section: {name: value}}``: the world file's settings the run's actions (and
+        their resources) declare, checked when the world was loaded (empty without a
+        scheduler). A metric reads a scenario's settings here, not in ``world.meta``."""
+        return {} if self.scheduler is None else self.scheduler.settings
 
     @property
     def tokens(self) -> dict[str, list[Any]]:
