@@ -104,3 +104,15 @@ def test_a_submodule_is_still_importable_from_the_top_level():
 
     assert callable(examples.path) and limits.__name__ == "petriflow.limits"
     assert callable(petriflow.view)  # the function, though petriflow.view is also a subpackage
+
+
+def test_type_checkers_see_each_stable_name_from_the_module_it_is_loaded_from():
+    """The ``if TYPE_CHECKING:`` imports of ``petriflow/__init__.py`` (what editors and
+    type checkers read) name the same module for each stable name as the lazy loader."""
+    import ast
+    from pathlib import Path
+
+    tree = ast.parse(Path(petriflow.__file__).read_text(encoding="utf-8"))
+    block = next(node for node in tree.body if isinstance(node, ast.If) and ast.unparse(node.test) == "TYPE_CHECKING")
+    seen = {alias.name: node.module for node in block.body for alias in node.names}
+    assert seen == {name: module for name, module in petriflow._STABLE.items()}
