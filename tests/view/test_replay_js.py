@@ -31,8 +31,8 @@ def _node_major() -> int:
     return int(re.match(r"v(\d+)", text).group(1))
 
 
-pytestmark = pytest.mark.skipif(NODE is None or _node_major() < 18,
-                                reason="no Node.js 18 or later (the page's replay is run in Node: apt-get install nodejs)")
+pytestmark = pytest.mark.skipif(NODE is None or _node_major() < 18, reason="no Node.js 18 or later"
+                                " (the page's replay is run in Node: apt-get install nodejs)")
 
 
 def replayed(page: Path) -> dict:
@@ -45,6 +45,11 @@ def replayed(page: Path) -> dict:
 
 def page_of(trace: Path, folder: Path, net: str | None = None) -> Path:
     return petriflow.view(trace, net=None if net is None else nets_folder() / net, out=folder / "page.html")
+
+
+def lines(trace: Path) -> list[dict]:
+    """The trace's events as its lines hold them."""
+    return [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()]
 
 
 def written(folder: Path, events: list[Event]) -> Path:
@@ -83,7 +88,7 @@ def test_the_pages_replay_is_petriflow_replays_at_every_event(which, net, reques
     out = replayed(page_of(trace, tmp_path, net))["events"]
     assert len(out) == len(events)
     assert [e["marking"] for e in out] == [m.to_dict() for _, m in markings(events)]
-    assert [e["record"] for e in out] == [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()]
+    assert [e["record"] for e in out] == lines(trace)
     assert [e["running"] for e in out] == running_after_each(events)
     assert any(e["running"] for e in out)
 
@@ -95,9 +100,9 @@ def test_the_pages_messages_and_poses_are_the_traces(bidding_trace, tmp_path):
     out = replayed(page_of(bidding_trace, tmp_path))
     m = unpacked(model(events))
     name = lambda table, k: None if k < 0 else m[table][k]  # noqa: E731
+    columns = zip(m["m_send"], m["m_end"], m["m_fate"], m["m_from"], m["m_to"], m["m_place"], m["m_channel"])
     expected = sorted(([s, e, m["fates"][f], name("agents", a), name("agents", b), name("places", p),
-                        name("channels", c)] for s, e, f, a, b, p, c in
-                       zip(m["m_send"], m["m_end"], m["m_fate"], m["m_from"], m["m_to"], m["m_place"], m["m_channel"])),
+                        name("channels", c)] for s, e, f, a, b, p, c in columns),
                       key=lambda row: (events[row[0]].time, row[0]))
     assert out["messages"] == expected and len(expected) > 10
     assert out["bodies"] == m["poses"] and len(out["bodies"]) >= 2
@@ -106,12 +111,14 @@ def test_the_pages_messages_and_poses_are_the_traces(bidding_trace, tmp_path):
 def test_failed_firings_and_ended_messages_are_seen_for_a_while(tmp_path):
     """A firing that failed is reported from its end on, for 5 s (5 s after still); a message
     that ended, from its delivery (not before, at the same time) on, for 5 s."""
+    box = {"place": "box", "channel": "lan"}
     events = [Event(0, 0.0, "run", data={"marking": {"i": 1}}),
               Event(1, 1.0, "start", "t", "a", {"firing": 1, "consumed": {"i": 1}}),
-              Event(2, 2.0, "end", "t", "a", {"firing": 1, "outcome": "failed", "reason": "blocked", "produced": {}}),
-              Event(3, 3.0, "message", None, "a", {"place": "box", "fate": "sent", "receiver": "b", "channel": "lan"}),
-              Event(4, 3.0, "message", None, "a", {"place": "box", "fate": "delivered", "channel": "lan"}),
-              Event(5, 7.0, "message", None, "b", {"place": "box", "fate": "lost", "why": "range", "channel": "lan"}),
+              Event(2, 2.0, "end", "t", "a", {"firing": 1, "outcome": "failed", "reason": "blocked",
+                                              "produced": {}}),
+              Event(3, 3.0, "message", None, "a", {**box, "fate": "sent", "receiver": "b"}),
+              Event(4, 3.0, "message", None, "a", {**box, "fate": "delivered"}),
+              Event(5, 7.0, "message", None, "b", {**box, "fate": "lost", "why": "range"}),
               Event(6, 10.0, "stop", data={"reason": "final", "firings": 1, "marking": {}})]
     out = replayed(page_of(written(tmp_path, events), tmp_path))["events"]
     assert [e["failed"] for e in out] == [[], [], [["t", "failed", "blocked"]], [["t", "failed", "blocked"]],
@@ -127,4 +134,4 @@ def test_node_rebuilds_awkward_records_exactly(awkward_events, tmp_path):
     record comes back as its trace line has it."""
     trace = written(tmp_path, awkward_events)
     out = replayed(page_of(trace, tmp_path))["events"]
-    assert [e["record"] for e in out] == [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()]
+    assert [e["record"] for e in out] == lines(trace)
