@@ -294,9 +294,9 @@ def to_dot(
                 if len(parts) < 2:
                     continue
                 lines.append(f"{indent}subgraph {quote('cluster_operator_' + group)} {{")
-                lines.append(f'{indent}  graph [label=<<FONT POINT-SIZE="9" COLOR="#7a4f00">operator {html_text(group)}'
-                             f'</FONT>>, labeljust=l, style="dashed,rounded", color="#b07d1a", penwidth=1.0,'
-                             f" margin=6];")
+                lines.append(f'{indent}  graph [label=<<FONT POINT-SIZE="9" COLOR="#7a4f00">operator'
+                             f' {html_text(group)}</FONT>>, labeljust=l, style="dashed,rounded",'
+                             f' color="#b07d1a", penwidth=1.0, margin=6];')
                 lines += [_transition_lines(net, t, t in chosen, indent + "  ", running.get(t)) for t in parts]
                 lines.append(f"{indent}}}")
         return lines

@@ -132,8 +132,8 @@ def folded_dot(net: Net, marking: Mapping[str, int] | None = None, *, title: str
     arcs, notes = _arcs(net, owner)
     title = (net.label or net.id) if title is None else title
     out = [f"digraph {quote(net.id)} {{"]
-    label = f' label=<<B>{html_text(title)}</B><BR/><FONT POINT-SIZE="10">folded: one box per agent</FONT>>,' \
-            f' labelloc=t,' if title else ""
+    label = f' label=<<B>{html_text(title)}</B><BR/><FONT POINT-SIZE="10">folded: one box per agent' \
+            f'</FONT>>, labelloc=t,' if title else ""
     pieces = _components(net, owner, arcs)
     columns = max(1, round(math.sqrt(pieces / 3 if rankdir == "LR" else pieces * 1.5)))
     out.append(f'  graph [rankdir={rankdir}, nodesep=0.25, ranksep=0.6,{label}'
@@ -164,7 +164,8 @@ def folded_dot(net: Net, marking: Mapping[str, int] | None = None, *, title: str
                        f' label=<{inner}>, xlabel=<{_xlabel(p.label or p.id, notes.get(p.id))}>];')
     for t in net.transitions.values():
         if t.subnet is None:
-            note = f'<BR/><FONT POINT-SIZE="8"><I>{html_text(notes[t.id])}</I></FONT>' if t.id in notes else ""
+            note = (f'<BR/><FONT POINT-SIZE="8"><I>{html_text(notes[t.id])}</I></FONT>'
+                    if t.id in notes else "")
             out.append(f'  {quote(t.id)} [shape=box, style="filled", fillcolor="#dfe6ee", height=0.3,'
                        f' label=<<B>{html_text(t.label or t.id)}</B>{note}>];')
     for (source, target), count in arcs.items():

@@ -254,7 +254,8 @@ def test_cycles_and_private_uses_are_found_in_a_small_tree(tmp_path):
     (package / "a.py").write_text("from petriflow import b\n")
     (package / "b.py").write_text("def late():\n    from .a import _secret\n")
     (package / "c.py").write_text("import petriflow.a as a\nfrom petriflow.sub._hidden import shown\nx = a._y\n"
-                                  "def use(thing):\n    return thing._counter, thing._own\n_own = 1\n")
+                                  "def use(thing):\n    return thing._counter, thing._own\n"
+                                  "_own = 1\n")
     (package / "d.py").write_text("class Counter:\n    def __init__(self):\n        self._counter = 0\n")
     graph, private = scan(tmp_path)
     assert cycles(graph) == [frozenset({"petriflow.a", "petriflow.b"})]
@@ -287,7 +288,8 @@ if __name__ == "__main__":
     for component in sorted(found, key=lambda c: (-len(c), sorted(c))):
         mark = " (allowlisted)" if component in RUNTIME_CYCLES_PENDING else ""
         print(f"  {len(component)}: {', '.join(sorted(component))}{mark}")
-    print(f"{len(private)} private uses across modules ({len(private & RUNTIME_PRIVATE_PENDING)} allowlisted)")
+    allowed = len(private & RUNTIME_PRIVATE_PENDING)
+    print(f"{len(private)} private uses across modules ({allowed} allowlisted)")
     for importer, imported, name in sorted(private):
         mark = " (allowlisted)" if (importer, imported, name) in RUNTIME_PRIVATE_PENDING else ""
         print(f"  {importer} <- {imported}: {name}{mark}")

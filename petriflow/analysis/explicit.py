@@ -195,7 +195,8 @@ def _partial_result(result: dict[str, Any], space: StateSpace, violations: list[
     if result.get("structurally_bounded") or (search.get("complete") and result.get("bounded") is None):
         result["bounded"] = True
     limits_found = (result.get("invariants") or {}).get("structural_bounds") or {}
-    if result["safe"] is None and len(limits_found) == len(names) and max(limits_found.values(), default=0) <= 1:
+    if (result["safe"] is None and len(limits_found) == len(names)
+            and max(limits_found.values(), default=0) <= 1):
         result["safe"] = True
     undecided = ["states", "edges", "live", "reversible", "dead_transitions",
                  "max_tokens_place", "max_tokens_marking", "k_bound"]

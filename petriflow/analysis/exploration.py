@@ -30,7 +30,8 @@ from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
 
-__all__ = ["DEFAULT_MAX_STATES", "StateSpaceLimit", "UnboundedNetError", "row_changes", "row_origins", "row_resets"]
+__all__ = ["DEFAULT_MAX_STATES", "StateSpaceLimit", "UnboundedNetError", "row_changes", "row_origins",
+           "row_resets"]
 
 #: Default limit on the number of states :func:`reachability_graph` stores.
 DEFAULT_MAX_STATES = 2_000_000

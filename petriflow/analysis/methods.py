@@ -478,8 +478,8 @@ def _fill_symmetric(result: dict, space, compiled: CompiledNet, structure, final
         path, reached = space.concrete(state)
         kind = "a deadlock" if dead_stuck else "no firing sequence leads back"
         violations.append(Violation(
-            "no_option_to_complete", f"no option to complete: from {format_marking(reached)} the final marking"
-            f" {format_marking(final)} can no longer be reached ({kind})", path, reached.to_dict()))
+            "no_option_to_complete", f"no option to complete: from {format_marking(reached)} the final"
+            f" marking {format_marking(final)} can no longer be reached ({kind})", path, reached.to_dict()))
     if dead:
         violations.append(Violation(
             "dead_transition", f"{len(dead)} dead transitions (enabled in no marking reachable"

@@ -133,7 +133,9 @@ def _run_end(result: dict[str, Any]) -> str | None:
         if result.get("sound") is True and result["initial_marking"] == start:
             return f"the final marking {format_marking(final)}"
         return None
-    return f"the declared final marking {format_marking(final)}" if result.get("stuck_markings") == 0 else None
+    if result.get("stuck_markings") == 0:
+        return f"the declared final marking {format_marking(final)}"
+    return None
 
 
 def _witnessed(result: dict[str, Any], kinds: set[str]) -> bool:
@@ -262,7 +264,8 @@ def format_report(result: dict[str, Any]) -> str:
                 facts.append(f"{quantity(found['deadlock_markings_found'], 'deadlock')} found")
             lines.append("  found before the limit: " + "; ".join(facts))
     elif result["states"] is not None:
-        lines.append(f"  state space: {quantity(result['states'], 'state')}, {quantity(result['edges'], 'edge')};"
+        lines.append(f"  state space: {quantity(result['states'], 'state')},"
+                     f" {quantity(result['edges'], 'edge')};"
                      f" at most {quantity(result['max_tokens_place'], 'token')} in a place,"
                      f" {result['max_tokens_marking']} in a marking")
     invariants = result.get("invariants") or {}

@@ -365,7 +365,8 @@ def multiset_count(reading: Reading, multiset: Element, node: str) -> int:
         total += count
         inside = list(value) if value is not None else []
         if not (len(inside) == 1 and local_name(inside[0].tag) == "token"):
-            shown = " ".join("".join(part.itertext()).strip() or local_name(part.tag) for part in inside) or "?"
+            shown = " ".join("".join(part.itertext()).strip() or local_name(part.tag)
+                             for part in inside) or "?"
             coloured.append(shown if count == 1 else f"{shown} x{count}")
     if coloured:
         reading.note("place", node, f"coloured token values ({', '.join(coloured[:5])}"
@@ -558,7 +559,8 @@ DIALECTS: tuple[Dialect, ...] = (
             net_types={PTNET_TYPE: "ISO/IEC 15909-2 P/T net (ePNK, Model Checking Contest)"},
             tools={"nupn": ToolData(read_nupn, frozenset({"net", "page"}))}),
     Dialect("PM4Py, ProM",
-            net_types={"http://www.pnml.org/version-2009/grammar/pnmlcoremodel": "PNML core model (PM4Py, ProM)"},
+            net_types={"http://www.pnml.org/version-2009/grammar/pnmlcoremodel":
+                       "PNML core model (PM4Py, ProM)"},
             tools={"ProM": ToolData(read_prom),
                    "StochasticPetriNet": ToolData(read_stochastic, frozenset({"transition"}))},
             tags={"net": frozenset({"finalmarkings", "variables"}),
@@ -570,14 +572,15 @@ DIALECTS: tuple[Dialect, ...] = (
     Dialect("WoPeD",
             net_types={"http://www.informatik.hu-berlin.de/top/pntd/ptNetb": "WoPeD"},
             tools={"WoPeD": ToolData(read_woped)}),
-    Dialect("PNK", net_types={"http://www.informatik.hu-berlin.de/top/pntd/ptNet": "pre-ISO PNML P/T net (PNK)"}),
+    Dialect("PNK",
+            net_types={"http://www.informatik.hu-berlin.de/top/pntd/ptNet": "pre-ISO PNML P/T net (PNK)"}),
     Dialect("JARP, Petri Net Plans", net_types={"PTNet": "JARP, Petri Net Plans"}),
     Dialect("PIPE",
             net_types={"P/T net": "PIPE"},
             tags={"net": frozenset({"token"}), "place": frozenset({"capacity"}), "transition": _GSPN_TAGS,
                   "arc": frozenset({"type", "tagged"})},
-            losses=(Loss("transition", _GSPN_TAGS, "GSPN timing (<rate>, <timed>, <infiniteServer>, <priority>)"
-                         " is not representable; read as an untimed P/T net"),)),
+            losses=(Loss("transition", _GSPN_TAGS, "GSPN timing (<rate>, <timed>, <infiniteServer>,"
+                         " <priority>) is not representable; read as an untimed P/T net"),)),
     Dialect("SNAKES"),
     Dialect("petriflow", tools={PETRIFLOW_TOOL: ToolData(read_petriflow)}),
 )

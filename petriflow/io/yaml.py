@@ -110,7 +110,8 @@ class _Reader:
         for subnet in self.as_list(data.get("subnets"), "subnets", data):
             members = self.as_list(subnet.get("transitions"), "transitions", subnet)
             for transition in members:
-                self.read_transition(transition, self.ident(subnet.get("id"), "a subnet id", subnet), line_of(members))
+                subnet_id = self.ident(subnet.get("id"), "a subnet id", subnet)
+                self.read_transition(transition, subnet_id, line_of(members))
         for transition in transitions:
             self.read_transition(transition, None, line_of(transitions))
         for arc in self.as_list(data.get("arcs"), "arcs", data):

@@ -14,11 +14,12 @@ Examples:
     >>> _ = (folder / "s.yaml").write_text("petriflow-sweep: 1\\nnet: n.yaml\\ntrials: 2\\n")
     >>> load_sweep(folder / "s.yaml").seeds
     [1, 2]
-    >>> _ = (folder / "bad.yaml").write_text("petriflow-sweep: 1\\nnet: n.yaml\\nset: {net.transitions.t.params.secs: 2}\\n")
+    >>> _ = (folder / "bad.yaml").write_text("petriflow-sweep: 1\\nnet: n.yaml\\n"
+    ...                                      "set: {net.transitions.t.params.secs: 2}\\n")
     >>> load_sweep(folder / "bad.yaml")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    petriflow.errors.NetFormatError: ...bad.yaml:3: ...n.yaml:3: 't': action has no parameter 'secs' (did you mean 'seconds'?) (it takes: seconds)
+    petriflow.errors.NetFormatError: ...bad.yaml:3: ...n.yaml:3: 't': action has no parameter 'secs' ...
 """
 
 from __future__ import annotations
