@@ -14,10 +14,8 @@ importable from here too, as the command uses them together.
 Examples:
     >>> from petriflow.classic import dining_philosophers
     >>> result = check_net(dining_philosophers(5))
-    >>> result["states"], result["edges"], result["bounded"], result["deadlock_free"]
-    (11, 30, True, True)
-    >>> exit_code(result)
-    0
+    >>> exit_code(result), format_report(result).splitlines()[0]
+    (0, 'philosophers-5: 15 places, 10 transitions -- OK')
 """
 
 from __future__ import annotations
