@@ -32,13 +32,12 @@ Examples:
 
 from __future__ import annotations
 
-import html
-import re
 import shutil
 import subprocess
 from pathlib import Path
 from typing import Mapping, Sequence
 
+from petriflow.dot import CLUSTER_COLOURS, FONT, attributes, html_text, quote, tokens_text
 from petriflow.errors import DependencyNotInstalled, PetriflowError, UnknownElementError
 from petriflow.net import Net
 
@@ -61,7 +60,6 @@ PNG_DPI = 150
 _MISSING_DOT = "Graphviz 'dot' not found: run scripts/setup.sh or apt-get install graphviz"
 
 # Colours and sizes. Inches for sizes, points for fonts, as Graphviz counts them.
-_FONT = "Helvetica"
 #: Colour of highlighted nodes and arcs (see :func:`to_dot`).
 HIGHLIGHT_COLOUR = "#d62728"
 _HIGHLIGHT_FILL = "#fde0dd"
@@ -74,67 +72,13 @@ RANK_DIRECTIONS = ("LR", "TB", "auto")
 #: height is drawn top to bottom instead.
 AUTO_RATIO = 2.2
 _TRANSITION_FILL = "#dfe6ee"
-_CLUSTER_COLOURS = (  # (fill, border) per subnet, in turn
-    ("#eef5fc", "#6b9bc8"),
-    ("#f1f8ec", "#7fae62"),
-    ("#fdf3e7", "#d39a4f"),
-    ("#f5effa", "#9c7dbf"),
-    ("#eef8f7", "#5fa8a0"),
-    ("#fbeff2", "#c77b90"),
-)
 _PLACE_SIZE = 0.42
 _NAME_ROW = 14  # points: height of the name under a place
-_DOT = "\u25cf"  # a black circle: one token
 _SEPARATOR = " \u00b7 "  # between a node's id and its label
 
-_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
-_BACKSLASHES_AT_RISK = re.compile(r'\\+(?=["\n]|\Z)')
-
-
-# Escaping ------------------------------------------------------------------------------
-
-
-def _quote(text: str) -> str:
-    """A DOT double-quoted string naming ``text``, distinct for distinct texts.
-
-    Inside quotes Graphviz reads ``\\"`` as a quote, keeps ``\\\\`` as two
-    backslashes and drops a backslash that ends a line. So quotes are escaped, and a
-    run of backslashes just before a quote, a line break or the end (which Graphviz
-    could misread) is doubled; every other text comes back exactly as it was.
-
-    Examples:
-        >>> print(_quote('say "hi"'), _quote("a:b/c d"))
-        "say \\"hi\\"" "a:b/c d"
-    """
-    quoted = _BACKSLASHES_AT_RISK.sub(lambda run: run.group(0) * 2, text)
-    return '"' + quoted.replace('"', '\\"') + '"'
-
-
-def _html(text: str) -> str:
-    """``text`` as the content of a Graphviz HTML-like label (lines kept)."""
-    text = text.replace("\r\n", "\n").replace("\r", "\n").replace("\t", " ")
-    text = _CONTROL.sub("\ufffd", text)
-    return "<BR/>".join(html.escape(line, quote=True) for line in text.split("\n"))
 
 
 # DOT text ------------------------------------------------------------------------------
-
-
-def _attributes(attrs: Mapping[str, str]) -> str:
-    return "[" + ", ".join(f"{key}={value}" for key, value in attrs.items()) + "]"
-
-
-def _tokens_text(count: int) -> str:
-    """Tokens drawn inside a place: dots for 1 to 4, the number from 5 on."""
-    if count == 0:
-        return " "
-    if count <= 4:
-        rows = {1: [1], 2: [2], 3: [2, 1], 4: [2, 2]}[count]
-        dots = "<BR/>".join(" ".join([_DOT] * n) for n in rows)
-        return f'<FONT POINT-SIZE="{12 if count == 1 else 8}">{dots}</FONT>'
-    digits = len(str(count))
-    size = {1: 10, 2: 10, 3: 9, 4: 8}.get(digits, 7)  # from 6 digits on it spills over the rim
-    return f'<FONT POINT-SIZE="{size}"><B>{count}</B></FONT>'
 
 
 def _place_lines(net: Net, place: str, count: int, highlighted: bool, indent: str) -> str:
@@ -147,18 +91,18 @@ def _place_lines(net: Net, place: str, count: int, highlighted: bool, indent: st
     spec = net.places[place]
     colour = HIGHLIGHT_COLOUR if highlighted else "black"
     side = round(_PLACE_SIZE * 72)
-    name = _html(_name(spec.id, spec.label))
+    name = html_text(_name(spec.id, spec.label))
     label = (
         '<<TABLE BORDER="0" CELLBORDER="0" CELLSPACING="0" CELLPADDING="0">'
         f'<TR><TD HEIGHT="{_NAME_ROW}"> </TD></TR>'
-        f'<TR><TD HEIGHT="{side}" WIDTH="{side}" FIXEDSIZE="TRUE">{_tokens_text(count)}</TD></TR>'
+        f'<TR><TD HEIGHT="{side}" WIDTH="{side}" FIXEDSIZE="TRUE">{tokens_text(count)}</TD></TR>'
         f'<TR><TD HEIGHT="{_NAME_ROW}" VALIGN="BOTTOM">{name}</TD></TR>'
         "</TABLE>>"
     )
     attrs = {"label": label, "color": f'"{colour}"', "fontcolor": f'"{colour}"'}
     if highlighted:
         attrs["penwidth"] = "2.5"
-    return f"{indent}{_quote(place)} {_attributes(attrs)};"
+    return f"{indent}{quote(place)} {attributes(attrs)};"
 
 
 def _name(node_id: str, label: str | None) -> str:
@@ -206,20 +150,20 @@ def _transition_lines(net: Net, transition: str, highlighted: bool, indent: str,
         attrs = {
             "label": '""', "width": "0.1", "height": "0.45", "fixedsize": "true",
             "style": "filled", "fillcolor": f'"{colour}"', "color": f'"{colour}"',
-            "tooltip": _quote(_name(spec.id, spec.label)), "xlabel": _quote(spec.id),
+            "tooltip": quote(_name(spec.id, spec.label)), "xlabel": quote(spec.id),
         }
-        return f"{indent}{_quote(transition)} {_attributes(attrs)};"
-    lines = [f"<B>{_html(_name(spec.id, spec.label))}</B>"]
+        return f"{indent}{quote(transition)} {attributes(attrs)};"
+    lines = [f"<B>{html_text(_name(spec.id, spec.label))}</B>"]
     marker = _operator_marker(net, transition)
     if marker:
-        lines.append(f'<FONT POINT-SIZE="8" COLOR="#7a4f00">{_html(marker)}</FONT>')
+        lines.append(f'<FONT POINT-SIZE="8" COLOR="#7a4f00">{html_text(marker)}</FONT>')
     if spec.action:
-        lines.append(f'<FONT POINT-SIZE="8" COLOR="#404040">{_html(spec.action)}</FONT>')
+        lines.append(f'<FONT POINT-SIZE="8" COLOR="#404040">{html_text(spec.action)}</FONT>')
     if spec.guard:
-        lines.append(f'<FONT POINT-SIZE="8" COLOR="#404040">[{_html(spec.guard)}]</FONT>')
+        lines.append(f'<FONT POINT-SIZE="8" COLOR="#404040">[{html_text(spec.guard)}]</FONT>')
     if holding is not None:
         held = ", ".join(p if n == 1 else f"{p}\u00d7{n}" for p, n in holding.items()) or "no token"
-        lines.append(f'<FONT POINT-SIZE="8" COLOR="{RUNNING_COLOUR}">running, holds {_html(held)}</FONT>')
+        lines.append(f'<FONT POINT-SIZE="8" COLOR="{RUNNING_COLOUR}">running, holds {html_text(held)}</FONT>')
     fill = _HIGHLIGHT_FILL if highlighted else (_RUNNING_FILL if holding is not None else _TRANSITION_FILL)
     attrs = {
         "label": "<" + "<BR/>".join(lines) + ">",
@@ -229,7 +173,7 @@ def _transition_lines(net: Net, transition: str, highlighted: bool, indent: str,
     }
     if highlighted or holding is not None:
         attrs["penwidth"] = "2.5"
-    return f"{indent}{_quote(transition)} {_attributes(attrs)};"
+    return f"{indent}{quote(transition)} {attributes(attrs)};"
 
 
 def _highlight_sets(net: Net, highlight: Sequence[str] | None) -> tuple[set[str], set[tuple[str, str]]]:
@@ -314,22 +258,22 @@ def to_dot(
         raise PetriflowError(f"rankdir must be LR or TB, got {rankdir!r}")
     title = (net.label or net.id) if title is None else title
 
-    out = [f"digraph {_quote(net.id)} {{"]
+    out = [f"digraph {quote(net.id)} {{"]
     graph = {
         "rankdir": rankdir, "nodesep": "0.3", "ranksep": "0.45", "newrank": "true",
-        "fontname": f'"{_FONT}"', "fontsize": "12", "pad": "0.25", "outputorder": "edgesfirst",
+        "fontname": f'"{FONT}"', "fontsize": "12", "pad": "0.25", "outputorder": "edgesfirst",
     }
-    heading = [f"<B>{_html(title)}</B>"] if title else []
+    heading = [f"<B>{html_text(title)}</B>"] if title else []
     if caption:
-        heading.append(f'<FONT POINT-SIZE="11">{_html(caption)}</FONT>')
+        heading.append(f'<FONT POINT-SIZE="11">{html_text(caption)}</FONT>')
     if heading:
         graph.update({"label": "<" + "<BR/>".join(heading) + ">", "labelloc": "t", "fontsize": "14"})
-    out.append(f"  graph {_attributes(graph)};")
+    out.append(f"  graph {attributes(graph)};")
     out.append(
-        f'  node [fontname="{_FONT}", fontsize=10, shape=circle, fixedsize=shape,'
+        f'  node [fontname="{FONT}", fontsize=10, shape=circle, fixedsize=shape,'
         f" width={_PLACE_SIZE}, height={_PLACE_SIZE}, penwidth=1.3];"
     )
-    out.append(f'  edge [fontname="{_FONT}", fontsize=10, arrowsize=0.7, penwidth=1.1];')
+    out.append(f'  edge [fontname="{FONT}", fontsize=10, arrowsize=0.7, penwidth=1.1];')
 
     def node_lines(places: list[str], transitions: list[str], indent: str) -> list[str]:
         lines = [_place_lines(net, p, marking[p], p in chosen, indent) for p in places]
@@ -349,21 +293,21 @@ def to_dot(
             for group, parts in groups.items():
                 if len(parts) < 2:
                     continue
-                lines.append(f"{indent}subgraph {_quote('cluster_operator_' + group)} {{")
-                lines.append(f'{indent}  graph [label=<<FONT POINT-SIZE="9" COLOR="#7a4f00">operator {_html(group)}'
-                             f'</FONT>>, labeljust=l, style="dashed,rounded", color="#b07d1a", penwidth=1.0,'
-                             f" margin=6];")
+                lines.append(f"{indent}subgraph {quote('cluster_operator_' + group)} {{")
+                lines.append(f'{indent}  graph [label=<<FONT POINT-SIZE="9" COLOR="#7a4f00">operator'
+                             f' {html_text(group)}</FONT>>, labeljust=l, style="dashed,rounded",'
+                             f' color="#b07d1a", penwidth=1.0, margin=6];')
                 lines += [_transition_lines(net, t, t in chosen, indent + "  ", running.get(t)) for t in parts]
                 lines.append(f"{indent}}}")
         return lines
 
     for number, subnet in enumerate(net.subnets.values()):
-        fill, border = _CLUSTER_COLOURS[number % len(_CLUSTER_COLOURS)]
+        fill, border = CLUSTER_COLOURS[number % len(CLUSTER_COLOURS)]
         caption = (
-            f'<B>{_html(subnet.label or subnet.id)}</B><BR ALIGN="LEFT"/>'
-            f'<FONT POINT-SIZE="9">agent: {_html(subnet.agent or subnet.id)}</FONT><BR ALIGN="LEFT"/>'
+            f'<B>{html_text(subnet.label or subnet.id)}</B><BR ALIGN="LEFT"/>'
+            f'<FONT POINT-SIZE="9">agent: {html_text(subnet.agent or subnet.id)}</FONT><BR ALIGN="LEFT"/>'
         )
-        out.append(f"  subgraph {_quote('cluster_' + subnet.id)} {{")
+        out.append(f"  subgraph {quote('cluster_' + subnet.id)} {{")
         out.append(
             f'    graph [label=<{caption}>, labeljust=l, labelloc=t, fontsize=11,'
             f' style="rounded,filled", fillcolor="{fill}", color="{border}", penwidth=1.2,'
@@ -380,12 +324,12 @@ def to_dot(
     for arc in net.arcs:
         attrs: dict[str, str] = {}
         if arc.weight > 1:
-            attrs["label"] = _quote(str(arc.weight))
+            attrs["label"] = quote(str(arc.weight))
         if (arc.source, arc.target) in bold_arcs:
             colour = f'"{HIGHLIGHT_COLOUR}"'
             attrs.update({"color": colour, "fontcolor": colour, "penwidth": "2.8"})
-        line = f"  {_quote(arc.source)} -> {_quote(arc.target)}"
-        out.append(f"{line} {_attributes(attrs)};" if attrs else f"{line};")
+        line = f"  {quote(arc.source)} -> {quote(arc.target)}"
+        out.append(f"{line} {attributes(attrs)};" if attrs else f"{line};")
     out.append("}")
     return "\n".join(out) + "\n"
 

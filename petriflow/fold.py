@@ -36,7 +36,7 @@ import math
 from collections import Counter
 from typing import Mapping
 
-from petriflow.export import _CLUSTER_COLOURS, _FONT, _html, _quote, _tokens_text
+from petriflow.dot import CLUSTER_COLOURS, FONT, html_text, quote, tokens_text
 from petriflow.net import Net
 
 __all__ = ["folded_dot", "should_fold", "FOLD_ABOVE"]
@@ -108,7 +108,7 @@ def _arcs(net: Net, owner: dict[str, str]) -> tuple[Counter, dict[str, str]]:
 
 def _xlabel(name: str, note: str | None) -> str:
     """The small text beside a kept place: its name and its note."""
-    text = _html(name) + (f"<BR/><I>{_html(note)}</I>" if note else "")
+    text = html_text(name) + (f"<BR/><I>{html_text(note)}</I>" if note else "")
     return f'<FONT POINT-SIZE="8">{text}</FONT>'
 
 
@@ -131,44 +131,45 @@ def folded_dot(net: Net, marking: Mapping[str, int] | None = None, *, title: str
     owner, kept = _groups(net)
     arcs, notes = _arcs(net, owner)
     title = (net.label or net.id) if title is None else title
-    out = [f"digraph {_quote(net.id)} {{"]
-    label = f' label=<<B>{_html(title)}</B><BR/><FONT POINT-SIZE="10">folded: one box per agent</FONT>>,' \
-            f' labelloc=t,' if title else ""
+    out = [f"digraph {quote(net.id)} {{"]
+    label = f' label=<<B>{html_text(title)}</B><BR/><FONT POINT-SIZE="10">folded: one box per agent' \
+            f'</FONT>>, labelloc=t,' if title else ""
     pieces = _components(net, owner, arcs)
     columns = max(1, round(math.sqrt(pieces / 3 if rankdir == "LR" else pieces * 1.5)))
     out.append(f'  graph [rankdir={rankdir}, nodesep=0.25, ranksep=0.6,{label}'
-               f' fontname="{_FONT}", fontsize=14, pad=0.2, pack=true, packmode="array_u{columns}"];')
-    out.append(f'  node [fontname="{_FONT}", fontsize=10];')
-    out.append(f'  edge [fontname="{_FONT}", fontsize=9, arrowsize=0.6, penwidth=0.9, color="#555555"];')
+               f' fontname="{FONT}", fontsize=14, pad=0.2, pack=true, packmode="array_u{columns}"];')
+    out.append(f'  node [fontname="{FONT}", fontsize=10];')
+    out.append(f'  edge [fontname="{FONT}", fontsize=9, arrowsize=0.6, penwidth=0.9, color="#555555"];')
     for number, subnet in enumerate(net.subnets.values()):
-        fill, border = _CLUSTER_COLOURS[number % len(_CLUSTER_COLOURS)]
+        fill, border = CLUSTER_COLOURS[number % len(CLUSTER_COLOURS)]
         places, transitions = net.nodes_of(subnet.id)
         inside = [p for p in places if p not in kept]
         tokens = sum(marking[p] for p in inside)
         name = subnet.agent or subnet.id
-        text = f"<B>{_html(name)}</B>"
+        text = f"<B>{html_text(name)}</B>"
         if subnet.label and subnet.label != name:
-            text += f'<BR/><FONT POINT-SIZE="9">{_html(subnet.label)}</FONT>'
+            text += f'<BR/><FONT POINT-SIZE="9">{html_text(subnet.label)}</FONT>'
         text += (f'<BR/><FONT POINT-SIZE="8">{len(inside)} places, {len(transitions)} transitions'
                  f'{f", {tokens} token" + ("s" if tokens != 1 else "") if tokens else ""}</FONT>')
         if f"agent:{subnet.id}" in notes:
-            text += f'<BR/><FONT POINT-SIZE="8"><I>{_html(notes[f"agent:{subnet.id}"])}</I></FONT>'
+            text += f'<BR/><FONT POINT-SIZE="8"><I>{html_text(notes[f"agent:{subnet.id}"])}</I></FONT>'
 
-        out.append(f'  {_quote("agent:" + subnet.id)} [shape=box, style="rounded,filled", fillcolor="{fill}",'
+        out.append(f'  {quote("agent:" + subnet.id)} [shape=box, style="rounded,filled", fillcolor="{fill}",'
                    f' color="{border}", penwidth=1.4, label=<{text}>];')
     for p in net.places.values():
         if p.id in kept:
             count = marking[p.id]
-            inner = _tokens_text(count) if count else ""
-            out.append(f'  {_quote(p.id)} [shape=circle, fixedsize=true, width=0.3, height=0.3,'
+            inner = tokens_text(count) if count else ""
+            out.append(f'  {quote(p.id)} [shape=circle, fixedsize=true, width=0.3, height=0.3,'
                        f' label=<{inner}>, xlabel=<{_xlabel(p.label or p.id, notes.get(p.id))}>];')
     for t in net.transitions.values():
         if t.subnet is None:
-            note = f'<BR/><FONT POINT-SIZE="8"><I>{_html(notes[t.id])}</I></FONT>' if t.id in notes else ""
-            out.append(f'  {_quote(t.id)} [shape=box, style="filled", fillcolor="#dfe6ee", height=0.3,'
-                       f' label=<<B>{_html(t.label or t.id)}</B>{note}>];')
+            note = (f'<BR/><FONT POINT-SIZE="8"><I>{html_text(notes[t.id])}</I></FONT>'
+                    if t.id in notes else "")
+            out.append(f'  {quote(t.id)} [shape=box, style="filled", fillcolor="#dfe6ee", height=0.3,'
+                       f' label=<<B>{html_text(t.label or t.id)}</B>{note}>];')
     for (source, target), count in arcs.items():
         attrs = f' [label="{count}"]' if count > 1 else ""
-        out.append(f"  {_quote(source)} -> {_quote(target)}{attrs};")
+        out.append(f"  {quote(source)} -> {quote(target)}{attrs};")
     out.append("}")
     return "\n".join(out) + "\n"

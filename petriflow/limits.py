@@ -15,7 +15,8 @@ one costs when raised.
 
 Beside the capacities, the fixed rules every reader shares: :func:`parse_integer` (the
 one rule for every whole number read from a file or an option: ASCII digits, at most
-:data:`MAX_INTEGER` = 2**60) and :func:`check_seconds` (simulated times).
+:data:`MAX_INTEGER` = 2**60), :func:`parse_decimal` (a decimal number in ASCII) and
+:func:`check_seconds` (simulated times).
 
 Examples:
     >>> from petriflow import limits
@@ -29,13 +30,14 @@ Examples:
 
 from __future__ import annotations
 
+import math
 import os
 import re
 
 from petriflow.errors import NumberError, PetriflowError, did_you_mean
 
 __all__ = ["LIMITS", "ENVIRONMENT_VARIABLE", "MAX_SECONDS", "MAX_INTEGER", "parse", "from_environment",
-           "check_seconds", "parse_integer", "integer_argument"]
+           "check_seconds", "parse_integer", "parse_decimal", "integer_argument"]
 
 #: Nesting depth of YAML collections (nets, worlds, run configurations).
 YAML_DEPTH = 64
@@ -195,6 +197,25 @@ def parse_integer(value: str | int, what: str = "the value", *, minimum: int | N
     if minimum is not None and number < minimum:
         raise NumberError(f"{what} must be a whole number >= {minimum}, got {number}")
     return number
+
+
+#: A decimal number in ASCII (XSD's ``decimal`` or ``double``, without INF and NaN):
+#: ``float()`` alone would read any script's digits, and underscores.
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+
+
+def parse_decimal(text: str | None) -> float | None:
+    """``text`` as a finite float when it is an ASCII decimal number, else ``None``.
+
+    Examples:
+        >>> parse_decimal(" 120.5 "), parse_decimal("1e3"), parse_decimal("\u0663"), parse_decimal("nan")
+        (120.5, 1000.0, None, None)
+    """
+    text = (text or "").strip(_XML_SPACE)
+    if not _DECIMAL.fullmatch(text):
+        return None
+    value = float(text)
+    return value if math.isfinite(value) else None
 
 
 def _beyond(negative: bool) -> str:

@@ -11,7 +11,7 @@ from typing import Any, Iterator, Mapping
 
 from petriflow.errors import MarkingError
 
-__all__ = ["Marking", "parse_marking"]
+__all__ = ["Marking", "format_marking", "parse_marking"]
 
 
 class Marking(Mapping[str, int]):
@@ -109,6 +109,17 @@ class Marking(Mapping[str, int]):
     def to_dict(self) -> dict[str, int]:
         """Plain ``{place: count}`` dict of the marked places, sorted by place id."""
         return dict(self._tokens)
+
+
+def format_marking(marking: Mapping[str, int]) -> str:
+    """A marking as the analyses' messages write it: ``place=count`` in the marking's
+    order, or ``(empty)``.
+
+    Examples:
+        >>> format_marking(Marking({"p": 1, "q": 2})), format_marking({})
+        ('p=1, q=2', '(empty)')
+    """
+    return ", ".join(f"{p}={c}" for p, c in marking.items()) or "(empty)"
 
 
 def parse_marking(text: str, places: Any = None) -> Marking:

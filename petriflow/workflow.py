@@ -1,4 +1,4 @@
-"""WF-net operators: AND/XOR split and join as plain P/T structure.
+"""Workflow nets: AND/XOR operators as plain P/T structure, and the WF-net structure.
 
 Workflow editors (WoPeD, YAWL) and nets drawn in their style draw operators such as an
 AND-split or an XOR-join as one box. Their meaning is plain P/T structure:
@@ -8,6 +8,10 @@ AND-split or an XOR-join as one box. Their meaning is plain P/T structure:
 
 :func:`add_operator` builds that structure. Every transition it makes carries an
 :class:`~petriflow.net.Operator` naming the group, so writers can fold it back.
+
+A **WF-net** has one source place ``i``, one sink place ``o``, and every node on a path
+from ``i`` to ``o``: :func:`workflow_structure` checks that, and :func:`final_marking_of`
+names the marking a run of the net should end in.
 
 Examples:
     >>> from petriflow.net import Net
@@ -22,13 +26,15 @@ Examples:
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
 from petriflow.errors import NetStructureError
 from petriflow.marking import Marking
 from petriflow.net import OPERATOR_KINDS, Net, Operator
 
-__all__ = ["add_operator", "operator_groups", "source_places", "sink_places", "final_marking_of"]
+__all__ = ["add_operator", "operator_groups", "source_places", "sink_places", "final_marking_of",
+           "WorkflowStructure", "workflow_structure"]
 
 
 def _weights(branches: Sequence[str] | Mapping[str, int]) -> list[tuple[str, int]]:
@@ -117,8 +123,6 @@ def final_marking_of(net: Net) -> Marking | None:
     """
     if net.final_marking is not None:
         return net.final_marking
-    from petriflow.analysis.soundness import workflow_structure
-
     structure = workflow_structure(net)
     return Marking({structure.sink: 1}) if structure.is_wf_net else None
 
@@ -127,3 +131,82 @@ def sink_places(net: Net) -> list[str]:
     """Places no transition takes tokens from (a WF-net has exactly one: ``o``)."""
     drained = {a.source for a in net.arcs if a.source in net.places}
     return [p for p in net.places if p not in drained]
+
+
+@dataclass
+class WorkflowStructure:
+    """The result of the WF-net structure check.
+
+    Attributes:
+        is_wf_net: whether the net is a WF-net.
+        source: the source place ``i`` (``None`` unless there is exactly one).
+        sink: the sink place ``o`` (``None`` unless there is exactly one).
+        source_places: every place without an incoming arc.
+        sink_places: every place without an outgoing arc.
+        not_on_path: nodes not on any path from ``i`` to ``o``.
+        problem: why the net is not a WF-net (``None`` when it is).
+    """
+
+    is_wf_net: bool
+    source: str | None
+    sink: str | None
+    source_places: list[str]
+    sink_places: list[str]
+    not_on_path: list[str]
+    problem: str | None
+
+
+def workflow_structure(net: Net) -> WorkflowStructure:
+    """Check the WF-net structure: one source place, one sink place, all nodes on a path.
+
+    Examples:
+        >>> from petriflow.io.yaml import loads_net
+        >>> net = loads_net('''
+        ... petriflow: 1
+        ... places: [i, o, stray]
+        ... transitions: [{id: t, in: [i], out: [o]}, {id: u, in: [stray], out: [stray]}]
+        ... ''')
+        >>> found = workflow_structure(net)
+        >>> found.is_wf_net, found.not_on_path
+        (False, ['stray', 'u'])
+    """
+    sources, sinks = source_places(net), sink_places(net)
+    if len(sources) != 1 or len(sinks) != 1:
+        problems = []
+        if not sources:
+            problems.append("no source place (every place has an incoming arc)")
+        elif len(sources) > 1:
+            problems.append(f"{len(sources)} source places: {', '.join(sources)}")
+        if not sinks:
+            problems.append("no sink place (every place has an outgoing arc)")
+        elif len(sinks) > 1:
+            problems.append(f"{len(sinks)} sink places: {', '.join(sinks)}")
+        return WorkflowStructure(False, sources[0] if len(sources) == 1 else None,
+                                 sinks[0] if len(sinks) == 1 else None, sources, sinks, [],
+                                 "; ".join(problems))
+    source, sink = sources[0], sinks[0]
+    if source == sink:
+        return WorkflowStructure(False, source, sink, sources, sinks, [],
+                                 f"place {source!r} is both the source and the sink")
+    forward: dict[str, list[str]] = {node: [] for node in net}
+    backward: dict[str, list[str]] = {node: [] for node in net}
+    for arc in net.arcs:
+        forward[arc.source].append(arc.target)
+        backward[arc.target].append(arc.source)
+
+    def closure(start: str, edges: dict[str, list[str]]) -> set[str]:
+        seen, todo = {start}, [start]
+        while todo:
+            for nxt in edges[todo.pop()]:
+                if nxt not in seen:
+                    seen.add(nxt)
+                    todo.append(nxt)
+        return seen
+
+    on_path = closure(source, forward) & closure(sink, backward)
+    missing = [node for node in net if node not in on_path]
+    problem = None
+    if missing:
+        shown = ", ".join(missing[:10]) + (" ..." if len(missing) > 10 else "")
+        problem = f"{len(missing)} nodes are not on a path from {source!r} to {sink!r}: {shown}"
+    return WorkflowStructure(not missing, source, sink, sources, sinks, missing, problem)

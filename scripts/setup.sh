@@ -18,6 +18,8 @@ command -v dot >/dev/null 2>&1 || packages+=(graphviz)
 # a headless browser for the tests of petriflow view's pages (Selenium drives it)
 command -v chromium >/dev/null 2>&1 || packages+=(chromium)
 command -v chromedriver >/dev/null 2>&1 || packages+=(chromium-driver)
+# Node.js runs the page's pure replay script in the tests (tests/view/test_replay_js.py)
+command -v node >/dev/null 2>&1 || packages+=(nodejs)
 if [ ! -x .venv/bin/python ] && ! "$PYTHON" -c 'import ensurepip, venv' >/dev/null 2>&1; then
     packages+=("python3-venv")
 fi

@@ -44,8 +44,8 @@ def digest(net: Path) -> dict:
         entry = {"exit": done.returncode}
         if trace.exists():
             entry["trace"] = hashlib.sha256(trace.read_bytes()).hexdigest()
-        else:
-            entry["stderr"] = hashlib.sha256(done.stderr.encode()).hexdigest()
+        else:  # the message, with the checkout's own folder left out (it names the net's path)
+            entry["stderr"] = hashlib.sha256(done.stderr.replace(str(REPO), "").encode()).hexdigest()
         return entry
 
 

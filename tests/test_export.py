@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 import petriflow.export as export
+from petriflow.dot import quote
 from petriflow.cli import main
 from petriflow.errors import DependencyNotInstalled, PetriflowError, UnknownElementError
 from petriflow.export import HIGHLIGHT_COLOUR, export_net, render, to_dot
@@ -188,10 +189,10 @@ def odd_net() -> Net:
 
 def test_awkward_ids_get_distinct_dot_names():
     """Quoting is one-to-one, also for backslashes that Graphviz reads specially."""
-    names = [export._quote(node) for node in ODD_IDS]
+    names = [quote(node) for node in ODD_IDS]
     assert len(set(names)) == len(names)
-    assert export._quote('say "hi"') == '"say \\"hi\\""'
-    assert export._quote("end\\") == '"end\\\\"'
+    assert quote('say "hi"') == '"say \\"hi\\""'
+    assert quote("end\\") == '"end\\\\"'
 
 
 @needs_dot

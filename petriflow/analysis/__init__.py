@@ -15,8 +15,12 @@ One concept per module:
   interchangeable agents;
 * :mod:`~petriflow.analysis.stubborn` — stubborn sets: deadlocks, reaching a marking;
 * :mod:`~petriflow.analysis.structural` — soundness of free-choice WF-nets by the Rank Theorem;
-* :mod:`~petriflow.analysis.methods` — ``check --method``: which of them answers what;
-* :mod:`~petriflow.analysis.report` — :func:`check_net`, the ``petriflow check`` command.
+* :mod:`~petriflow.analysis.check` — :func:`check_net`, what ``petriflow check`` answers,
+  by the explicit state space (:mod:`~petriflow.analysis.explicit`) or a reduction
+  (:mod:`~petriflow.analysis.methods`: which of them answers what), each filling the
+  result of :mod:`~petriflow.analysis.check_result`;
+* :mod:`~petriflow.analysis.verdict` — the exit code of a check; and
+  :mod:`~petriflow.analysis.report` — its text.
 
 Examples:
     >>> from petriflow.classic import dining_philosophers
@@ -59,7 +63,8 @@ from petriflow.analysis.reachability import (
     reachability_graph,
     to_networkx,
 )
-from petriflow.analysis.report import check_net, exit_code, format_report
+from petriflow.analysis.check import check_net
+from petriflow.analysis.report import format_report
 from petriflow.analysis.soundness import (
     SoundnessReport,
     Violation,
@@ -68,6 +73,7 @@ from petriflow.analysis.soundness import (
     is_free_choice,
     workflow_structure,
 )
+from petriflow.analysis.verdict import exit_code
 
 __all__ = [
     "DEFAULT_MAX_COVERABILITY", "DEFAULT_MAX_STATES", "OMEGA", "CoverabilityGraph",

@@ -22,9 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from petriflow.analysis._kernel import _jit, _mix
+from petriflow.analysis._kernel import mix
+from petriflow.analysis._numba import njit
 
 __all__ = ["OK", "LIMIT", "FULL", "OVERFLOW", "OMEGA", "search"]
+
+_jit = njit(__name__)
 
 #: Status codes (as in :mod:`petriflow.analysis._kernel`).
 OK, LIMIT, OVERFLOW, FULL = 0, 1, 3, 5
@@ -41,7 +44,7 @@ def _hash_row(row):
     h = _GOLDEN
     for p in range(row.shape[0]):
         h = (h ^ np.uint64(row[p])) * _M1
-    return _mix(h)
+    return mix(h)
 
 
 @_jit
@@ -106,7 +109,7 @@ def search(pre_at, pre_place, pre_weight, change_at, change_place, change_delta,
         # Each node tries the transitions from its own pseudo-random first one on, so
         # the search goes deep in varied directions instead of always taking the same
         # transitions first (which can circle in one bounded part for ever).
-        t = np.int64((_mix(np.uint64(node) + _GOLDEN) + np.uint64(tried)) % np.uint64(n_t))
+        t = np.int64((mix(np.uint64(node) + _GOLDEN) + np.uint64(tried)) % np.uint64(n_t))
         enabled = True
         for a in range(pre_at[t], pre_at[t + 1]):
             if rows[node, pre_place[a]] < pre_weight[a]:

@@ -83,7 +83,7 @@ except ImportError:  # pragma: no cover - exercised only where numba is missing
     COMPILED = False
 
 __all__ = ["OK", "LIMIT", "NOT_SAFE", "OVERFLOW", "UNBOUNDED", "FULL", "COMPILED",
-           "expand_bits", "expand_counts", "rehash", "prefetch"]
+           "expand_bits", "expand_counts", "rehash", "prefetch", "mix"]
 
 #: Status codes returned as the first element of a kernel's result.
 OK, LIMIT, NOT_SAFE, OVERFLOW, UNBOUNDED = 0, 1, 2, 3, 4
@@ -98,7 +98,7 @@ _ONE = np.uint64(1)
 
 
 @_jit
-def _mix(x):
+def mix(x):
     """splitmix64's finaliser: a bijection of uint64 that spreads every input bit."""
     x = x ^ (x >> _S30)
     x = x * _M1
@@ -120,7 +120,7 @@ def rehash(table, stride, id_bits, bigger):
         entry = table[stride * slot + stride - 1]
         if entry == 0:
             continue
-        h = table[2 * slot] if stride == 2 else _mix(entry >> np.uint64(id_bits))
+        h = table[2 * slot] if stride == 2 else mix(entry >> np.uint64(id_bits))
         i = h & mask
         while bigger[stride * i + stride - 1] != 0:
             i = (i + _ONE) & mask
@@ -135,7 +135,7 @@ def rehash(table, stride, id_bits, bigger):
 def _hash_bits(row, key_mask):
     h = _GOLDEN
     for w in range(row.shape[0]):
-        h = _mix(h ^ (row[w] & key_mask[w]))
+        h = mix(h ^ (row[w] & key_mask[w]))
     return h
 
 
@@ -213,7 +213,7 @@ def _expand_bits(n_w, pre, post, keep, kind, key_mask, id_bits, max_states, rows
         parent[0] = -1
         parent_t[0] = -1
         key = rows[0, 0] & key_mask[0]
-        h = _mix(key) if stride == 1 else _hash_bits(rows[0], key_mask)
+        h = mix(key) if stride == 1 else _hash_bits(rows[0], key_mask)
         if stride == 1:
             table[h & mask] = (key << shift) | _ONE
         else:
@@ -265,7 +265,7 @@ def _expand_bits(n_w, pre, post, keep, kind, key_mask, id_bits, max_states, rows
                     status = NOT_SAFE
                 found[c, w] = kept | post[t, w]
             if stride == 1:
-                h = _mix(found[c, 0] & key_mask[0])
+                h = mix(found[c, 0] & key_mask[0])
             else:
                 h = _hash_bits(found[c], key_mask)
             hashes[c] = h
@@ -329,7 +329,7 @@ def _hash_counts(row, key):
     h = _GOLDEN
     for p in range(key):
         h = (h ^ np.uint64(row[p])) * _M1
-    return _mix(h)
+    return mix(h)
 
 
 @_jit

@@ -44,7 +44,13 @@ from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from petriflow.analysis.reachability import DEFAULT_MAX_STATES, StateSpaceLimit
+from petriflow.analysis.exploration import (
+    DEFAULT_MAX_STATES,
+    StateSpaceLimit,
+    UnboundedNetError,
+    row_changes,
+    row_origins,
+)
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.net import Net
@@ -136,7 +142,7 @@ def coverability_graph(
     Args:
         net: the net.
         marking: the start marking (default: the net's initial marking).
-        max_nodes: stop with :class:`~petriflow.analysis.reachability.StateSpaceLimit`
+        max_nodes: stop with :class:`~petriflow.analysis.exploration.StateSpaceLimit`
             beyond this many nodes (the graph of a bounded net is its whole
             reachability graph, which can be large).
         compiled: a :class:`~petriflow.engine.CompiledNet` of ``net`` to reuse.
@@ -187,10 +193,8 @@ def coverability_graph(
                 parent_t.append(t)
                 queue.append(target)
             edges.append((node, t, target))
-    origin = getattr(compiled, "origin", None)
-    origins = tuple(o[0] for o in origin) if origin else tuple(compiled.transitions)
     return CoverabilityGraph(tuple(compiled.places), tuple(compiled.transitions), markings,
-                             edges, parent, parent_t, origins)
+                             edges, parent, parent_t, row_origins(compiled))
 
 
 def _accelerate(successor: list, node: int, markings: list[tuple], parent: list[int]) -> list:
@@ -256,7 +260,7 @@ class CoverabilitySearch:
         nodes, edges: the graph's size when the search stopped.
         unbounded_places: places with ω in some node: unbounded, all of them when
             ``complete``, at least these otherwise.
-        witness: an :class:`~petriflow.analysis.reachability.UnboundedNetError` built
+        witness: an :class:`~petriflow.analysis.exploration.UnboundedNetError` built
             from the first pump found (a plain firing sequence and the pump that can be
             repeated), ``None`` when none was found.
         dead_transitions: transitions no node enables (``None`` unless ``complete``).
@@ -326,7 +330,6 @@ def coverability_search(
 
     from petriflow.analysis import _karp_miller as km
     from petriflow.analysis import _kernel
-    from petriflow.analysis.reachability import UnboundedNetError, _changes, _origins
 
     compiled = compiled or CompiledNet(net)
     if getattr(compiled, "has_resets", False):
@@ -346,7 +349,7 @@ def coverability_search(
         return (at, np.array([p for p, _ in flat], dtype=np.int64),
                 np.array([w for _, w in flat], dtype=np.int64))
 
-    fixed = (*csr(compiled.pre), *csr(_changes(compiled)), max_nodes)
+    fixed = (*csr(compiled.pre), *csr(row_changes(compiled)), max_nodes)
     size = min(1024, max_nodes + 1)
     per_node = [np.empty((size, n_p), dtype=np.int64)] + [
         np.empty(size, dtype=np.int64) for _ in range(7)]
@@ -391,7 +394,7 @@ def coverability_search(
 
         covered_row = rows[ancestor]
         covering_row = rows[node].copy()
-        for p, d in _changes(compiled)[t]:
+        for p, d in row_changes(compiled)[t]:
             covering_row[p] += d
         prefix, pump = walk(ancestor, 0), walk(node, ancestor) + [compiled.transitions[t]]
         prefix, pump, covered_row, covering_row = _shorter(compiled, start, prefix, pump)
@@ -400,11 +403,11 @@ def coverability_search(
                                     compiled.marking([int(c) for c in covered_row]),
                                     compiled.marking([int(c) for c in covering_row]))
     complete = status == km.OK
-    origins = _origins(compiled)
-    fired_names = list(dict.fromkeys(origins[t] for t in np.flatnonzero(fired)))
+    origin_of = row_origins(compiled)
+    fired_names = list(dict.fromkeys(origin_of[t] for t in np.flatnonzero(fired)))
     dead = bounds = None
     if complete:
-        dead = list(dict.fromkeys(origins[t] for t in range(n_t) if not fired[t]))
+        dead = list(dict.fromkeys(origin_of[t] for t in range(n_t) if not fired[t]))
         dead = [d for d in dead if d not in set(fired_names)]
         top = rows.max(axis=0) if nodes else np.zeros(n_p, dtype=np.int64)
         bounds = {p: (None if omega[j] else int(top[j])) for j, p in enumerate(compiled.places)}

@@ -1,9 +1,9 @@
 """How ``petriflow check`` answers: the explicit state space, or a reduction.
 
-:func:`check_with_method` runs :func:`~petriflow.analysis.report.check_net` with one
+:func:`check_with_method` runs :func:`~petriflow.analysis.check.check_net` with one
 of :data:`METHODS`:
 
-* ``explicit`` — the full state space (``report``'s own exploration);
+* ``explicit`` — the full state space (:mod:`~petriflow.analysis.explicit`);
 * ``symmetry`` — the state space up to permutations of interchangeable agents
   (:mod:`~petriflow.analysis.symmetry`); falls back to ``explicit`` (and says so) when
   the net has no verified symmetric agents, its boundedness is not proved first, or a
@@ -29,10 +29,20 @@ import numpy as np
 
 from petriflow.analysis._graph import components, reaching
 from petriflow.analysis.reachability import StateSpaceLimit
-from petriflow.analysis.soundness import Violation, _format as _fmt
+from petriflow.analysis.check_result import (
+    add_p_semiflows,
+    add_t_semiflows,
+    coverability_note,
+    explored_marking,
+    skeleton,
+    soundness_final,
+)
+from petriflow.analysis.explicit import explicit_check
+from petriflow.analysis.soundness import Violation
+from petriflow.workflow import workflow_structure
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
-from petriflow.marking import Marking
+from petriflow.marking import Marking, format_marking
 from petriflow.net import Net
 
 __all__ = ["METHODS", "check_with_method"]
@@ -55,15 +65,10 @@ PROPERTIES = ("sound", "bounded", "deadlock_free", "dead_transitions", "live", "
 
 def check_with_method(net: Net, method: str, **budgets) -> dict[str, Any]:
     """``check_net`` by ``method`` (see the module); ``budgets`` are ``check_net``'s."""
-    from petriflow.analysis import report
-    from petriflow.analysis.soundness import workflow_structure
-
     if method not in METHODS:
         raise PetriflowError(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
     structure = workflow_structure(net)
-    start = net.initial_marking
-    if not start and structure.is_wf_net:
-        start = Marking({structure.source: 1})
+    start = explored_marking(net, structure)
     notes: list[str] = []
     result = None
     used = "explicit"
@@ -74,7 +79,7 @@ def check_with_method(net: Net, method: str, **budgets) -> dict[str, Any]:
         elif method == "symmetry" or why != "no symmetric agents":
             notes.append(f"symmetry reduction not used ({why}): explicit state space")
     if result is None and method == "stubborn":
-        result = report.check_net(net, method=None, **dict(budgets, max_states=1))
+        result = explicit_check(net, **dict(budgets, max_states=1))
         result["error"] = ("--method stubborn explores no full state space: deadlocks (and a"
                            " WF-net's soundness) by stubborn sets, the properties they do not"
                            " preserve undecided")
@@ -88,7 +93,7 @@ def check_with_method(net: Net, method: str, **budgets) -> dict[str, Any]:
                 result[key] = None
         used = "stubborn"
     if result is None:
-        result = report.check_net(net, method=None, **budgets)
+        result = explicit_check(net, **budgets)
     result["method"] = method
     methods = {key: (used if used != "stubborn" else None) for key in PROPERTIES}
     if used == "explicit" or used == "symmetry":
@@ -187,7 +192,6 @@ def _structural(net: Net, result: dict, methods: dict, notes: list[str]) -> None
 
 def _stubborn(net: Net, structure, start, result: dict, methods: dict, notes: list[str],
               budgets: dict) -> None:
-    from petriflow.analysis.report import soundness_final
     from petriflow.analysis.stubborn import stubborn_deadlocks
 
     final = soundness_final(net, structure) if structure.is_wf_net else net.final_marking
@@ -214,15 +218,15 @@ def _stubborn(net: Net, structure, start, result: dict, methods: dict, notes: li
         methods["deadlock_free"] = "stubborn"
         if result.get("stuck_markings") is None:
             result["stuck_markings_at_least"] = 1
-        message = (f"deadlock: {_fmt(found.marking)} enables no transition (stubborn-set search;"
+        message = (f"deadlock: {format_marking(found.marking)} enables no transition (stubborn-set search;"
                    " more may exist)")
         if structure.is_wf_net:
             if result.get("sound") is None:
                 result["sound"] = False
                 methods["sound"] = "stubborn"
             violations.append(Violation(
-                "no_option_to_complete", f"no option to complete: {_fmt(found.marking)} is a"
-                f" deadlock other than the final marking {_fmt(final)} (stubborn-set search)",
+                "no_option_to_complete", f"no option to complete: {format_marking(found.marking)} is a"
+                f" deadlock other than the final marking {format_marking(final)} (stubborn-set search)",
                 found.witness, found.marking.to_dict()).to_dict())
         elif not any(v["kind"] == "deadlock" for v in violations):
             violations.append(Violation("deadlock", message, found.witness,
@@ -291,9 +295,7 @@ def _reduced(net: Net, result: dict, methods: dict, notes: list[str], budgets: d
 
 def _symmetric(net: Net, structure, start, budgets: dict) -> tuple[dict | None, str]:
     """The symmetry-reduced check, or ``(None, why not)``."""
-    from petriflow.analysis import report
     from petriflow.analysis.coverability import DEFAULT_MAX_COVERABILITY, coverability_search
-    from petriflow.analysis.invariants import DEFAULT_BUDGET
     from petriflow.analysis.symmetry import (
         SymmetryUnsupported,
         find_symmetries,
@@ -301,27 +303,22 @@ def _symmetric(net: Net, structure, start, budgets: dict) -> tuple[dict | None, 
     )
 
     compiled = CompiledNet(net)
-    final_sound = report.soundness_final(net, structure)
+    final_sound = soundness_final(net, structure)
     if structure.is_wf_net and start != Marking({structure.source: 1}):
         return None, "a WF-net explored from a marking other than [i]"
     final = final_sound if structure.is_wf_net else net.final_marking
     groups = find_symmetries(net, compiled=compiled, start=start, final=final)
     if not groups:
         return None, "no symmetric agents"
-    result = report._skeleton(net, structure, start)
+    result = skeleton(net, structure, start)
     invariant_budget = budgets.get("invariant_budget")
-    p_budget = DEFAULT_BUDGET if invariant_budget is None else invariant_budget
-    result["invariants"], _ = report._invariants(compiled, start, p_budget)
-    structurally_bounded = bool(result["invariants"].get("covered_by_p_semiflows"))
-    result["structurally_bounded"] = structurally_bounded
-    if structurally_bounded:
-        result["algorithm"].append("P-semiflows cover every place: bounded for any marking")
-    else:
+    add_p_semiflows(result, compiled, start, invariant_budget)
+    if not result["structurally_bounded"]:
         budget = budgets.get("max_coverability", DEFAULT_MAX_COVERABILITY)
         if budget <= 0 or compiled.has_resets:
             return None, "boundedness not proved by P-semiflows"
         probe = coverability_search(net, start, max_nodes=budget, compiled=compiled)
-        report._coverability_note(result, probe, budget)
+        coverability_note(result, probe, budget)
         if not probe.bounded:
             return None, "boundedness not proved by P-semiflows or the Karp-Miller search"
     max_states = budgets.get("max_states") or 2_000_000
@@ -344,12 +341,7 @@ def _symmetric(net: Net, structure, start, budgets: dict) -> tuple[dict | None, 
         violations.append(Violation("not_wf_net", f"not a WF-net: {structure.problem}",
                                     elements=structure.not_on_path))
     _fill_symmetric(result, space, compiled, structure, final, violations)
-    t_budget = invariant_budget
-    if t_budget is None:
-        t_budget = min(DEFAULT_BUDGET, max(report.T_BUDGET_FLOOR,
-                                           report.T_BUDGET_PER_EDGE * (space.num_states + space.num_edges)))
-    result["invariants"]["t_budget"] = t_budget
-    report._semiflows(result["invariants"], "t", compiled, t_budget)
+    add_t_semiflows(result, compiled, invariant_budget, space.num_states + space.num_edges)
     result["violations"] = [v.to_dict() for v in violations]
     result["algorithm"] = "; ".join(result["algorithm"])
     return result, ""
@@ -398,8 +390,8 @@ def _fill_symmetric(result: dict, space, compiled: CompiledNet, structure, final
                 state = stuck[0]
                 path, reached = space.concrete(state)
                 violations.append(Violation(
-                    "no_option_to_complete", f"no option to complete: {_fmt(reached)} is a deadlock"
-                    f" other than the final marking {_fmt(final)} (found before the state limit)",
+                    "no_option_to_complete", f"no option to complete: {format_marking(reached)} is a deadlock"
+                    f" other than the final marking {format_marking(final)} (found before the state limit)",
                     path, reached.to_dict()))
                 result["sound"] = False
             else:
@@ -407,7 +399,7 @@ def _fill_symmetric(result: dict, space, compiled: CompiledNet, structure, final
         elif stuck:
             path, reached = space.concrete(stuck[0])
             violations.append(Violation(
-                "deadlock", f"deadlock: {_fmt(reached)} enables no transition (found before the"
+                "deadlock", f"deadlock: {format_marking(reached)} enables no transition (found before the"
                 " state limit; more may exist)", path, reached.to_dict()))
         result["stuck_markings"] = None
         result["undecided"] = undecided
@@ -465,7 +457,7 @@ def _fill_symmetric(result: dict, space, compiled: CompiledNet, structure, final
         count = result["stuck_markings"]
         violations.append(Violation(
             "deadlock", f"deadlock: {count} reachable marking{'s' if count != 1 else ''} enable no"
-            f" transition, e.g. {_fmt(reached)}", path, reached.to_dict()))
+            f" transition, e.g. {format_marking(reached)}", path, reached.to_dict()))
     if not structure.is_wf_net:
         return
     # soundness from [i]: Mf and [i] are fixed by every permutation
@@ -475,8 +467,8 @@ def _fill_symmetric(result: dict, space, compiled: CompiledNet, structure, final
         path, reached = space.concrete(int(improper[0]))
         violations.append(Violation(
             "improper_completion", f"improper completion: {sum(orbit[s] for s in improper.tolist())}"
-            f" reachable markings cover the final marking {_fmt(final)} with tokens left elsewhere,"
-            f" e.g. {_fmt(reached)}", path, reached.to_dict()))
+            f" reachable markings cover the final marking {format_marking(final)} with tokens left elsewhere,"
+            f" e.g. {format_marking(reached)}", path, reached.to_dict()))
     can_finish = np.zeros(n, dtype=bool) if final_state is None else reaching(
         space.edge_offsets, space.edge_target, [final_state])
     if not can_finish.all():
@@ -486,8 +478,8 @@ def _fill_symmetric(result: dict, space, compiled: CompiledNet, structure, final
         path, reached = space.concrete(state)
         kind = "a deadlock" if dead_stuck else "no firing sequence leads back"
         violations.append(Violation(
-            "no_option_to_complete", f"no option to complete: from {_fmt(reached)} the final marking"
-            f" {_fmt(final)} can no longer be reached ({kind})", path, reached.to_dict()))
+            "no_option_to_complete", f"no option to complete: from {format_marking(reached)} the final"
+            f" marking {format_marking(final)} can no longer be reached ({kind})", path, reached.to_dict()))
     if dead:
         violations.append(Violation(
             "dead_transition", f"{len(dead)} dead transitions (enabled in no marking reachable"

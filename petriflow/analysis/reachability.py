@@ -66,6 +66,14 @@ import numpy as np
 
 from petriflow import limits
 from petriflow.analysis._linear import pivot_columns
+from petriflow.analysis.exploration import (
+    DEFAULT_MAX_STATES,
+    StateSpaceLimit,
+    UnboundedNetError,
+    row_changes,
+    row_origins,
+    row_resets,
+)
 from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
 from petriflow.marking import Marking
@@ -79,65 +87,6 @@ __all__ = [
     "reachability_graph",
     "to_networkx",
 ]
-
-#: Default limit on the number of states :func:`reachability_graph` stores.
-DEFAULT_MAX_STATES = 2_000_000
-
-
-
-class StateSpaceLimit(PetriflowError):
-    """The reachable state space has more states than the limit allows.
-
-    Attributes:
-        limit: the ``max_states`` that was exceeded.
-        explored: states stored when the exploration stopped.
-        expanded: states whose successors had all been computed.
-        partial: what was explored, as a :class:`StateSpace` whose ``expanded`` says
-            how many of its states (the first ones) have all their edges; every fact
-            read off it is a fact about the net (``None`` where the search that stopped
-            keeps no graph).
-    """
-
-    def __init__(self, limit: int, explored: int, expanded: int,
-                 partial: StateSpace | None = None) -> None:
-        self.limit = limit
-        self.explored = explored
-        self.expanded = expanded
-        self.partial = partial
-        super().__init__(
-            f"state space exceeds max_states={limit}: stopped after {explored} states "
-            f"({expanded} fully expanded); raise the limit (--max-states) to explore further"
-        )
-
-
-class UnboundedNetError(PetriflowError):
-    """The net is unbounded: a reachable marking strictly covers an earlier one.
-
-    Firing ``prefix`` from the initial marking reaches ``covered``; firing ``pump`` from
-    there reaches ``covering`` >= ``covered`` with more tokens in ``places``. Since
-    ``pump`` is enabled again in ``covering`` (monotonicity), repeating it grows those
-    places without bound.
-
-    Attributes:
-        places: ids of the places that strictly grow along ``pump`` (all unbounded).
-        prefix: transition ids from the initial marking to ``covered``.
-        pump: transition ids from ``covered`` to ``covering``.
-        covered: the earlier marking.
-        covering: the later marking.
-    """
-
-    def __init__(self, places: list[str], prefix: list[str], pump: list[str],
-                 covered: Marking, covering: Marking) -> None:
-        self.places = places
-        self.prefix = prefix
-        self.pump = pump
-        self.covered = covered
-        self.covering = covering
-        super().__init__(
-            f"net is unbounded: firing {pump} from the marking reached by {prefix} adds tokens"
-            f" to {places} and can be repeated forever"
-        )
-
 
 @dataclass(eq=False)
 class StateSpace:
@@ -376,7 +325,7 @@ def reachability_graph(
         >>> reachability_graph(producer_consumer(3), max_states=10)
         Traceback (most recent call last):
         ...
-        petriflow.analysis.reachability.StateSpaceLimit: state space exceeds max_states=10: stopped after 10 states (7 fully expanded); raise the limit (--max-states) to explore further
+        petriflow.analysis.exploration.StateSpaceLimit: state space exceeds max_states=10: stopped after 10 states (7 fully expanded); raise the limit (--max-states) to explore further
     """
     compiled = compiled or CompiledNet(net)
     start = net.initial_marking if marking is None else net.check_marking(marking)
@@ -425,31 +374,6 @@ def warm_up() -> None:
         reachability_graph(net)
 
 
-def _origins(compiled: CompiledNet) -> tuple[str, ...]:
-    """Per row, the net transition it belongs to (rows are transitions or outcome variants)."""
-    origin = getattr(compiled, "origin", None)
-    return tuple(o[0] for o in origin) if origin else tuple(compiled.transitions)
-
-
-def _resets_of(compiled: CompiledNet) -> list[tuple[int, ...]]:
-    """Per row, the places its cancellation region empties (reset arcs)."""
-    return list(getattr(compiled, "reset", None) or [()] * len(compiled.transitions))
-
-
-def _changes(compiled: CompiledNet) -> list[list[tuple[int, int]]]:
-    """Per row, ``(place, post - pre)`` of the places whose count it changes: the
-    incidence matrix row by row, sparse (a dense one of a large net costs gigabytes)."""
-    rows = []
-    for pre, post in zip(compiled.pre, compiled.post):
-        delta: dict[int, int] = {}
-        for p, w in pre:
-            delta[p] = delta.get(p, 0) - w
-        for p, w in post:
-            delta[p] = delta.get(p, 0) + w
-        rows.append(sorted((p, d) for p, d in delta.items() if d))
-    return rows
-
-
 def _layout(compiled: CompiledNet, has_resets: bool,
             threshold: int) -> tuple[list[int], list[int], int]:
     """``(column -> place, place -> column, number of key columns)``.
@@ -460,7 +384,7 @@ def _layout(compiled: CompiledNet, has_resets: bool,
     """
     n_places = len(compiled.places)
     too_big = n_places * len(compiled.transitions) > limits.BASIS_ENTRIES  # elimination is cubic
-    if has_resets or n_places <= threshold or too_big or not any(_changes(compiled)):
+    if has_resets or n_places <= threshold or too_big or not any(row_changes(compiled)):
         identity = list(range(n_places))
         return identity, identity, n_places
     basis = pivot_columns(compiled.incidence)
@@ -617,7 +541,7 @@ def _explore(compiled: CompiledNet, m0: Sequence[int], max_states: int,
     """
     from petriflow.analysis import _kernel
 
-    resets = _resets_of(compiled)
+    resets = row_resets(compiled)
     has_resets = any(resets)
     if bits and max(m0, default=0) <= 1:
         space = _explore_bits(_kernel, compiled, m0, max_states, resets, has_resets,
@@ -672,7 +596,7 @@ def _explore_counts(kernel, compiled: CompiledNet, m0: Sequence[int], max_states
         return (at, np.array([col[p] for p, _ in flat], dtype=np.int64),
                 np.array([w for _, w in flat], dtype=np.int64))
 
-    changes = _changes(compiled)
+    changes = row_changes(compiled)
     reset_at, reset_place, _ = csr([[(p, 0) for p in places] for places in resets])
     conservative = all(sum(d for _, d in row) == 0 for row in changes)
     check = detect_unbounded and not conservative
@@ -729,7 +653,7 @@ def _space(compiled: CompiledNet, representation: str, buffers: _Buffers,
     return StateSpace(
         places=tuple(compiled.places),
         transitions=tuple(compiled.transitions),
-        origins=_origins(compiled),
+        origins=row_origins(compiled),
         edge_offsets=offsets,
         edge_transition=e_transition[:edges],
         edge_target=e_target[:edges],
@@ -759,7 +683,7 @@ def _unbounded(compiled: CompiledNet, buffers: _Buffers, column: list[int]) -> N
 
     covered, covering = marking(ancestor), marking(state)
     pump = walk(state, ancestor)
-    resets = _resets_of(compiled)
+    resets = row_resets(compiled)
     reset = {compiled.places[p] for t in pump for p in resets[compiled.transitions.index(t)]}
     grown = [p for p in compiled.places if covering[p] > covered[p] and p not in reset]
     raise UnboundedNetError(grown, walk(ancestor, 0), pump, covered, covering)

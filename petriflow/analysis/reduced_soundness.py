@@ -60,10 +60,12 @@ import numpy as np
 
 from petriflow.analysis._graph import reaching
 from petriflow.analysis.reachability import DEFAULT_MAX_STATES, StateSpaceLimit
-from petriflow.analysis.soundness import Violation, workflow_structure, _format as _fmt
+from petriflow.analysis.check_result import invariants_section, soundness_final
+from petriflow.analysis.soundness import Violation
 from petriflow.engine import CompiledNet
-from petriflow.marking import Marking
+from petriflow.marking import Marking, format_marking
 from petriflow.net import Net
+from petriflow.workflow import workflow_structure
 
 __all__ = ["ReducedSoundness", "reduced_soundness"]
 
@@ -120,7 +122,6 @@ def reduced_soundness(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
         A :class:`ReducedSoundness`. Not a WF-net, reset arcs, or a start marking the
         permutations move: ``sound`` is ``None`` with the reason.
     """
-    from petriflow.analysis.report import _invariants, soundness_final
     from petriflow.analysis.symmetry import (
         SymmetryUnsupported,
         find_symmetries,
@@ -138,7 +139,7 @@ def reduced_soundness(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
     start = Marking({structure.source: 1})
     final = soundness_final(net, structure)
     if covered is None:
-        section, _ = _invariants(compiled, start, DEFAULT_BUDGET)
+        section, _ = invariants_section(compiled, start, DEFAULT_BUDGET)
         covered = bool(section.get("covered_by_p_semiflows"))
     groups = find_symmetries(net, compiled=compiled, start=start, final=final)
     found = ReducedSoundness(None, groups=[g.agents for g in groups], final=final.to_dict())
@@ -160,8 +161,8 @@ def reduced_soundness(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
     if stuck:
         path, reached = space.concrete(stuck[0])
         found.violations.append(Violation(
-            "no_option_to_complete", f"no option to complete: {_fmt(reached)} enables no transition"
-            f" that changes the marking, and it is not the final marking {_fmt(final)}"
+            "no_option_to_complete", f"no option to complete: {format_marking(reached)} enables no transition"
+            f" that changes the marking, and it is not the final marking {format_marking(final)}"
             " (stubborn-set search)", path, reached.to_dict()))
         found.option_to_complete = False
     if not found.complete:
@@ -175,9 +176,9 @@ def reduced_soundness(net: Net, *, max_states: int = DEFAULT_MAX_STATES,
         state = int(np.flatnonzero(~finishing)[0])
         path, reached = space.concrete(state)
         found.violations.append(Violation(
-            "no_option_to_complete", f"no option to complete: from {_fmt(reached)} no marking"
+            "no_option_to_complete", f"no option to complete: from {format_marking(reached)} no marking"
             " without a move is reachable, so neither is the final marking"
-            f" {_fmt(final)} (stubborn-set search)", path, reached.to_dict()))
+            f" {format_marking(final)} (stubborn-set search)", path, reached.to_dict()))
         found.option_to_complete = False
     if found.option_to_complete is None:
         found.option_to_complete = True

@@ -1,4 +1,4 @@
-"""Workflow nets: the WF-net structure check and classical soundness, with witnesses.
+"""Workflow nets: classical soundness, with witnesses.
 
 A **WF-net** has exactly one source place ``i`` (no arc into it), exactly one sink
 place ``o`` (no arc out of it), and every place and transition lies on a path from
@@ -14,6 +14,9 @@ A WF-net is **sound** (van der Aalst) for one token in ``i`` and the final marki
 
 An unbounded WF-net is never sound (proper completion or the option to complete
 fails), so unboundedness is checked first, on the fly, and reported as such.
+
+The structure check itself is :func:`~petriflow.workflow.workflow_structure` (kept
+importable from here).
 
 :func:`check_soundness` decides all three on the reachability graph from ``[i]`` and
 returns every violation with a witness: the shortest firing sequence from ``[i]`` to a
@@ -62,9 +65,9 @@ from petriflow.analysis.reachability import (
     reachability_graph,
 )
 from petriflow.engine import CompiledNet
-from petriflow.marking import Marking
+from petriflow.marking import Marking, format_marking
 from petriflow.net import Net
-from petriflow.workflow import sink_places, source_places
+from petriflow.workflow import WorkflowStructure, workflow_structure
 
 __all__ = [
     "VIOLATION_KINDS",
@@ -79,10 +82,6 @@ __all__ = [
 #: The kinds of :class:`Violation` the analyses report.
 VIOLATION_KINDS = ("not_wf_net", "no_option_to_complete", "improper_completion",
                    "dead_transition", "unbounded", "deadlock")
-
-
-def _format(marking: Mapping[str, int]) -> str:
-    return ", ".join(f"{p}={c}" for p, c in marking.items()) or "(empty)"
 
 
 @dataclass
@@ -110,85 +109,6 @@ class Violation:
         return {"kind": self.kind, "transitions": list(self.transitions),
                 "message": self.message, "marking": self.marking,
                 "elements": list(self.elements)}
-
-
-@dataclass
-class WorkflowStructure:
-    """The result of the WF-net structure check.
-
-    Attributes:
-        is_wf_net: whether the net is a WF-net.
-        source: the source place ``i`` (``None`` unless there is exactly one).
-        sink: the sink place ``o`` (``None`` unless there is exactly one).
-        source_places: every place without an incoming arc.
-        sink_places: every place without an outgoing arc.
-        not_on_path: nodes not on any path from ``i`` to ``o``.
-        problem: why the net is not a WF-net (``None`` when it is).
-    """
-
-    is_wf_net: bool
-    source: str | None
-    sink: str | None
-    source_places: list[str]
-    sink_places: list[str]
-    not_on_path: list[str]
-    problem: str | None
-
-
-def workflow_structure(net: Net) -> WorkflowStructure:
-    """Check the WF-net structure: one source place, one sink place, all nodes on a path.
-
-    Examples:
-        >>> from petriflow.io.yaml import loads_net
-        >>> net = loads_net('''
-        ... petriflow: 1
-        ... places: [i, o, stray]
-        ... transitions: [{id: t, in: [i], out: [o]}, {id: u, in: [stray], out: [stray]}]
-        ... ''')
-        >>> found = workflow_structure(net)
-        >>> found.is_wf_net, found.not_on_path
-        (False, ['stray', 'u'])
-    """
-    sources, sinks = source_places(net), sink_places(net)
-    if len(sources) != 1 or len(sinks) != 1:
-        problems = []
-        if not sources:
-            problems.append("no source place (every place has an incoming arc)")
-        elif len(sources) > 1:
-            problems.append(f"{len(sources)} source places: {', '.join(sources)}")
-        if not sinks:
-            problems.append("no sink place (every place has an outgoing arc)")
-        elif len(sinks) > 1:
-            problems.append(f"{len(sinks)} sink places: {', '.join(sinks)}")
-        return WorkflowStructure(False, sources[0] if len(sources) == 1 else None,
-                                 sinks[0] if len(sinks) == 1 else None, sources, sinks, [],
-                                 "; ".join(problems))
-    source, sink = sources[0], sinks[0]
-    if source == sink:
-        return WorkflowStructure(False, source, sink, sources, sinks, [],
-                                 f"place {source!r} is both the source and the sink")
-    forward: dict[str, list[str]] = {node: [] for node in net}
-    backward: dict[str, list[str]] = {node: [] for node in net}
-    for arc in net.arcs:
-        forward[arc.source].append(arc.target)
-        backward[arc.target].append(arc.source)
-
-    def closure(start: str, edges: dict[str, list[str]]) -> set[str]:
-        seen, todo = {start}, [start]
-        while todo:
-            for nxt in edges[todo.pop()]:
-                if nxt not in seen:
-                    seen.add(nxt)
-                    todo.append(nxt)
-        return seen
-
-    on_path = closure(source, forward) & closure(sink, backward)
-    missing = [node for node in net if node not in on_path]
-    problem = None
-    if missing:
-        shown = ", ".join(missing[:10]) + (" ..." if len(missing) > 10 else "")
-        problem = f"{len(missing)} nodes are not on a path from {source!r} to {sink!r}: {shown}"
-    return WorkflowStructure(not missing, source, sink, sources, sinks, missing, problem)
 
 
 def is_free_choice(net: Net) -> bool:
@@ -332,7 +252,7 @@ def check_soundness(
         report.violations.append(Violation(
             "improper_completion",
             f"improper completion: {len(improper)} reachable markings cover the final marking"
-            f" {_format(final)} with tokens left elsewhere, e.g. {_format(reached)}",
+            f" {format_marking(final)} with tokens left elsewhere, e.g. {format_marking(reached)}",
             space.path(state), reached.to_dict()))
 
     final_state = space.index(final)
@@ -349,12 +269,12 @@ def check_soundness(
         reached = space.marking(state)
         dead_end = bool((deadlocked == state).any())
         if final_state is None:
-            why = f"the final marking {_format(final)} is not reachable from [{source}] at all"
+            why = f"the final marking {format_marking(final)} is not reachable from [{source}] at all"
             if dead_end:
-                why += f"; e.g. {_format(reached)} is a deadlock"
+                why += f"; e.g. {format_marking(reached)} is a deadlock"
         else:
             kind = "a deadlock" if dead_end else "no firing sequence leads back"
-            why = (f"from {_format(reached)} the final marking {_format(final)} can no longer"
+            why = (f"from {format_marking(reached)} the final marking {format_marking(final)} can no longer"
                    f" be reached ({kind}); {int(stuck.sum())} of {space.num_states} reachable"
                    " markings are like this")
         report.violations.append(Violation("no_option_to_complete", f"no option to complete: {why}",

@@ -293,7 +293,7 @@ def _umask() -> int:
 
 def read_yaml_file(path: str | Path, *, lines: bool = False) -> Any:
     """Parse a YAML data file (world, run configuration) with the net reader's safe,
-    bounded parser (:func:`petriflow.io.yaml.parse_yaml`): no tags run, no alias bombs,
+    bounded parser (:func:`petriflow.io.safe_yaml.parse_yaml`): no tags run, no alias bombs,
     no nesting deeper than it allows, every error with its line.
 
     Args:
@@ -307,20 +307,18 @@ def read_yaml_file(path: str | Path, *, lines: bool = False) -> Any:
     import yaml
 
     from petriflow.errors import NetFormatError
-    from petriflow.io.yaml import _plain, parse_yaml
+    from petriflow.io.safe_yaml import parse_yaml, plain, yaml_problem
 
     path = Path(path)
     text = read_text_file(path)
     try:
         data = parse_yaml(text)
-        return data if lines else _plain(data)
+        return data if lines else plain(data)
     except NetFormatError as exc:
         raise exc.at(str(path)) from None
     except yaml.YAMLError as exc:
-        from petriflow.io.yaml import _yaml_problem
-
         mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
-        problem = getattr(exc, "problem", None) or getattr(exc, "context", None) or _yaml_problem(exc)
+        problem = getattr(exc, "problem", None) or getattr(exc, "context", None) or yaml_problem(exc)
         raise NetFormatError(f"malformed YAML: {problem}", path=str(path),
                              line=mark.line + 1 if mark else None) from None
 

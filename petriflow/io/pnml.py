@@ -1,8 +1,9 @@
 """Standard PNML, read and written: lossless where the file is valid, loud where not.
 
 The reader (:mod:`petriflow.io.pnml_read`) takes ISO/IEC 15909-2 P/T nets and the
-dialects other tools write (PM4Py/ProM, WoPeD, JARP, PIPE, SNAKES). It parses with
-defusedxml and refuses DTDs and entities, raises :class:`~petriflow.errors.NetFormatError`
+dialects other tools write (PM4Py/ProM, WoPeD, JARP, PIPE, SNAKES: the table of
+:mod:`petriflow.io.pnml_dialects`). It parses with defusedxml
+(:mod:`petriflow.io.safe_xml`) and refuses DTDs and entities, raises :class:`~petriflow.errors.NetFormatError`
 with the line for anything malformed or not a P/T net, and emits one
 :class:`PnmlWarning` per kind of content a petriflow net cannot hold.
 
@@ -32,17 +33,15 @@ Examples:
 
 from __future__ import annotations
 
-from petriflow.io.pnml_read import (
+from petriflow.io.pnml_dialects import (
     PETRIFLOW_TOOL,
     PETRIFLOW_TOOL_VERSION,
     PNML_NAMESPACE,
     PT_NET_TYPES,
     PTNET_TYPE,
     WOPED_OPERATOR_TYPES,
-    PnmlWarning,
-    load_pnml,
-    loads_pnml,
 )
+from petriflow.io.pnml_read import PnmlWarning, load_pnml, loads_pnml
 from petriflow.io.pnml_write import dumps_pnml, save_pnml
 
 __all__ = [

@@ -42,13 +42,8 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from petriflow.errors import NetFormatError
 from petriflow.io.files import write_atomic
-from petriflow.io.pnml_read import (
-    PETRIFLOW_TOOL,
-    PETRIFLOW_TOOL_VERSION,
-    PNML_NAMESPACE,
-    PTNET_TYPE,
-    PnmlWarning,
-)
+from petriflow.io.pnml_dialects import PETRIFLOW_TOOL, PETRIFLOW_TOOL_VERSION, PNML_NAMESPACE, PTNET_TYPE
+from petriflow.io.pnml_read import PnmlWarning
 from petriflow.net import OPERATOR_KINDS, Net, Place, Transition
 
 __all__ = ["dumps_pnml", "save_pnml"]

@@ -4,8 +4,8 @@ The format is the constructor in data: every key maps onto an argument of
 :meth:`Net.add_place`, :meth:`Net.add_transition`, :meth:`Net.add_arc` or
 :func:`~petriflow.workflow.add_operator`. See ``docs/yaml-format.md``.
 
-Files are parsed with a safe loader (no Python tags; libyaml's C parser when PyYAML
-has it) into containers that record line numbers, so an error names the line:
+Files are parsed with a safe loader (:mod:`petriflow.io.safe_yaml`: no Python tags,
+bounded) into containers that record line numbers, so an error names the line:
 ``nets/relay.yaml:14: 't9': unknown place 'p9'``. The reader keeps those lines on the
 net (:attr:`Net.lines`) for the errors found later, when actions are bound.
 
@@ -25,7 +25,6 @@ Examples:
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -34,10 +33,17 @@ import yaml
 from petriflow import limits
 from petriflow.collector import paused
 from petriflow.errors import NetFormatError, NumberError, PetriflowError, did_you_mean
+from petriflow.io.files import read_text_file, write_atomic
+from petriflow.io.safe_yaml import LineDict, line_of, parse_yaml, plain, yaml_problem
 from petriflow.net import OPERATOR_KINDS, OUTCOMES, Net, Operator, Transition
 from petriflow.workflow import add_operator, operator_groups
 
-__all__ = ["FORMAT_VERSION", "load_yaml", "loads_net", "dumps_net", "save_yaml", "net_to_dict"]
+__all__ = ["FORMAT_VERSION", "load_yaml", "loads_net", "dumps_net", "save_yaml", "net_to_dict", "parse_yaml",
+           "yaml_problem"]
+
+#: The name runtime/session.py imports (allowlisted in tests/test_architecture.py): drop it
+#: once it imports :func:`yaml_problem`.
+_yaml_problem = yaml_problem
 
 #: The version of the YAML format this module reads and writes.
 FORMAT_VERSION = 1
@@ -52,152 +58,6 @@ _TRANSITION_KEYS = {
 _ARC_KEYS = {"from", "to", "weight", "id", "when"}
 
 
-class _LineDict(dict):
-    """A mapping that remembers its line and the line of each key."""
-
-    line: int = 0
-    key_lines: dict[Any, int] = {}
-
-
-class _LineList(list):
-    line: int = 0
-
-
-_Composer = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-_STR = "tag:yaml.org,2002:str"
-_INT = "tag:yaml.org,2002:int"
-_SEQ = "tag:yaml.org,2002:seq"
-_MAP = "tag:yaml.org,2002:map"
-_MERGE = "tag:yaml.org,2002:merge"
-
-
-class _Builder:
-    """Turns composed YAML nodes into plain data with line numbers.
-
-    Composing is libyaml's (fast); building is this small walk: strings are taken as
-    they are, other scalars through PyYAML's safe constructor; a node reached twice
-    through an alias is built once and shared, so aliases never multiply work. The
-    walk refuses what would exhaust the machine later: nesting deeper than
-    :data:`~petriflow.limits.YAML_DEPTH`, more than :data:`~petriflow.limits.YAML_VALUES`
-    values once aliases are expanded
-    (an "alias bomb"), an alias inside itself, and numbers too long to convert.
-
-    Integers follow petriflow's one rule (:func:`~petriflow.limits.parse_integer`):
-    decimal ASCII digits with an optional sign, at most 2**60. The other forms YAML 1.1
-    (PyYAML) reads as integers are refused with their line rather than guessed at:
-    ``0x1F``, ``0b101``, ``017`` (octal 15 in YAML 1.1, 17 in YAML 1.2), ``1_000``,
-    ``1:30`` (base 60: 90).
-    """
-
-    def __init__(self) -> None:
-        self.scalars = yaml.SafeLoader("")
-        self.built: dict[int, Any] = {}
-        self.sizes: dict[int, int] = {}
-        self.open: set[int] = set()
-        self.total = 0
-
-    def fail(self, message: str, node: yaml.Node) -> NetFormatError:
-        return NetFormatError(message, line=node.start_mark.line + 1)
-
-    def scalar(self, node: yaml.Node) -> Any:
-        if node.tag == _INT:
-            return self.integer(node)
-        try:
-            return self.scalars.construct_object(node)
-        except (ValueError, OverflowError) as exc:  # e.g. an integer of more than 4,300 digits
-            why = "a number of more than 4,300 digits" if "digits" in str(exc) else str(exc)
-            raise self.fail(f"value {node.value[:20]!r}{'...' if len(node.value) > 20 else ''} cannot be"
-                            f" read: {why}", node) from None
-
-    def integer(self, node: yaml.Node) -> int:
-        """A YAML integer, by the one rule (its text, not PyYAML's reading of it)."""
-        text = node.value
-        if re.fullmatch(r"[-+]?0[0-9]+", text) or (not re.fullmatch(r"[-+]?[0-9]+", text)
-                                                   and re.fullmatch(r"[-+]?[0-9a-fA-FxXob_:]+", text)):
-            shown = text if len(text) <= 20 else text[:20] + "..."
-            meant = ""
-            if len(text) <= 20:
-                try:
-                    meant = f" (YAML 1.1 reads it as {self.scalars.construct_object(node)})"
-                except (ValueError, OverflowError):  # pragma: no cover - short texts convert
-                    pass
-            raise self.fail(f"integer {shown!r}{meant} is not plain decimal: petriflow reads whole numbers"
-                            " written with the digits 0-9 and no leading zero (no 0x, 0b, octal, _ or"
-                            " base 60); write it in decimal, or quote it to make it text", node)
-        try:
-            return limits.parse_integer(text, "integer")
-        except NumberError as exc:
-            raise self.fail(f"{exc} (quote it if it is text, such as an id)", node) from None
-
-    def build(self, node: yaml.Node, depth: int = 0) -> Any:
-        kind = node.__class__
-        if kind is yaml.ScalarNode:
-            self.total += 1
-            return node.value if node.tag == _STR else self.scalar(node)
-        key = id(node)
-        if key in self.open:
-            raise self.fail("an alias refers to a value that contains it (a recursive alias)", node)
-        if key in self.built:  # an alias: shared, but counted as if it were copied
-            self.total += self.sizes[key]
-            if self.total > limits.YAML_VALUES:
-                raise self.fail(f"more than {limits.YAML_VALUES:,} values once aliases are expanded (an alias bomb?)",
-                                node)
-            return self.built[key]
-        if depth > limits.YAML_DEPTH:
-            raise self.fail(f"nested more than {limits.YAML_DEPTH} levels deep", node)
-        before = self.total
-        self.open.add(key)
-        try:
-            result = self.container(node, kind, depth)
-        finally:
-            self.open.discard(key)
-        self.sizes[key] = self.total - before
-        self.built[key] = result
-        return result
-
-    def container(self, node: yaml.Node, kind: type, depth: int) -> Any:
-        self.total += 1
-        if node.tag not in (_SEQ, _MAP):  # !!set, !!omap...: PyYAML's safe constructor, or its error
-            return self.scalars.construct_object(node, deep=True)
-        if kind is yaml.SequenceNode:
-            result = _LineList()
-            result.line = node.start_mark.line + 1
-            result.extend(self.build(child, depth + 1) for child in node.value)
-            return result
-        if kind is not yaml.MappingNode:  # pragma: no cover - the composer makes only these
-            raise self.fail(f"unexpected YAML node {node.tag}", node)
-        if any(key.tag == _MERGE for key, _ in node.value):
-            self.scalars.flatten_mapping(node)
-        mapping = _LineDict()
-        mapping.line = node.start_mark.line + 1
-        mapping.key_lines = {}
-        for key_node, value_node in node.value:
-            key = self.build(key_node, depth + 1)
-            try:
-                hash(key)
-            except TypeError:
-                raise self.fail("a mapping key must be a plain value", key_node) from None
-            if key in mapping:
-                raise self.fail(f"duplicate key {key!r}", key_node)
-            mapping.key_lines[key] = key_node.start_mark.line + 1
-            mapping[key] = self.build(value_node, depth + 1)
-        return mapping
-
-
-def parse_yaml(text: str) -> Any:
-    """Parse YAML text safely into data whose mappings and lists know their lines.
-
-    Raises:
-        yaml.YAMLError: malformed YAML.
-        NetFormatError: a duplicate key (with its line).
-    """
-    node = yaml.compose(text, Loader=_Composer)  # noqa: S506 - a safe composer: no tags are run
-    return None if node is None else _Builder().build(node)
-
-
-def _line(item: Any, default: int | None = None) -> int | None:
-    return getattr(item, "line", default)
-
 
 class _Reader:
     """Builds a :class:`Net` from parsed YAML, raising errors with line numbers."""
@@ -209,7 +69,7 @@ class _Reader:
         self.pending_arcs: list[tuple[str, str, Any, int | None, str | None, str | None]] = []
 
     def fail(self, message: str, item: Any = None, element: str | None = None, line=None):
-        raise NetFormatError(message, line=line or _line(item), element=element)
+        raise NetFormatError(message, line=line or line_of(item), element=element)
 
     def check_keys(self, item: Any, allowed: set[str], what: str, element: str | None = None):
         if not isinstance(item, dict):
@@ -245,14 +105,15 @@ class _Reader:
             self.read_subnet(subnet)
         places = self.as_list(data.get("places"), "places", data)
         for place in places:
-            self.read_place(place, None, _line(places))
+            self.read_place(place, None, line_of(places))
         transitions = self.as_list(data.get("transitions"), "transitions", data)
         for subnet in self.as_list(data.get("subnets"), "subnets", data):
             members = self.as_list(subnet.get("transitions"), "transitions", subnet)
             for transition in members:
-                self.read_transition(transition, self.ident(subnet.get("id"), "a subnet id", subnet), _line(members))
+                subnet_id = self.ident(subnet.get("id"), "a subnet id", subnet)
+                self.read_transition(transition, subnet_id, line_of(members))
         for transition in transitions:
-            self.read_transition(transition, None, _line(transitions))
+            self.read_transition(transition, None, line_of(transitions))
         for arc in self.as_list(data.get("arcs"), "arcs", data):
             self.read_arc(arc)
         self.add_pending_arcs()
@@ -289,11 +150,11 @@ class _Reader:
             self.fail(str(exc), item, sid)
         places = self.as_list(item.get("places"), "places", item)
         for place in places:
-            self.read_place(place, sid, _line(places))
+            self.read_place(place, sid, line_of(places))
 
     def read_place(self, item: Any, subnet: str | None, list_line: int | None = None) -> None:
         if not isinstance(item, dict):
-            item = _LineDict(id=self.ident(item, "a place id", None, line=list_line))
+            item = LineDict(id=self.ident(item, "a place id", None, line=list_line))
             item.line = list_line or 0
         self.check_keys(item, _PLACE_KEYS, "place", item.get("id"))
         if "id" not in item:
@@ -364,7 +225,7 @@ class _Reader:
 
     def read_transition(self, item: Any, subnet: str | None, list_line: int | None = None) -> None:
         if not isinstance(item, dict):
-            item = _LineDict(id=self.ident(item, "a transition id", None, line=list_line))
+            item = LineDict(id=self.ident(item, "a transition id", None, line=list_line))
             item.line = list_line or 0
         self.check_keys(item, _TRANSITION_KEYS, "transition", item.get("id"))
         if "id" not in item:
@@ -462,7 +323,7 @@ class _Reader:
         if isinstance(item, list) and len(item) in (2, 3):
             source, target = (self.ident(end, "an arc's end", item) for end in item[:2])
             weight = item[2] if len(item) == 3 else 1
-            self.pending_arcs.append((source, target, weight, _line(item), None, None))
+            self.pending_arcs.append((source, target, weight, line_of(item), None, None))
             return
         self.check_keys(item, _ARC_KEYS, "arc")
         for key in ("from", "to"):
@@ -473,7 +334,7 @@ class _Reader:
             self.fail(f"'when' must be ok or one of {', '.join(OUTCOMES)}, got {when!r}", item)
         self.pending_arcs.append(
             (self.ident(item["from"], "an arc's 'from'", item), self.ident(item["to"], "an arc's 'to'", item),
-             item.get("weight", 1), _line(item), item.get("id"), when)
+             item.get("weight", 1), line_of(item), item.get("id"), when)
         )
 
     def add_pending_arcs(self) -> None:
@@ -521,22 +382,12 @@ class _Reader:
                   item, line=line)
 
 
-def _plain(value: Any) -> Any:
-    """Strip the line-recording containers so parameters are plain dicts and lists
-    (:func:`parse_yaml` has bounded the size and depth already)."""
-    if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_plain(v) for v in value]
-    return value
-
-
 def _exact(value: Any, what: str, fail) -> Any:
     """Plain data that JSON (and so PNML, journals and traces) keeps exactly: text keys,
     finite numbers; ``fail`` is told the first thing that is not."""
     import math
 
-    value = _plain(value)
+    value = plain(value)
     stack: list[tuple[Any, str]] = [(value, "")]
     while stack:
         item, where = stack.pop()
@@ -582,7 +433,7 @@ def _meta(value: Any, fail) -> dict[str, Any]:
                 check(inner)
 
     check(value)
-    return _plain(value)
+    return plain(value)
 
 
 def loads_net(text: str, *, path: str | None = None, name: str | None = None) -> Net:
@@ -610,21 +461,11 @@ def loads_net(text: str, *, path: str | None = None, name: str | None = None) ->
         problem = exc.problem or exc.context or "malformed YAML"
         raise NetFormatError(f"malformed YAML: {problem}", path=path, line=line) from None
     except yaml.YAMLError as exc:
-        raise NetFormatError(f"malformed YAML: {_yaml_problem(exc)}", path=path) from None
-
-
-def _yaml_problem(exc: Exception) -> str:
-    """A YAML error's problem, on one line (a reader error names the bad character)."""
-    reason = getattr(exc, "reason", None)
-    if reason is not None:  # yaml.reader.ReaderError: a character YAML does not allow
-        return f"{reason} (character {getattr(exc, 'character', '?')!r} at position {getattr(exc, 'position', '?')})"
-    return " ".join(str(exc).split())
+        raise NetFormatError(f"malformed YAML: {yaml_problem(exc)}", path=path) from None
 
 
 def load_yaml(path: str | Path) -> Net:
     """Read a net from a YAML file (see :func:`loads_net`)."""
-    from petriflow.io.files import read_text_file
-
     path = Path(path)
     return loads_net(read_text_file(path), path=str(path))
 
@@ -802,6 +643,4 @@ def dumps_net(net: Net) -> str:
 
 def save_yaml(net: Net, path: str | Path) -> None:
     """Write ``net`` to ``path`` as YAML (atomically: a failed write leaves the old file)."""
-    from petriflow.io.files import write_atomic
-
     write_atomic(path, dumps_net(net))

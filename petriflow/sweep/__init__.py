@@ -41,7 +41,8 @@ from petriflow.errors import PetriflowError
 from petriflow.sweep.backends import BACKENDS, RETRIES, BackendError, RayBackend, default_workers, run_local
 from petriflow.sweep.report import metric_names, summary, trial_status
 from petriflow.sweep.ship import collect
-from petriflow.sweep.spec import Sweep, Trial, canonical, load_sweep
+from petriflow.sweep.load import load_sweep
+from petriflow.sweep.spec import Sweep, Trial, canonical
 from petriflow.sweep.store import Store, StoreError
 
 __all__ = ["Sweep", "SweepResult", "load_sweep", "run_sweep", "BACKENDS", "BackendError", "StoreError"]

@@ -1,7 +1,7 @@
 """What a trial reads, found once: for the resume fingerprint and for shipping to a cluster.
 
-:func:`collect` builds every row of a sweep (as :meth:`Sweep.check
-<petriflow.sweep.spec.Sweep.check>` does: nothing runs) and gathers the files its
+:func:`collect` builds every row of a sweep (as :func:`~petriflow.sweep.load.check_sweep`
+does: nothing runs) and gathers the files its
 trials read: the net (each row's, when the net's name holds ``${param}``), the run
 configuration, the world description and the files it names (URDFs and the meshes they
 name), the action modules (a ``.py`` file or a package folder), and a net builder's
@@ -56,6 +56,8 @@ _SKIP = shutil.ignore_patterns("__pycache__", "*.pyc", "*.pyo", ".git", "*.nbi",
 #: File names inside a world description or a URDF that are other files it reads.
 _FILE_VALUE = re.compile(r".+\.(urdf|sdf|xml|obj|stl|dae|mtl|png|jpe?g|bmp|tga|yaml|yml)\Z", re.I)
 _URDF_FILE = re.compile(r"""filename\s*=\s*["']([^"']+)["']""")
+#: The folder of the petriflow package this process runs (this file is petriflow/sweep/ship.py).
+_PETRIFLOW = Path(__file__).parent.parent
 
 
 def file_digest(path: Path) -> str:
@@ -143,11 +145,9 @@ def _package_files(folder: Path) -> list[Path]:
 def _installed(origin: Path) -> bool:
     """Whether a module file belongs to an installed distribution (or petriflow):
     what a node gets from its own environment, not from the sweep."""
-    import petriflow
-
     if any(part in ("site-packages", "dist-packages") for part in origin.parts):
         return True
-    if any(_inside(origin, Path(p).resolve()) for p in petriflow.__path__):
+    if _inside(origin, _PETRIFLOW.resolve()):
         return True
     for name, module in list(sys.modules.items()):
         if name.startswith("__editable__") and isinstance(getattr(module, "MAPPING", None), dict):
@@ -274,9 +274,7 @@ def collect(sweep: Sweep) -> Bundle:
 def stage_petriflow(folder: Path) -> Path:
     """Copy the petriflow package this process runs into ``folder/petriflow`` (with the
     subpackages an editable install maps from other folders); returns that folder."""
-    import petriflow
-
-    source = Path(petriflow.__path__[0])
+    source = _PETRIFLOW
     target = folder / "petriflow"
     shutil.copytree(source, target, ignore=_SKIP)
     for name, module in list(sys.modules.items()):

@@ -57,7 +57,7 @@ from typing import Any
 from petriflow.errors import NetFormatError
 from petriflow.runtime.metrics import MetricRef, parse_refs
 
-__all__ = ["Sweep", "Row", "Trial", "MetricRef", "load_sweep", "substitute", "FORMAT_VERSION", "SET_ROOTS"]
+__all__ = ["Sweep", "Row", "Trial", "MetricRef", "substitute", "FORMAT_VERSION", "SET_ROOTS"]
 
 #: The sweep format version this reader understands (``petriflow-sweep: 1``).
 FORMAT_VERSION = 1
@@ -281,26 +281,6 @@ class Sweep:
         return cls(path, name, net_value, run, seeds, float(timeout), rows, dict(targets), metrics,
                    paper_source, description, lines, shown)
 
-    def check(self, rows: int = 200) -> None:
-        """Build the first ``rows`` rows' trials without running them (net read and
-        bound with the row's targets set, run configuration, world description, metrics),
-        so a mistake fails before any trial starts.
-
-        Raises:
-            NetFormatError: naming the net, configuration or world file and line, or this
-                file and the ``set:``/``metrics:`` line.
-        """
-        from petriflow.sweep.trial import TrialError, build
-
-        for row in self.rows[:rows]:
-            try:
-                build(self.to_data(), row.params, self.seeds[0])
-            except (TrialError, NetFormatError) as exc:
-                key = "metrics" if str(exc).startswith("metrics:") else "set" if self.set else "net"
-                where = f"row {row.index + 1} ({canonical(row.params)}): " if row.params else ""
-                raise NetFormatError(f"{where}{exc}", path=self.shown or self.path,
-                                     line=self.lines.get(key) or self.lines.get("net")) from None
-
     # Using ----------------------------------------------------------------------------
     def with_seeds(self, trials: int) -> "Sweep":
         """The same sweep run with seeds 1..``trials``."""
@@ -320,16 +300,6 @@ class Sweep:
     def payload(self, trial: Trial) -> dict[str, Any]:
         """What a worker runs: :func:`petriflow.sweep.trial.run_trial` of this."""
         return {"sweep": self.to_data(), "row": trial.row, "params": trial.params, "seed": trial.seed}
-
-    @property
-    def digest(self) -> str:
-        """The sweep's fingerprint: what decides a trial's result (net, run, set,
-        metrics; not the seeds, the timeout or the paper's values) and the *content* of
-        every file its trials read (:func:`petriflow.sweep.ship.collect`): a results
-        database answers for one."""
-        from petriflow.sweep.ship import collect
-
-        return collect(self).digest()
 
     @property
     def parameters(self) -> list[str]:
@@ -454,19 +424,3 @@ def _paper(data: dict, rows: list[Row], metric_names: set[str], fail) -> str | N
             if not _plain_value(value) or isinstance(value, (list, dict)):
                 fail(f"paper: {name}: a value is a number or text", key="paper" if paper is not None else "rows")
     return source
-
-
-def load_sweep(path: str | Path) -> Sweep:
-    """Read and check a sweep file.
-
-    Raises:
-        NetFormatError: the file is unreadable or malformed, naming it and the line; or
-            a row's trial cannot be built (:meth:`Sweep.check`).
-    """
-    from petriflow.io.files import read_yaml_file
-
-    if not Path(path).is_file():
-        raise NetFormatError("no such file", path=str(path))
-    sweep = Sweep.from_dict(read_yaml_file(path, lines=True), path)
-    sweep.check()
-    return sweep

@@ -246,6 +246,12 @@ def _take(out: dict[str, Any], queue: list[int], sender: int, time: float) -> in
     return None
 
 
+#: The page's scripts, inlined in this order: the shared helpers, the trace decoded, the pure
+#: replay (these three run in Node too: tests/view/replay_node.js), one per panel, then the
+#: summary and controls that tie them together.
+SCRIPTS = ["common.js", "trace.js", "replay.js", "panel-net.js", "panel-world.js", "panel-messages.js",
+           "panel-gantt.js", "panel-events.js", "run.js"]
+
 #: What the page needs of each kind of event, never left out to keep it small.
 _KEEP = {"run": {"marking", "agents", "net", "seed", "dt"}, "start": {"firing", "consumed"},
          "end": {"firing", "outcome", "produced", "reason"}, "cancel": {"withdrawn", "actions"},
@@ -406,10 +412,10 @@ def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float 
     title = f"{name}: run (seed {first.get('seed')})"
     data["page_bytes"] = 0
     page = render(title=title, body=_BODY.replace("{title}", html.escape(title)), data=data,
-                  scripts=["common.js", "run.js"], styles=["common.css", "run.css"])
+                  scripts=SCRIPTS, styles=["common.css", "run.css"])
     data["page_bytes"] = len(page.encode("utf-8"))
     return render(title=title, body=_BODY.replace("{title}", html.escape(title)), data=data,
-                  scripts=["common.js", "run.js"], styles=["common.css", "run.css"])
+                  scripts=SCRIPTS, styles=["common.css", "run.css"])
 
 
 _BODY = """

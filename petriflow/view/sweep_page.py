@@ -55,6 +55,7 @@ def read_results(db: str | Path) -> tuple[dict[str, str], list[dict[str, Any]]]:
 def _load_spec(db: Path, meta: dict[str, str], sweep: str | Path | None) -> tuple[Any, str | None]:
     """The sweep file's spec (or ``None``) and a note on why it is not used."""
     from petriflow.sweep import load_sweep
+    from petriflow.sweep.ship import collect
 
     if sweep is not None:
         spec = load_sweep(sweep)
@@ -65,7 +66,7 @@ def _load_spec(db: Path, meta: dict[str, str], sweep: str | Path | None) -> tupl
         if found is None:
             return None, f"its sweep file {named!r} was not found (--sweep FILE names it): no paper values"
         spec = load_sweep(found)
-    if spec.digest != meta.get("digest"):
+    if collect(spec).digest() != meta.get("digest"):
         return spec, (f"{spec.path} has changed since these results were recorded: its rows and paper values"
                       " are shown as the file says now")
     return spec, None

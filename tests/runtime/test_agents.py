@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import pytest
 
-from petriflow import Param, Scheduler
+from petriflow import Param
 from petriflow.errors import NetFormatError, PetriflowError
 from petriflow.io.yaml import loads_net
 from petriflow.runtime.action import InstantAction
 from petriflow.runtime.agents import AgentState
 from petriflow.runtime.registry import Registry
+from petriflow.runtime.scheduler import Scheduler
 
 
 class Inbox(AgentState):

@@ -38,7 +38,8 @@ def _module(folder: Path, source: str, name: str = "shop.py") -> Path:
 
 
 CLASSES = """
-from petriflow import Action, InstantAction, Param, Port, action
+from petriflow import Action, Param, Port, action
+from petriflow.runtime.action import InstantAction
 from petriflow.runtime.registry import default_registry as registry
 
 FORCE = 5.0

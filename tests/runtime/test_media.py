@@ -7,13 +7,13 @@ import math
 
 import pytest
 
-from petriflow import Scheduler
 from petriflow.io.yaml import loads_net
 from petriflow.runtime.action import InstantAction, Param
 from petriflow.runtime.config import RunConfig
 from petriflow.runtime.kernel import Kernel
 from petriflow.runtime.media import Medium, ProcessClock
 from petriflow.runtime.registry import Registry
+from petriflow.runtime.scheduler import Scheduler
 
 
 class BufferedWire(Medium):

@@ -6,7 +6,9 @@ import pytest
 
 from petriflow.errors import NetFormatError
 from petriflow.io.files import read_yaml_file
-from petriflow.sweep.spec import Sweep, load_sweep
+from petriflow.sweep.load import load_sweep
+from petriflow.sweep.ship import collect
+from petriflow.sweep.spec import Sweep
 
 from .conftest import write
 
@@ -60,7 +62,7 @@ def test_the_digest_ignores_seeds_timeout_and_paper_but_not_what_decides_results
     one = load_sweep(write(tmp_path, "a.yaml", sweep_text(folder, base + "trials: 2\ntimeout: 5\n")))
     two = load_sweep(write(tmp_path, "b.yaml", sweep_text(folder, base + "trials: 9\n")))
     three = load_sweep(write(tmp_path, "c.yaml", sweep_text(folder, base + "metrics: [core.firings]\n")))
-    assert one.digest == two.digest != three.digest
+    assert collect(one).digest() == collect(two).digest() != collect(three).digest()
 
 
 @pytest.mark.parametrize("body, fragment, line", [

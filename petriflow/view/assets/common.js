@@ -1,16 +1,7 @@
-/* petriflow view: helpers every page shares (no network, no globals but PF). */
+/* petriflow view: helpers every page shares (no network, no globals but PF; no data in Node). */
 "use strict";
-window.PF = (function () {
-  const data = JSON.parse(document.getElementById("pf-data").textContent);
-
-  /** The text packed by petriflow.view.page.pack (gzip + base64), inflated by the browser. */
-  async function inflate(b64) {
-    const binary = atob(b64);
-    const bytes = new Uint8Array(binary.length);
-    for (let i = 0; i < binary.length; i++) bytes[i] = binary.charCodeAt(i);
-    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip"));
-    return await new Response(stream).text();
-  }
+globalThis.PF = (function () {
+  const data = typeof document === "undefined" ? null : JSON.parse(document.getElementById("pf-data").textContent);
 
   /** The bytes packed by petriflow.view.page.pack_bytes (gzip + base64), inflated by the browser. */
   async function inflateBytes(b64) {
@@ -20,6 +11,9 @@ window.PF = (function () {
     const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip"));
     return new Uint8Array(await new Response(stream).arrayBuffer());
   }
+
+  /** The text packed by petriflow.view.page.pack, inflated. */
+  async function inflate(b64) { return new TextDecoder().decode(await inflateBytes(b64)); }
 
   const PALETTE = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#17becf",
                    "#bcbd22", "#7f7f7f", "#393b79", "#ad494a", "#637939", "#8c6d31", "#843c39", "#7b4173"];
@@ -50,7 +44,7 @@ window.PF = (function () {
   /** A canvas sized to its CSS box in device pixels; returns its 2D context. */
   const sizes = new WeakMap();   // canvas -> its CSS size, read once (reading forces a layout)
   const resized = { n: 0 };
-  window.addEventListener("resize", () => { resized.n++; });
+  if (typeof window !== "undefined") window.addEventListener("resize", () => { resized.n++; });
   function fit(canvas) {
     const ratio = window.devicePixelRatio || 1;
     let size = sizes.get(canvas);

@@ -10,7 +10,7 @@ import yaml
 from petriflow import examples
 from petriflow.agents.bidding.nets import build
 from petriflow.io.yaml import dumps_net
-from petriflow.sweep.spec import load_sweep
+from petriflow.sweep import load_sweep
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
