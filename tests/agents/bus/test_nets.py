@@ -119,7 +119,7 @@ def test_a_middle_modules_message_is_one_frame_read_by_both_neighbours_at_their_
     scheduler.on_event(events.append)
     assert scheduler.run(until=60).reason == "final"
     medium = scheduler.channels.models["bus"].state
-    carrier = scheduler.channels.models["bus"]._carrier
+    carrier = scheduler.channels.models["bus"].carrier
     by_number = {number: agent for agent, number in carrier.numbers.items()}
     frames = [(by_number[t.frame.sender], sorted(by_number[r] for r in t.frame.receivers))
               for t in medium.transmissions]

@@ -8,7 +8,7 @@ import pytest
 
 from petriflow import run
 from petriflow.agents.bus import metrics
-from petriflow.agents.bus.medium import BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
+from petriflow.agents.bus import BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
 from petriflow.agents.bus.nets import build
 from petriflow.io.yaml import loads_net
 
@@ -88,7 +88,7 @@ def test_a_relay_whose_table_is_full_drops_the_broadcast_for_its_module():
     for k in range(8):
         sim.send(0.05 * k, frame(2, (1,), tag=k))   # fills every table with module 2's broadcasts
     medium = sim.run(until=1.5)
-    medium._btt[0].clear()                          # module 0's radio restarts: an empty table
+    medium.table(0).clear()                        # module 0's radio restarts: an empty table
     sim.send(1.6, frame(0, (1, 2), tag="new"))
     medium = sim.run()
     lost = [(loss.module, loss.reason) for loss in medium.losses if loss.frame.tag == "new"]
