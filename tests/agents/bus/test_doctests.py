@@ -9,7 +9,7 @@ import importlib
 import pytest
 
 MODULES = ["errors", "frames", "packet", "radio", "records", "buffer", "parameters", "rs485", "can", "zigbee",
-           "network", "simulator", "channel", "cpg", "algorithms", "addressing", "plugin"]
+           "network", "simulator", "channel", "nets", "cpg", "algorithms", "addressing", "plugin"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -10,7 +10,6 @@ from petriflow import run
 from petriflow.agents.bus import metrics
 from petriflow.agents.bus import BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
 from petriflow.agents.bus.nets import build
-from petriflow.io.yaml import loads_net
 
 
 def frame(sender, receivers=(1,), data=bytes(8), tag=None):
@@ -128,7 +127,7 @@ def test_an_end_device_sends_through_its_parent():
 # Whole runs: power-up in step, reception models, the sniffer's count ------------------------
 
 def _run(bus, algorithm, seed=1, **boot):
-    net = loads_net(build(3, algorithm, messages=20))
+    net = build(3, algorithm, messages=20)
     for k in (1, 2, 3):
         net.transitions[f"m{k}_boot"].params.update(boot)
     config = {"channels": {"bus": {"model": f"bus.{bus}", "on_loss": "notify"}}, "dt": 0.002, "until": 300}
