@@ -47,22 +47,18 @@ A medium's access rule is a subclass: it implements :meth:`BusMedium.is_free`,
 ``_started``, ``_ended``, ``_garble``, ``_lost`` and ``_notify_idle``.
 
 Examples:
-    A module that reads every 10 ms finds two frames at its first read after they came:
+    A module that reads its buffer every 10 ms finds two frames at its first read after
+    they came (CAN serialises them; a buffer of two holds both):
 
-    >>> from petriflow.agents.bus.can import CanMedium
     >>> from petriflow.agents.bus.parameters import CanBus
-    >>> from petriflow.agents.bus.records import Frame
-    >>> from petriflow.runtime.kernel import Kernel
-    >>> from petriflow.runtime.media import ProcessClock
-    >>> import random
-    >>> clock = ProcessClock(Kernel(dt=0.0001))
-    >>> medium = CanMedium(CanBus(rx_buffer=2), clock, random.Random(0), [0, 1, 2], read_period=0.01)
+    >>> from petriflow.agents.bus.simulator import BusSimulator
+    >>> sim = BusSimulator(CanBus(rx_buffer=2), modules=[0, 1, 2])
+    >>> sim.reads_every(0, 0.01)
     >>> for sender in (1, 2):
-    ...     _ = medium.request(Frame(sender, (0,), b"hi", identifier=0x100 + sender))
-    >>> clock.run(until=0.005); medium.waiting(0)
-    2
-    >>> clock.run(until=0.02); [(d.frame.sender, d.read) for d in medium.deliveries]
-    [(1, 0.01), (2, 0.01)]
+    ...     sim.send(0.0, Frame(sender, (0,), b"hi", identifier=0x100 + sender))
+    >>> medium = sim.run(until=0.005)
+    >>> medium.waiting(0), [(d.frame.sender, d.read) for d in sim.run(until=0.02).deliveries]
+    (2, [(1, 0.01), (2, 0.01)])
 """
 
 from __future__ import annotations
@@ -321,11 +317,15 @@ class BusMedium:
         self._reads.pop(module, None)
         self.read(module)
 
-    def _started(self, transmission: Transmission) -> None:
+    def _tell(self, log: list[Any], listeners: list[Callable[[Any], Any]], what: Any) -> None:
+        """Keep ``what`` in ``log`` (with ``logs``) and call every listener with it."""
         if self.logs:
-            self.transmissions.append(transmission)
-        for callback in self._on_start:
-            callback(transmission)
+            log.append(what)
+        for callback in listeners:
+            callback(what)
+
+    def _started(self, transmission: Transmission) -> None:
+        self._tell(self.transmissions, self._on_start, transmission)
 
     def _ended(self, transmission: Transmission) -> None:
         self.last_end = transmission.end if self.last_end is None else max(self.last_end, transmission.end)
@@ -339,16 +339,10 @@ class BusMedium:
             self._lost(Lost(transmission.frame, None, Loss.COLLISION, self.clock.now))
 
     def _delivered(self, delivery: Delivery) -> None:
-        if self.logs:
-            self.deliveries.append(delivery)
-        for callback in self._on_delivery:
-            callback(delivery)
+        self._tell(self.deliveries, self._on_delivery, delivery)
 
     def _lost(self, lost: Lost) -> None:
-        if self.logs:
-            self.losses.append(lost)
-        for callback in self._on_loss:
-            callback(lost)
+        self._tell(self.losses, self._on_loss, lost)
 
     def _notify_idle(self, modules: Iterable[int]) -> None:
         for module in modules:

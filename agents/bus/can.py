@@ -10,21 +10,19 @@ Error frames, bit errors and bus-off are not modelled. The parameters are
 :class:`~petriflow.agents.bus.parameters.CanBus`.
 
 Examples:
+    Two frames asked for at once: the lower identifier goes first, and the module that
+    reads its one-frame buffer after both arrived finds the second only:
+
     >>> from petriflow.agents.bus.parameters import CanBus
-    >>> from petriflow.agents.bus.records import Frame
-    >>> from petriflow.runtime.kernel import Kernel
-    >>> from petriflow.runtime.media import ProcessClock
-    >>> import random
-    >>> clock = ProcessClock(Kernel(dt=0.001))
-    >>> medium = CanBus().medium(clock, random.Random(0), modules=[0, 1, 2], read_period=None)
-    >>> _ = medium.request(Frame(sender=2, receivers=(0,), data=b"late", identifier=0x102))
-    >>> _ = medium.request(Frame(sender=1, receivers=(0,), data=b"wins", identifier=0x101))
-    >>> clock.run(until=0.01)
-    >>> [t.frame.sender for t in medium.transmissions]   # both started together: 0x101 first
-    [1, 2]
-    >>> [f.data for f in medium.read(0)]                 # one-frame buffer: the first was overwritten
-    [b'late']
-    >>> [(loss.reason.value, round(loss.time * 1e6)) for loss in medium.losses]  # when the second arrived
+    >>> from petriflow.agents.bus.simulator import BusSimulator
+    >>> sim = BusSimulator(CanBus(), modules=[0, 1, 2])
+    >>> sim.send(0.0, Frame(sender=2, receivers=(0,), data=b"late", identifier=0x102))
+    >>> sim.send(0.0, Frame(sender=1, receivers=(0,), data=b"wins", identifier=0x101))
+    >>> sim.read(0.01, 0)
+    >>> bus = sim.run()
+    >>> [t.frame.sender for t in bus.transmissions], [f.data for f in sim.received[0]]
+    ([1, 2], [b'late'])
+    >>> [(loss.reason.value, round(loss.time * 1e6)) for loss in bus.losses]  # when the second arrived
     [('overwritten', 309)]
 """
 

@@ -23,17 +23,13 @@ Examples:
     each hears every other relay, so nobody retransmits.
 
     >>> from petriflow.agents.bus.parameters import ZigbeeBus
-    >>> from petriflow.agents.bus.records import Frame
-    >>> from petriflow.runtime.kernel import Kernel
-    >>> from petriflow.runtime.media import ProcessClock
-    >>> import random
-    >>> clock = ProcessClock(Kernel(dt=1e-6))
-    >>> net = ZigbeeNetworkMedium(ZigbeeBus(), clock, random.Random(2), [0, 1, 2], read_period=0.0)
-    >>> _ = net.request(Frame(0, (1,), bytes(8)))
-    >>> clock.run(until=2.0)
-    >>> len(net.transmissions), net.losses, [net.role(n) for n in range(3)]
+    >>> from petriflow.agents.bus.simulator import BusSimulator
+    >>> sim = BusSimulator(ZigbeeBus(), modules=[0, 1, 2], seed=2)
+    >>> sim.send(0.0, Frame(0, (1,), bytes(8)))
+    >>> network = sim.run()
+    >>> len(network.transmissions), network.losses, [network.role(n) for n in range(3)]
     (3, [], ['coordinator', 'router', 'router'])
-    >>> net.btt_size(1), net.table(1).entries
+    >>> network.btt_size(1), network.table(1).entries
     (1, 8)
 """
 

@@ -41,7 +41,7 @@ import math
 import random
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from petriflow.agents.bus.buffer import OWN_READ_PERIOD, BusMedium
 from petriflow.agents.bus.can import CanMedium
@@ -66,6 +66,11 @@ from petriflow.runtime.media import Medium, MediumPort, ProcessClock
 __all__ = ["BusModel", "CanBus", "SerialBus", "ZigbeeBus"]
 
 
+def _ranged(default: float, low: float, high: float) -> Any:
+    """A parameter's default and the range a run configuration may set it in."""
+    return field(default=default, metadata={"range": (low, high)})
+
+
 @dataclass
 class BusModel(Medium):
     """Parameters shared by the buses; a subclass adds its physical layer. As a petriflow
@@ -84,10 +89,10 @@ class BusModel(Medium):
             frame's identifier, so a payload need not carry it (CAN).
     """
 
-    tx_queue: int = field(default=3, metadata={"range": (0, 10_000)})
-    rx_buffer: int = field(default=1, metadata={"range": (1, 10_000)})
+    tx_queue: int = _ranged(3, 0, 10_000)
+    rx_buffer: int = _ranged(1, 1, 10_000)
     acceptance_filter: bool = False
-    read_period: float = field(default=0.0, metadata={"range": (0.0, 3600.0)})
+    read_period: float = _ranged(0.0, 0.0, 3600.0)
     logs: bool = False
 
     sender_in_identifier: ClassVar[bool] = False
@@ -148,9 +153,9 @@ class SerialBus(BusModel):
         100
     """
 
-    baud: float = field(default=115_200.0, metadata={"range": (1.0, 1e9)})
-    checksum_bytes: int = field(default=1, metadata={"range": (0, 16)})
-    sense_bits: float = field(default=1.0, metadata={"range": (0.0, 1e6)})
+    baud: float = _ranged(115_200.0, 1.0, 1e9)
+    checksum_bytes: int = _ranged(1, 0, 16)
+    sense_bits: float = _ranged(1.0, 0.0, 1e6)
 
     def frame_bits(self, frame: Frame) -> int:
         return uart_frame_bits(len(frame.data) + self.checksum_bytes)
@@ -171,9 +176,9 @@ class CanBus(BusModel):
         True
     """
 
-    tx_queue: int = field(default=2, metadata={"range": (0, 10_000)})
-    bitrate: float = field(default=512_000.0, metadata={"range": (1.0, 1e9)})
-    arbitration_bits: float = field(default=1.0, metadata={"range": (0.0, 1e6)})
+    tx_queue: int = _ranged(2, 0, 10_000)
+    bitrate: float = _ranged(512_000.0, 1.0, 1e9)
+    arbitration_bits: float = _ranged(1.0, 0.0, 1e6)
 
     sender_in_identifier: ClassVar[bool] = True
 
@@ -203,29 +208,29 @@ class ZigbeeBus(BusModel):
         2.083
     """
 
-    uart_baud: float = field(default=57_600.0, metadata={"range": (1.0, 1e9)})
-    air_bitrate: float = field(default=250_000.0, metadata={"range": (1.0, 1e9)})
-    network_bytes: int = field(default=16, metadata={"range": (0, 100)})
-    packetization_chars: float = field(default=3.0, metadata={"range": (0.0, 1000.0)})
-    min_be: int = field(default=3, metadata={"range": (0, 8)})
-    max_be: int = field(default=5, metadata={"range": (3, 8)})
-    max_backoffs: int = field(default=4, metadata={"range": (0, 5)})
-    spacing: float = field(default=0.08, metadata={"range": (0.0, 1e4)})
-    tx_power_dbm: float = field(default=0.0, metadata={"range": (-100.0, 40.0)})
-    reference_loss_db: float = field(default=40.0, metadata={"range": (0.0, 200.0)})
-    exponent: float = field(default=2.0, metadata={"range": (1.0, 8.0)})
-    noise_floor_dbm: float = field(default=-93.0, metadata={"range": (-200.0, 0.0)})
-    interference_dbm: float = field(default=-200.0, metadata={"range": (-200.0, 40.0)})
-    shadowing_db: float = field(default=0.0, metadata={"range": (0.0, 40.0)})
+    uart_baud: float = _ranged(57_600.0, 1.0, 1e9)
+    air_bitrate: float = _ranged(250_000.0, 1.0, 1e9)
+    network_bytes: int = _ranged(16, 0, 100)
+    packetization_chars: float = _ranged(3.0, 0.0, 1000.0)
+    min_be: int = _ranged(3, 0, 8)
+    max_be: int = _ranged(5, 3, 8)
+    max_backoffs: int = _ranged(4, 0, 5)
+    spacing: float = _ranged(0.08, 0.0, 1e4)
+    tx_power_dbm: float = _ranged(0.0, -100.0, 40.0)
+    reference_loss_db: float = _ranged(40.0, 0.0, 200.0)
+    exponent: float = _ranged(2.0, 1.0, 8.0)
+    noise_floor_dbm: float = _ranged(-93.0, -200.0, 0.0)
+    interference_dbm: float = _ranged(-200.0, -200.0, 40.0)
+    shadowing_db: float = _ranged(0.0, 0.0, 40.0)
     network: bool = True
     roles: str = "routers"
-    btt_entries: int = field(default=8, metadata={"range": (1, 1000)})
-    btt_lifetime: float = field(default=8.0, metadata={"range": (0.0, 3600.0)})
-    broadcast_retries: int = field(default=2, metadata={"range": (0, 10)})
-    passive_ack_timeout: float = field(default=0.5, metadata={"range": (0.0, 60.0)})
-    max_jitter: float = field(default=0.063, metadata={"range": (0.0, 10.0)})
-    poll_period: float = field(default=0.1, metadata={"range": (1e-4, 60.0)})
-    mac_retries: int = field(default=3, metadata={"range": (0, 10)})
+    btt_entries: int = _ranged(8, 1, 1000)
+    btt_lifetime: float = _ranged(8.0, 0.0, 3600.0)
+    broadcast_retries: int = _ranged(2, 0, 10)
+    passive_ack_timeout: float = _ranged(0.5, 0.0, 60.0)
+    max_jitter: float = _ranged(0.063, 0.0, 10.0)
+    poll_period: float = _ranged(0.1, 1e-4, 60.0)
+    mac_retries: int = _ranged(3, 0, 10)
 
     def __post_init__(self) -> None:
         if self.min_be > self.max_be:

@@ -79,7 +79,14 @@ class Transmission:
 
 @dataclass(frozen=True)
 class Delivery:
-    """A module read a frame addressed to it: it reached the buffer at ``arrived``."""
+    """A module read a frame addressed to it.
+
+    Attributes:
+        frame: the frame.
+        module: the module that read it.
+        arrived: when it reached the module's receive buffer.
+        read: when the module read it (``arrived`` for a module that reads on arrival).
+    """
 
     frame: Frame
     module: int
@@ -89,7 +96,7 @@ class Delivery:
 
 @dataclass(frozen=True)
 class Lost:
-    """A frame lost for ``module`` (``None``: for every module) at ``time``."""
+    """A frame lost for ``module`` (``None``: for every module) at ``time``, for ``reason``."""
 
     frame: Frame
     module: int | None

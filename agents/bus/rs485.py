@@ -10,16 +10,14 @@ and collide. The parameters are :class:`~petriflow.agents.bus.parameters.SerialB
 
 Examples:
     >>> from petriflow.agents.bus.parameters import SerialBus
-    >>> from petriflow.agents.bus.records import Frame
-    >>> from petriflow.runtime.kernel import Kernel
-    >>> from petriflow.runtime.media import ProcessClock
-    >>> import random
-    >>> clock = ProcessClock(Kernel(dt=1e-6))
-    >>> line = SerialMedium(SerialBus(), clock, random.Random(0), [0, 1], read_period=0.0)
-    >>> _ = line.request(Frame(0, (1,), bytes(9)))   # (9 + 1) bytes of 10 bits: 868 µs
-    >>> clock.run(until=0.0005); line.busy(), line.is_free(1)
-    (True, False)
-    >>> clock.run(until=0.001); [round(d.arrived * 1e6) for d in line.deliveries]
+    >>> from petriflow.agents.bus.simulator import BusSimulator
+    >>> sim = BusSimulator(SerialBus(), modules=[0, 1])
+    >>> sim.reads_every(1, 0.0)
+    >>> sim.send(0.0, Frame(0, (1,), bytes(9)))   # (9 + 1) bytes of 10 bits: 868 µs
+    >>> line = sim.run(until=0.0005)
+    >>> type(line).__name__, line.busy(), line.is_free(1)
+    ('SerialMedium', True, False)
+    >>> [round(delivery.arrived * 1e6) for delivery in sim.run().deliveries]
     [868]
 """
 
@@ -40,7 +38,8 @@ __all__ = ["SerialMedium"]
 
 
 class SerialMedium(BusMedium):
-    """An RS-485 line: frames go out when asked; overlapping frames garble each other."""
+    """An RS-485 line: a module's UART sends a frame as soon as its previous one is out;
+    frames that overlap garble each other, lost at every receiver from that moment."""
 
     bus: SerialBus
 

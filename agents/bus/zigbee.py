@@ -29,15 +29,10 @@ Examples:
     bits on the air (1344 µs):
 
     >>> from petriflow.agents.bus.parameters import ZigbeeBus
-    >>> from petriflow.agents.bus.records import Frame
-    >>> from petriflow.runtime.kernel import Kernel
-    >>> from petriflow.runtime.media import ProcessClock
-    >>> import random
-    >>> clock = ProcessClock(Kernel(dt=1e-6))
-    >>> air = ZigbeeMedium(ZigbeeBus(network=False), clock, random.Random(3), [0, 1], read_period=0.0)
-    >>> _ = air.request(Frame(0, (1,), bytes(9)))
-    >>> clock.run(until=0.01)
-    >>> [(round(t.start * 1e6), round(t.end * 1e6)) for t in air.transmissions]
+    >>> from petriflow.agents.bus.simulator import BusSimulator
+    >>> sim = BusSimulator(ZigbeeBus(network=False), modules=[0, 1], seed=3)
+    >>> sim.send(0.0, Frame(0, (1,), bytes(9)))
+    >>> [(round(t.start * 1e6), round(t.end * 1e6)) for t in sim.run().transmissions]
     [(3363, 4707)]
 """
 
