@@ -27,7 +27,7 @@ Examples:
     >>> sim = BusSimulator(ZigbeeBus(), modules=[0, 1, 2], seed=2)
     >>> sim.send(0.0, Frame(0, (1,), bytes(8)))
     >>> network = sim.run()
-    >>> len(network.transmissions), network.losses, [network.role(n) for n in range(3)]
+    >>> len(network.transmissions), network.losses, [f"{network.role(n)}" for n in range(3)]
     (3, [], ['coordinator', 'router', 'router'])
     >>> network.btt_size(1), network.table(1).entries
     (1, 8)
@@ -35,7 +35,6 @@ Examples:
 
 from __future__ import annotations
 
-import enum
 import math
 import random
 from collections import deque
@@ -45,12 +44,24 @@ from typing import TYPE_CHECKING, Any
 from petriflow.agents.bus.buffer import MEDIUM, BusMedium
 from petriflow.agents.bus.records import Frame, Loss, Lost, Transmission
 from petriflow.agents.bus.zigbee import CsmaCa
+from petriflow.outcome import Name
 from petriflow.runtime.media import ProcessClock, Timer
 
 if TYPE_CHECKING:
     from petriflow.agents.bus.parameters import ZigbeeBus
 
-__all__ = ["BroadcastTable", "ZigbeeNetworkMedium"]
+__all__ = ["BroadcastTable", "Role", "ZigbeeNetworkMedium"]
+
+
+class Role(Name):
+    """A node's role in the ZigBee network."""
+
+    COORDINATOR = "coordinator"
+    """The first module: it starts the network (and is the end devices' parent)."""
+    ROUTER = "router"
+    """It relays broadcasts (every module with ``roles: routers``, and a sniffer)."""
+    END_DEVICE = "end_device"
+    """It sends to its parent and gets broadcasts by polling it (``roles: end_devices``)."""
 
 
 class BroadcastTable:
@@ -92,7 +103,7 @@ class BroadcastTable:
             self._expiries.popleft()
 
 
-class _Hop(enum.Enum):
+class _Hop(Name):
     """What a node's radio sends a broadcast for."""
 
     UP = "up"
@@ -156,17 +167,17 @@ class ZigbeeNetworkMedium(BusMedium):
         """The coordinator: the first attached module that is not a sniffer."""
         return next((m for m in self.modules if m not in self.sniffers), None)
 
-    def role(self, node: int) -> str:
-        """``"coordinator"``, ``"router"`` or ``"end_device"``."""
+    def role(self, node: int) -> Role:
+        """``node``'s role in the network."""
         if node == self.coordinator():
-            return "coordinator"
+            return Role.COORDINATOR
         if node in self.sniffers or self.bus.roles == "routers":
-            return "router"
-        return "end_device"
+            return Role.ROUTER
+        return Role.END_DEVICE
 
     def parent(self, node: int) -> int | None:
         """An end device's parent (the coordinator); ``None`` for the others."""
-        return self.coordinator() if self.role(node) == "end_device" else None
+        return self.coordinator() if self.role(node) is Role.END_DEVICE else None
 
     def table(self, node: int) -> BroadcastTable:
         """``node``'s broadcast transaction table."""
@@ -199,7 +210,7 @@ class ZigbeeNetworkMedium(BusMedium):
         frame = self._queues[node].popleft()
         self._sequence += 1
         broadcast = _Broadcast(frame, node, (node, self._sequence))
-        if self.role(node) == "end_device":
+        if self.role(node) is Role.END_DEVICE:
             self._push(node, broadcast, _Hop.UP)
             return
         if not self._tables[node].record(broadcast.key, self.clock.now):
@@ -327,7 +338,7 @@ class ZigbeeNetworkMedium(BusMedium):
                     self._push(node, broadcast, _Hop.UP)
         elif transmission is not None:
             for other in self.modules:
-                if other == node or self.role(other) == "end_device":
+                if other == node or self.role(other) is Role.END_DEVICE:
                     continue
                 if transmission.garbled:
                     broadcast.why.setdefault(other, Loss.COLLISION)
@@ -348,7 +359,7 @@ class ZigbeeNetworkMedium(BusMedium):
         """The passive acknowledgement timeout: retransmit unless every neighbouring
         router (and the coordinator) was heard transmitting the broadcast."""
         broadcast.pending -= 1
-        neighbours = [m for m in self.modules if m != node and self.role(m) != "end_device"]
+        neighbours = [m for m in self.modules if m != node and self.role(m) is not Role.END_DEVICE]
         heard = broadcast.heard.get(node, set())
         if any(m not in heard for m in neighbours) and broadcast.tries.get(node, 0) <= self.bus.broadcast_retries:
             self._push(node, broadcast, _Hop.BROADCAST)
