@@ -187,9 +187,9 @@ class NetBuilder:
             agent: the agent (or its name) whose subnet holds it; its places may then be
                 named locally too.
         """
-        return self._transition(id, self._agent_name(agent), action=action, params=params, guard=guard, priority=priority,
-                                label=label, silent=silent, timeout=timeout, inputs=inputs, outputs=outputs,
-                                outcomes=outcomes, cancels=cancels)
+        return self._transition(id, self._agent_name(agent), action=action, params=params, guard=guard,
+                                priority=priority, label=label, silent=silent, timeout=timeout, inputs=inputs,
+                                outputs=outputs, outcomes=outcomes, cancels=cancels)
 
     def arc(self, source: str, target: str, weight: int = 1, *, outcome: str | None = None) -> None:
         """Add one arc between existing nodes (:meth:`Net.add_arc <petriflow.net.Net.add_arc>`)."""

@@ -87,8 +87,8 @@ def _native(module: _Module, boot: dict[str, Any]) -> None:
     slots = [f"slot_{name}_{other}" for other in targets.values() if other is not None]
     a.transition("boot", label="auto-addressing", action="bus.boot", params=boot, inputs=["start"],
                  outputs=["loop", "listen"])
-    a.transition("cpg", label="θ = CPG(...); move actuator", action="bus.cpg", guard="bus.sending", inputs=["loop"],
-                 outputs=["moved"])
+    a.transition("cpg", label="θ = CPG(...); move actuator", action="bus.cpg", guard="bus.sending",
+                 inputs=["loop"], outputs=["moved"])
     a.transition("wait", label="Wait(Delay)", action="bus.wait", inputs=["moved"], outputs=["waited"])
     a.transition("send", label="send a message to the neighbours", action="bus.send",
                  params={"boxes": boxes, "state": a.id("loop")}, inputs=["waited", *slots],
@@ -106,20 +106,22 @@ def _bus_aware(module: _Module, boot: dict[str, Any], box: str, slot: str) -> No
 
     a.transition("boot", label="auto-addressing", action="bus.boot", params=boot, inputs=["start"],
                  outputs=["loop", "listen", "watch", "timer"])
-    a.transition("cpg", label="θ = CPG(...); move actuator", action="bus.cpg", guard="bus.sending", inputs=["loop"],
-                 outputs=["loop"])
+    a.transition("cpg", label="θ = CPG(...); move actuator", action="bus.cpg", guard="bus.sending",
+                 inputs=["loop"], outputs=["loop"])
     a.transition("available", label="bus available interrupt", action="bus.available", params={"box": box},
                  guard="bus.sending", inputs=["watch"], outputs=["tx"])
     a.transition("send", label="send a message (bus available)", action="bus.send",
                  params=send("watch"), guard="bus.sending", inputs=["tx", slot],
                  outputs=["watch", box])
-    a.transition("late", label="nothing left to send", guard="bus.finished", priority=1, inputs=["tx"], outputs=["watch"])
+    a.transition("late", label="nothing left to send", guard="bus.finished", priority=1, inputs=["tx"],
+                 outputs=["watch"])
     a.transition("overflow", label="overflow interrupt (1 s)", action="bus.overflow", guard="bus.sending",
                  inputs=["timer"], outputs=["tick"])
     a.transition("send_overflow", label="send a message (overflow, p = 0.5)", action="bus.send",
                  params=send("timer"), guard="bus.overflow_sends", inputs=["tick", slot],
                  outputs=["timer", box])
-    a.transition("skip", label="overflow: no send", guard="bus.overflow_skips", inputs=["tick"], outputs=["timer"])
+    a.transition("skip", label="overflow: no send", guard="bus.overflow_skips", inputs=["tick"],
+                 outputs=["timer"])
     a.transition("finish", label="all messages sent", guard="bus.finished", inputs=["loop", "watch", "timer"],
                  outputs=["done"])
 
@@ -160,7 +162,8 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
     if messages < 1:
         raise ValueError(f"messages must be >= 1, got {messages}")
     chain = [f"m{k + 1}" for k in range(modules)]
-    b = NetBuilder(f"bus-algorithm{algorithm}-{modules}", label=f"seed 002: {modules} modules, algorithm {algorithm}")
+    b = NetBuilder(f"bus-algorithm{algorithm}-{modules}",
+                   label=f"seed 002: {modules} modules, algorithm {algorithm}")
     # every place first (a module sends into its neighbour's mailbox), in the net's order
     chained = [_Module(b.agent(name, label=f"module {name}"), chain[k - 1] if k > 0 else None,
                        chain[k + 1] if k + 1 < modules else None, []) for k, name in enumerate(chain)]
@@ -189,12 +192,13 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
         else:
             _bus_aware(module, boot, *void)
         _receptions(module)
-        closing += [slot for _, _, slot in module.inboxes] + [module.agent.id("done"), module.agent.id("listen")]
+        closing += [slot for _, _, slot in module.inboxes]
+        closing += [module.agent.id("done"), module.agent.id("listen")]
     if algorithm == 2:
         closing.append(void[1])
     first_box = f"box_{chain[0]}_{chain[1]}"
-    sniffer.transition("boot", label="the sniffer joins the bus", action="bus.sniffer", params={"box": first_box},
-                       inputs=["start"], outputs=["on"])
+    sniffer.transition("boot", label="the sniffer joins the bus", action="bus.sniffer",
+                       params={"box": first_box}, inputs=["start"], outputs=["on"])
     b.transition("end", agent=sniffer, label="every module sent its messages: the sniffer's record",
                  action="bus.sniffed", params={"box": first_box}, inputs=[*closing, "on"], outputs=["o"])
     slots = [place for place in closing if place.startswith("slot_")]  # one token each: a sender may send
@@ -219,8 +223,8 @@ def main(argv: list[str] | None = None) -> None:
     for algorithm in (1, 2):
         net = build(3, algorithm)
         net.run = "run.yaml"
-        (out / f"{net.id}.yaml").write_text("# Generated by python -m petriflow.agents.bus.nets; the run configuration"
-                                            f" is run.yaml.\n{dumps_net(net)}")
+        head = "# Generated by python -m petriflow.agents.bus.nets; the run configuration is run.yaml.\n"
+        (out / f"{net.id}.yaml").write_text(head + dumps_net(net))
     print(f"wrote the nets under {out}")
 
 

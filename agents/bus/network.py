@@ -145,8 +145,9 @@ class ZigbeeNetworkMedium(BusMedium):
 
     def __init__(self, bus: ZigbeeBus, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (),
                  positions: dict[int, float] | None = None, **options: Any) -> None:
-        self.radio = CsmaCa(bus, clock, rng, on_start=self._started, on_sent=self._sent, on_failure=self._failed,
-                            on_free=self._free, positions=positions)  # a collision is decided at the frame's end
+        # no on_collision: what a collision costs is decided when the broadcast's last frame ends
+        self.radio = CsmaCa(bus, clock, rng, on_start=self._started, on_sent=self._sent,
+                            on_failure=self._failed, on_free=self._free, positions=positions)
         self._tables: dict[int, BroadcastTable] = {}
         self._outbox: dict[int, deque[tuple[_Broadcast, _Hop]]] = {}  # what each radio has to send
         self._uart_free: dict[int, float] = {}
@@ -238,7 +239,8 @@ class ZigbeeNetworkMedium(BusMedium):
         frame = broadcast.frame
         self.clock.at(now + self.bus.uart_time(len(frame.data)), self._arrive, frame, node, rank=MEDIUM)
         broadcast.pending += 1
-        self.clock.at(now + self.rng.uniform(0.0, self.bus.max_jitter), self._relay, node, broadcast, rank=MEDIUM)
+        jitter = self.rng.uniform(0.0, self.bus.max_jitter)
+        self.clock.at(now + jitter, self._relay, node, broadcast, rank=MEDIUM)
         self._buffer_for_children(node, broadcast)
 
     def _relay(self, node: int, broadcast: _Broadcast) -> None:
@@ -361,7 +363,8 @@ class ZigbeeNetworkMedium(BusMedium):
         broadcast.pending -= 1
         neighbours = [m for m in self.modules if m != node and self.role(m) is not Role.END_DEVICE]
         heard = broadcast.heard.get(node, set())
-        if any(m not in heard for m in neighbours) and broadcast.tries.get(node, 0) <= self.bus.broadcast_retries:
+        retries_left = broadcast.tries.get(node, 0) <= self.bus.broadcast_retries
+        if any(m not in heard for m in neighbours) and retries_left:
             self._push(node, broadcast, _Hop.BROADCAST)
         self._check_done(broadcast)
 

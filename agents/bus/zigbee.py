@@ -216,7 +216,8 @@ class ZigbeeMedium(BusMedium):
     def __init__(self, bus: ZigbeeBus, clock: ProcessClock, rng: random.Random, modules: Iterable[int] = (),
                  positions: dict[int, float] | None = None, **options: Any) -> None:
         self.radio = CsmaCa(bus, clock, rng, on_start=self._started, on_collision=self._collided,
-                            on_sent=self._sent, on_failure=self._failed, on_free=self._free, positions=positions)
+                            on_sent=self._sent, on_failure=self._failed, on_free=self._free,
+                            positions=positions)
         self._ready: dict[int, deque[float]] = {}  # when each queued frame is in its radio
         super().__init__(bus, clock, rng, modules, **options)
 
@@ -236,7 +237,8 @@ class ZigbeeMedium(BusMedium):
         if not self._enqueue(frame, self.radio.serving(sender)):
             return False
         # The module's UART writes the bytes, then the XBee waits the packetization timeout.
-        self._ready[sender].append(self.clock.now + self.bus.uart_time(len(frame.data) + self.bus.packetization_chars))
+        uart = self.bus.uart_time(len(frame.data) + self.bus.packetization_chars)
+        self._ready[sender].append(self.clock.now + uart)
         if not self.radio.serving(sender):
             self._serve(sender)
         return True

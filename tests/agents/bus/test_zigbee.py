@@ -101,6 +101,6 @@ def test_a_frame_taken_during_the_spacing_starts_at_once_and_the_radio_is_free_o
 def test_distance_and_link_follow_the_spacing_unless_positions_say_otherwise():
     clock = ProcessClock(Kernel(1e-6))
     noop = lambda *args: None  # noqa: E731
-    mac = CsmaCa(ZigbeeBus(spacing=0.5), clock, random.Random(0), on_start=noop, on_sent=noop, on_failure=noop,
-                 on_free=noop, positions={2: 10.0})
+    mac = CsmaCa(ZigbeeBus(spacing=0.5), clock, random.Random(0), on_start=noop, on_sent=noop,
+                 on_failure=noop, on_free=noop, positions={2: 10.0})
     assert mac.distance(0, 1) == 0.5 and mac.distance(1, 2) == 9.5
