@@ -95,10 +95,12 @@ def _difference(journaled: str, event: Event) -> str:
         >>> old = Event(4, 1.0, "end", "t", None, {"outcome": "ok", "firing": 2}).to_json()
         >>> _difference(old, Event(4, 1.5, "end", "t", None, {"outcome": "failed", "firing": 2}))
         "end of t: data.outcome 'ok' in the journal, 'failed' now; time 1.0 in the journal, 1.5 now"
+        >>> _difference(None, Event(4, 1.5, "end", "t", None, {}))
+        'the journaled line is not an event'
     """
     try:
         before = json.loads(journaled)
-    except ValueError:
+    except (TypeError, ValueError):  # not text (a damaged row holds NULL or a number), or not JSON
         return "the journaled line is not an event"
     now = json.loads(event.to_json())
     found: list[str] = []
