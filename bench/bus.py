@@ -23,6 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def net_run(algorithm: int, bus: str, seconds: float = 120.0) -> tuple[float, float, str]:
     from petriflow.agents.bus.nets import build
+    from petriflow.io.yaml import dumps_net
     from petriflow.runtime.session import run_files
 
     with tempfile.TemporaryDirectory() as folder:
@@ -32,7 +33,8 @@ def net_run(algorithm: int, bus: str, seconds: float = 120.0) -> tuple[float, fl
         config = yaml.safe_load((ROOT / "nets" / "bus" / "run.yaml").read_text())
         config["channels"]["bus"]["model"] = f"bus.{bus}"
         (folder / "run.yaml").write_text(yaml.safe_dump(config))
-        (folder / "net.yaml").write_text(build(3, algorithm, messages=10_000))  # never runs out in 2 minutes
+        net = build(3, algorithm, messages=10_000)  # never runs out in 2 minutes
+        (folder / "net.yaml").write_text(dumps_net(net))
         start = time.perf_counter()
         outcome = run_files(folder / "net.yaml", until=seconds)
         return outcome.result.time, time.perf_counter() - start, outcome.result.reason

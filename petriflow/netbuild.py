@@ -148,9 +148,11 @@ class NetBuilder:
         self._agents[name] = AgentBuilder(self, name)
         return self._agents[name]
 
-    def place(self, id: str, *, tokens: int = 0, label: str | None = None, channel: str | None = None) -> str:
-        """Add a place outside every agent and return its id."""
-        return self._place(id, None, tokens, label, channel)
+    def place(self, id: str, *, tokens: int = 0, label: str | None = None, channel: str | None = None,
+              agent: AgentBuilder | str | None = None) -> str:
+        """Add a place and return its id: outside every agent, or in ``agent``'s subnet
+        under the full id ``id`` (an id outside the naming rule, such as a net file's)."""
+        return self._place(id, self._agent_name(agent), tokens, label, channel)
 
     def transition(
         self,
@@ -167,8 +169,10 @@ class NetBuilder:
         outputs: Places = (),
         outcomes: Mapping[str, Places] | None = None,
         cancels: Iterable[str] = (),
+        agent: AgentBuilder | str | None = None,
     ) -> str:
-        """Add a transition outside every agent, with its arcs, and return its id.
+        """Add a transition with its arcs and return its id: outside every agent, or in
+        ``agent``'s subnet under the full id ``id`` (an id outside the naming rule).
 
         Args:
             id: the transition's id.
@@ -180,10 +184,12 @@ class NetBuilder:
             outcomes: output places per other outcome (``failed``, ``timeout``,
                 ``cancelled``), each given like ``outputs``.
             cancels: the cancellation region: places and transitions (they must exist).
+            agent: the agent (or its name) whose subnet holds it; its places may then be
+                named locally too.
         """
-        return self._transition(id, None, action=action, params=params, guard=guard, priority=priority,
-                                label=label, silent=silent, timeout=timeout, inputs=inputs, outputs=outputs,
-                                outcomes=outcomes, cancels=cancels)
+        return self._transition(id, self._agent_name(agent), action=action, params=params, guard=guard,
+                                priority=priority, label=label, silent=silent, timeout=timeout, inputs=inputs,
+                                outputs=outputs, outcomes=outcomes, cancels=cancels)
 
     def arc(self, source: str, target: str, weight: int = 1, *, outcome: str | None = None) -> None:
         """Add one arc between existing nodes (:meth:`Net.add_arc <petriflow.net.Net.add_arc>`)."""

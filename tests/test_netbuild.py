@@ -166,6 +166,21 @@ def test_places_are_named_locally_or_by_full_id():
     assert net.initial_marking == {"shared": 2} and net.final_marking is None
 
 
+def test_an_agent_may_hold_elements_named_outside_the_naming_rule():
+    """NetBuilder.place and .transition with ``agent=`` put a full id in that agent's
+    subnet (a net file's ids kept as they are); its places may then be named locally."""
+    b = NetBuilder()
+    a = b.agent("a")
+    a.place("on")
+    box = b.place("box_b_a", agent=a, channel="radio")
+    end = b.transition("end", agent="a", inputs=["on", box])
+    net = b.build()
+    assert (net.place(box).subnet, net.place(box).channel, net.transition(end).subnet) == ("a", "radio", "a")
+    assert net.preset("end") == {"a_on": 1, "box_b_a": 1}
+    with pytest.raises(UnknownElementError):
+        b.place("p", agent="nobody")
+
+
 def test_registrations_count_whenever_they_are_made_and_build_can_be_called_again():
     """A mailbox made after envelope() is still handed out by begin; each build() is a new
     net, unchanged by what the builder does later."""

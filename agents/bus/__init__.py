@@ -13,12 +13,21 @@ modules' firmware as actions of a net; the experiment is a sweep
 * :mod:`~petriflow.agents.bus.packet`: the CPG message and its bytes.
 * :mod:`~petriflow.agents.bus.radio`: frame errors of the ZigBee radios (RSSI from the
   core's log-distance model).
-* :mod:`~petriflow.agents.bus.medium`: the buses (RS-485, CAN, ZigBee) at bit-level
-  timing, receive buffers and transmit queues, on a
-  :class:`~petriflow.runtime.media.ProcessClock`; ZigBee as a network (broadcast
-  transaction tables, relaying with passive acknowledgement, end devices polling
-  their parent); a sniffer node on any bus; each bus is a petriflow medium, and
-  :class:`~petriflow.agents.bus.medium.BusSimulator` runs one on its own.
+* :mod:`~petriflow.agents.bus.records`: frames, transmissions, deliveries, losses and
+  their reasons.
+* :mod:`~petriflow.agents.bus.parameters`: the buses' parameters (RS-485, CAN, ZigBee);
+  each bus is a petriflow medium.
+* :mod:`~petriflow.agents.bus.buffer`: what every bus shares at bit-level timing on a
+  :class:`~petriflow.runtime.media.ProcessClock`: transmit queues, receive buffers,
+  reads, listeners, a sniffer node.
+* :mod:`~petriflow.agents.bus.rs485`, :mod:`~petriflow.agents.bus.can`,
+  :mod:`~petriflow.agents.bus.zigbee`: the three MAC layers (a line with no
+  arbitration, arbitration by identifier, 802.15.4 CSMA/CA radios).
+* :mod:`~petriflow.agents.bus.network`: ZigBee as a network over the 802.15.4 MAC
+  (broadcast transaction tables, relaying with passive acknowledgement, end devices
+  polling their parent).
+* :mod:`~petriflow.agents.bus.simulator`: a bus on its own, outside a run
+  (:class:`~petriflow.agents.bus.simulator.BusSimulator`).
 * :mod:`~petriflow.agents.bus.channel`: a run's messages as frames on a bus, their
   fates when they happen, and the view a module's firmware asks the bus through.
 * :mod:`~petriflow.agents.bus.cpg`: the phase oscillators and the phase-locking error.
@@ -42,7 +51,10 @@ from petriflow.agents.bus.algorithms import ALGORITHMS, BusAwareScheme, NativeSc
 from petriflow.agents.bus.cpg import CpgChain, CpgParameters, phase_error
 from petriflow.agents.bus.errors import AddressingError, BusError, FrameError
 from petriflow.agents.bus.channel import BusView
-from petriflow.agents.bus.medium import BusMedium, BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
+from petriflow.agents.bus.buffer import BusMedium
+from petriflow.agents.bus.parameters import CanBus, SerialBus, ZigbeeBus
+from petriflow.agents.bus.records import Frame, Loss
+from petriflow.agents.bus.simulator import BusSimulator
 
 __all__ = [
     "ALGORITHMS",

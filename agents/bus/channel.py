@@ -1,7 +1,7 @@
 """A bus as a petriflow medium: a run's channel messages as frames on the bus, and the
 frames' fates as the messages' fates, each when it happens.
 
-:meth:`BusModel.attach <petriflow.agents.bus.medium.BusModel.attach>` starts a
+:meth:`BusModel.attach <petriflow.agents.bus.parameters.BusModel.attach>` starts a
 :class:`Carrier` on the run's kernel; the run hands it every message put into a
 channel place the bus carries (:meth:`Carrier.send`), and the carrier:
 
@@ -25,7 +25,7 @@ channel place the bus carries (:meth:`Carrier.send`), and the carrier:
 Firmware asks the bus only through a :class:`BusView` (``ctx.medium(place)``).
 
 Examples:
-    >>> from petriflow.agents.bus.medium import CanBus, SerialBus
+    >>> from petriflow.agents.bus.parameters import SerialBus
     >>> from petriflow.runtime.channels import Message
     >>> from petriflow.runtime.kernel import Kernel
     >>> from petriflow.runtime.media import MediumPort, ProcessClock
@@ -52,12 +52,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from petriflow.agents.bus.medium import Delivery, Frame, Lost, Transmission
+from petriflow.agents.bus.records import Delivery, Frame, Lost, Transmission
 from petriflow.runtime.channels import Message
 from petriflow.runtime.media import MediumPort
 
 if TYPE_CHECKING:
-    from petriflow.agents.bus.medium import BusModel
+    from petriflow.agents.bus.parameters import BusModel
 
 __all__ = ["BusView", "Carrier", "payload_of"]
 
@@ -110,7 +110,7 @@ class Carrier:
         logs: the bus keeps its transmissions, deliveries and losses.
 
     Attributes:
-        medium: the bus (:class:`~petriflow.agents.bus.medium.BusMedium`) on the run's kernel.
+        medium: the bus (:class:`~petriflow.agents.bus.buffer.BusMedium`) on the run's kernel.
         numbers: ``{agent: module number}``.
     """
 
@@ -272,7 +272,7 @@ class BusView:
     def sniff(self) -> None:
         """This agent is a sniffer on the bus: a node that never sends and takes every
         intact frame that reaches it, whoever it is for, on arrival
-        (:meth:`~petriflow.agents.bus.medium.BusMedium.sniff`)."""
+        (:meth:`~petriflow.agents.bus.buffer.BusMedium.sniff`)."""
         carrier = self._carrier
         carrier.medium.sniff(carrier.module(self.agent))
 

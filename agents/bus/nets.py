@@ -21,27 +21,123 @@ The paper's sniffer is a subnet of its own (agent ``sniffer``): ``sniffer_boot``
 the bus as a node that only listens, and ``end`` (when every module has sent its
 messages) records what it captured from each module (``bus.sniffed``).
 
+The net is built with :class:`~petriflow.netbuild.NetBuilder`: every place first (a
+module sends into its neighbour's mailbox), then each module's transitions, the
+sniffer's, and the workflow envelope: ``begin`` hands out the start places and every
+mailbox's slot, the sniffer's ``end`` collects them. Sweep files use :func:`build` directly (``net: {builder:
+petriflow.agents.bus.nets:build}``); ``python -m petriflow.agents.bus.nets`` writes the
+shipped nets of ``nets/bus/``.
+
 Examples:
-    >>> from petriflow.io.yaml import loads_net
-    >>> net = loads_net(build(3, algorithm=1))
+    >>> net = build(3, algorithm=1)
     >>> sorted(net.subnets), len([p for p in net.places.values() if p.channel])
     (['m1', 'm2', 'm3', 'sniffer'], 4)
+    >>> net.preset("m2_receive_m1"), net.postset("m2_receive_m1")
+    ({'box_m1_m2': 1, 'm2_listen': 1}, {'m2_listen': 1, 'slot_m1_m2': 1})
 """
 
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
+from petriflow.net import Net
+from petriflow.netbuild import AgentBuilder, NetBuilder
 
 __all__ = ["build", "main"]
 
+@dataclass
+class _Module:
+    """One module's subnet as it is built: its neighbours and the mailboxes it reads."""
+
+    agent: AgentBuilder
+    front: str | None
+    back: str | None
+    inboxes: list[tuple[str, str, str]]  # (sender, channel place, slot place)
+
+    @property
+    def name(self) -> str:
+        return self.agent.name
+
+
+def _places(b: NetBuilder, module: _Module, algorithm: int) -> None:
+    """The module's state places, then a mailbox (channel place and slot) per neighbour
+    that sends to it: both (algorithm 1) or the one in front (algorithm 2 sends only to
+    address + 1)."""
+    a, name = module.agent, module.name
+    steps = ("moved", "waited") if algorithm == 1 else ("watch", "tx", "timer", "tick")
+    for local in ("start", "loop", "listen", "done", *steps):
+        a.place(local)
+    senders = [module.front, module.back] if algorithm == 1 else [module.front]
+    for other in senders:
+        if other is None:
+            continue
+        box = b.place(f"box_{other}_{name}", agent=a, channel="bus", label=f"{other} to {name}")
+        slot = b.place(f"slot_{other}_{name}", agent=a, label=f"{other} may send to {name}")
+        module.inboxes.append((other, box, slot))
+
+
+def _native(module: _Module, boot: dict[str, Any]) -> None:
+    """Algorithm 1: boot, then cpg → wait → send to both neighbours, until done."""
+    a, name = module.agent, module.name
+    targets = {"+1": module.back, "-1": module.front}
+    boxes = {offset: f"box_{name}_{other}" for offset, other in targets.items() if other is not None}
+    slots = [f"slot_{name}_{other}" for other in targets.values() if other is not None]
+    a.transition("boot", label="auto-addressing", action="bus.boot", params=boot, inputs=["start"],
+                 outputs=["loop", "listen"])
+    a.transition("cpg", label="θ = CPG(...); move actuator", action="bus.cpg", guard="bus.sending",
+                 inputs=["loop"], outputs=["moved"])
+    a.transition("wait", label="Wait(Delay)", action="bus.wait", inputs=["moved"], outputs=["waited"])
+    a.transition("send", label="send a message to the neighbours", action="bus.send",
+                 params={"boxes": boxes, "state": a.id("loop")}, inputs=["waited", *slots],
+                 outputs=["loop", *boxes.values()])
+    a.transition("finish", label="all messages sent", guard="bus.finished", inputs=["loop"], outputs=["done"])
+
+
+def _bus_aware(module: _Module, boot: dict[str, Any], box: str, slot: str) -> None:
+    """Algorithm 2: the loop runs cpg only; the bus-available and the overflow interrupts
+    are two more threads that send into ``box`` (taking a token of ``slot``)."""
+    a = module.agent
+
+    def send(state: str) -> dict[str, Any]:  # each transition's params of its own
+        return {"boxes": {"+1": box}, "state": a.id(state)}
+
+    a.transition("boot", label="auto-addressing", action="bus.boot", params=boot, inputs=["start"],
+                 outputs=["loop", "listen", "watch", "timer"])
+    a.transition("cpg", label="θ = CPG(...); move actuator", action="bus.cpg", guard="bus.sending",
+                 inputs=["loop"], outputs=["loop"])
+    a.transition("available", label="bus available interrupt", action="bus.available", params={"box": box},
+                 guard="bus.sending", inputs=["watch"], outputs=["tx"])
+    a.transition("send", label="send a message (bus available)", action="bus.send",
+                 params=send("watch"), guard="bus.sending", inputs=["tx", slot],
+                 outputs=["watch", box])
+    a.transition("late", label="nothing left to send", guard="bus.finished", priority=1, inputs=["tx"],
+                 outputs=["watch"])
+    a.transition("overflow", label="overflow interrupt (1 s)", action="bus.overflow", guard="bus.sending",
+                 inputs=["timer"], outputs=["tick"])
+    a.transition("send_overflow", label="send a message (overflow, p = 0.5)", action="bus.send",
+                 params=send("timer"), guard="bus.overflow_sends", inputs=["tick", slot],
+                 outputs=["timer", box])
+    a.transition("skip", label="overflow: no send", guard="bus.overflow_skips", inputs=["tick"],
+                 outputs=["timer"])
+    a.transition("finish", label="all messages sent", guard="bus.finished", inputs=["loop", "watch", "timer"],
+                 outputs=["done"])
+
+
+def _receptions(module: _Module) -> None:
+    """The reception routine, one transition per mailbox: it takes a frame (or a loss
+    notice) and gives the sender's slot back."""
+    for other, box, slot in module.inboxes:
+        module.agent.transition(f"receive_{other}", label=f"reception from {other}", action="bus.receive",
+                                params={"box": box, "state": module.agent.id("listen")}, priority=2,
+                                inputs=[box, "listen"], outputs=["listen", slot])
+
 
 def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_time: float = 0.02,
-          max_delay: float = 1.0, idle_window: float = 3.0, world: bool = False, **ignored: Any) -> str:
-    """The chain's net as petriflow YAML (see the module).
+          max_delay: float = 1.0, idle_window: float = 3.0, world: bool = False, **ignored: Any) -> Net:
+    """The chain's net (see the module).
 
     Args:
         modules: modules in the chain (2 … 254).
@@ -54,6 +150,10 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
         world: the modules drive the joints of a chain in the world (the world file
             must hold it: :func:`petriflow.agents.bus.chain.world`).
         ignored: other sweep parameters (they go elsewhere).
+
+    Raises:
+        ValueError: an algorithm other than 1 or 2, a chain shorter than 2 or longer
+            than 254 modules, or fewer than one message.
     """
     if algorithm not in (1, 2):
         raise ValueError(f"algorithm is 1 or 2, not {algorithm!r}")
@@ -62,121 +162,69 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
     if messages < 1:
         raise ValueError(f"messages must be >= 1, got {messages}")
     chain = [f"m{k + 1}" for k in range(modules)]
-    subnets, top_places, top_transitions, end_in = [], [], [], []
-    boot = {"chain": chain, "algorithm": algorithm, "messages": messages, "step_time": step_time,
-            "max_delay": max_delay, "idle_window": idle_window}
-    for k, name in enumerate(chain):
-        front = chain[k - 1] if k > 0 else None
-        back = chain[k + 1] if k + 1 < modules else None
-        places: list[Any] = [f"{name}_start", f"{name}_loop", f"{name}_listen", f"{name}_done"]
-        senders = [front, back] if algorithm == 1 else [front]  # algorithm 2 sends only to address + 1
-        mailboxes = [f"box_{other}_{name}" for other in senders if other is not None]
-        transitions: list[dict[str, Any]] = []
+    b = NetBuilder(f"bus-algorithm{algorithm}-{modules}",
+                   label=f"seed 002: {modules} modules, algorithm {algorithm}")
+    # every place first (a module sends into its neighbour's mailbox), in the net's order
+    chained = [_Module(b.agent(name, label=f"module {name}"), chain[k - 1] if k > 0 else None,
+                       chain[k + 1] if k + 1 < modules else None, []) for k, name in enumerate(chain)]
+    sniffer = b.agent("sniffer", label="the sniffer on the bus")
+    for module in chained:
+        _places(b, module, algorithm)
+    sniffer.place("start")
+    sniffer.place("on")
+    b.place("i", tokens=1)
+    b.place("o")
+    last = chained[-1].name
+    void = (f"void_{last}", f"slot_{last}_void")  # algorithm 2's tail sends to an address no module holds
+    if algorithm == 2:
+        b.place(void[0], channel="bus", label=f"{last}'s frames to address {modules}")
+        b.place(void[1], label=f"{last} may send to address {modules}")
+    # then the transitions: each module's, the sniffer's, the envelope's
+    closing: list[str] = []  # what "end" collects: each module's slots, done and listening places
+    for module in chained:
+        boot = {"chain": list(chain), "algorithm": algorithm, "messages": messages, "step_time": step_time,
+                "max_delay": max_delay, "idle_window": idle_window,
+                "mailboxes": [box for _, box, _ in module.inboxes]}  # lists of its own: a sweep may set one
         if algorithm == 1:
-            targets = {"+1": back, "-1": front}
-            boxes = {offset: f"box_{name}_{other}" for offset, other in targets.items() if other is not None}
-            slots = [f"slot_{name}_{other}" for other in targets.values() if other is not None]
-            places += [f"{name}_moved", f"{name}_waited"]
-            transitions += [
-                {"id": f"{name}_boot", "label": "auto-addressing", "action": "bus.boot",
-                 "params": {**boot, "mailboxes": mailboxes}, "in": [f"{name}_start"],
-                 "out": [f"{name}_loop", f"{name}_listen"]},
-                {"id": f"{name}_cpg", "label": "θ = CPG(...); move actuator", "action": "bus.cpg",
-                 "guard": "bus.sending", "in": [f"{name}_loop"], "out": [f"{name}_moved"]},
-                {"id": f"{name}_wait", "label": "Wait(Delay)", "action": "bus.wait",
-                 "in": [f"{name}_moved"], "out": [f"{name}_waited"]},
-                {"id": f"{name}_send", "label": "send a message to the neighbours", "action": "bus.send",
-                 "params": {"boxes": boxes, "state": f"{name}_loop"},
-                 "in": [f"{name}_waited", *slots], "out": [f"{name}_loop", *boxes.values()]},
-                {"id": f"{name}_finish", "label": "all messages sent", "guard": "bus.finished",
-                 "in": [f"{name}_loop"], "out": [f"{name}_done"]},
-            ]
-            end_from = [f"{name}_done"]
+            _native(module, boot)
+        elif module.back is not None:
+            _bus_aware(module, boot, f"box_{module.name}_{module.back}", f"slot_{module.name}_{module.back}")
         else:
-            box = f"box_{name}_{back}" if back is not None else f"void_{name}"
-            slot = f"slot_{name}_{back}" if back is not None else f"slot_{name}_void"
-            places += [f"{name}_watch", f"{name}_tx", f"{name}_timer", f"{name}_tick"]
-            send = {"boxes": {"+1": box}}
-            transitions += [
-                {"id": f"{name}_boot", "label": "auto-addressing", "action": "bus.boot",
-                 "params": {**boot, "mailboxes": mailboxes}, "in": [f"{name}_start"],
-                 "out": [f"{name}_loop", f"{name}_listen", f"{name}_watch", f"{name}_timer"]},
-                {"id": f"{name}_cpg", "label": "θ = CPG(...); move actuator", "action": "bus.cpg",
-                 "guard": "bus.sending", "in": [f"{name}_loop"], "out": [f"{name}_loop"]},
-                {"id": f"{name}_available", "label": "bus available interrupt", "action": "bus.available",
-                 "params": {"box": box}, "guard": "bus.sending", "in": [f"{name}_watch"], "out": [f"{name}_tx"]},
-                {"id": f"{name}_send", "label": "send a message (bus available)", "action": "bus.send",
-                 "params": {**send, "state": f"{name}_watch"}, "guard": "bus.sending",
-                 "in": [f"{name}_tx", slot], "out": [f"{name}_watch", box]},
-                {"id": f"{name}_late", "label": "nothing left to send", "guard": "bus.finished", "priority": 1,
-                 "in": [f"{name}_tx"], "out": [f"{name}_watch"]},
-                {"id": f"{name}_overflow", "label": "overflow interrupt (1 s)", "action": "bus.overflow",
-                 "guard": "bus.sending", "in": [f"{name}_timer"], "out": [f"{name}_tick"]},
-                {"id": f"{name}_send_overflow", "label": "send a message (overflow, p = 0.5)",
-                 "action": "bus.send", "params": {**send, "state": f"{name}_timer"}, "guard": "bus.overflow_sends",
-                 "in": [f"{name}_tick", slot], "out": [f"{name}_timer", box]},
-                {"id": f"{name}_skip", "label": "overflow: no send", "guard": "bus.overflow_skips",
-                 "in": [f"{name}_tick"], "out": [f"{name}_timer"]},
-                {"id": f"{name}_finish", "label": "all messages sent", "guard": "bus.finished",
-                 "in": [f"{name}_loop", f"{name}_watch", f"{name}_timer"], "out": [f"{name}_done"]},
-            ]
-            if back is None:
-                top_places.append({"id": box, "channel": "bus", "label": f"{name}'s frames to address {modules}"})
-                top_places.append({"id": slot, "label": f"{name} may send to address {modules}"})
-                top_transitions.append({"id": f"drain_{name}", "label": "a frame for nobody leaves the bus",
-                                        "action": "bus.drain", "params": {"box": box}, "in": [box], "out": [slot]})
-            end_from = [f"{name}_done"]
-        for other in (front, back):
-            if other is None:
-                continue
-            box, slot = f"box_{other}_{name}", f"slot_{other}_{name}"
-            if algorithm == 2 and chain.index(other) > k:
-                continue  # algorithm 2 sends only to address + 1
-            places += [{"id": box, "channel": "bus", "label": f"{other} to {name}"},
-                       {"id": slot, "label": f"{other} may send to {name}"}]
-            transitions.append({"id": f"{name}_receive_{other}", "label": f"reception from {other}",
-                                "action": "bus.receive", "params": {"box": box, "state": f"{name}_listen"},
-                                "priority": 2, "in": [box, f"{name}_listen"], "out": [f"{name}_listen", slot]})
-            end_in.append(slot)
-        subnets.append({"id": name, "agent": name, "label": f"module {name}", "places": places,
-                        "transitions": transitions})
-        end_in += end_from + [f"{name}_listen"]
-    end_in += [p["id"] for p in top_places if p["id"].startswith("slot_")]
+            _bus_aware(module, boot, *void)
+        _receptions(module)
+        closing += [slot for _, _, slot in module.inboxes]
+        closing += [module.agent.id("done"), module.agent.id("listen")]
+    if algorithm == 2:
+        closing.append(void[1])
     first_box = f"box_{chain[0]}_{chain[1]}"
-    subnets.append({"id": "sniffer", "agent": "sniffer", "label": "the sniffer on the bus",
-                    "places": ["sniffer_start", "sniffer_on"],
-                    "transitions": [
-                        {"id": "sniffer_boot", "label": "the sniffer joins the bus", "action": "bus.sniffer",
-                         "params": {"box": first_box}, "in": ["sniffer_start"], "out": ["sniffer_on"]},
-                        {"id": "end", "label": "every module sent its messages: the sniffer's record",
-                         "action": "bus.sniffed", "params": {"box": first_box}, "in": [*end_in, "sniffer_on"],
-                         "out": ["o"]}]})
-    net = {
-        "petriflow": 1,
-        "net": f"bus-algorithm{algorithm}-{modules}",
-        "label": f"seed 002: {modules} modules, algorithm {algorithm}",
-        "subnets": subnets,
-        "places": [{"id": "i", "tokens": 1}, "o", *top_places],
-        "transitions": [
-            {"id": "begin", "label": "power on", "in": ["i"],
-             "out": [f"{m}_start" for m in chain] + [s for s in end_in if s.startswith("slot_")] + ["sniffer_start"]},
-            *top_transitions,
-        ],
-        "final": {"o": 1},
-    }
-    return yaml.safe_dump(net, sort_keys=False, width=120)
+    sniffer.transition("boot", label="the sniffer joins the bus", action="bus.sniffer",
+                       params={"box": first_box}, inputs=["start"], outputs=["on"])
+    b.transition("end", agent=sniffer, label="every module sent its messages: the sniffer's record",
+                 action="bus.sniffed", params={"box": first_box}, inputs=[*closing, "on"], outputs=["o"])
+    slots = [place for place in closing if place.startswith("slot_")]  # one token each: a sender may send
+    b.transition("begin", label="power on", inputs=["i"],
+                 outputs=[*(module.agent.id("start") for module in chained), *slots, sniffer.id("start")])
+    if algorithm == 2:
+        b.transition(f"drain_{last}", label="a frame for nobody leaves the bus", action="bus.drain",
+                     params={"box": void[0]}, inputs=[void[0]], outputs=[void[1]])
+    net = b.build()
+    net.set_final_marking({"o": 1})
+    return net
 
 
 def main(argv: list[str] | None = None) -> None:
     """Write the shipped nets (``nets/bus/``)."""
+    from petriflow.io.yaml import dumps_net
+
     parser = argparse.ArgumentParser(description="write seed 002's nets")
     parser.add_argument("--out", default="nets/bus")
     args = parser.parse_args(argv)
     out = Path(args.out)
     for algorithm in (1, 2):
-        name = f"bus-algorithm{algorithm}-3.yaml"
-        (out / name).write_text("# Generated by python -m petriflow.agents.bus.nets; the run configuration is"
-                                f" run.yaml.\nrun: run.yaml\n{build(3, algorithm)}")
+        net = build(3, algorithm)
+        net.run = "run.yaml"
+        head = "# Generated by python -m petriflow.agents.bus.nets; the run configuration is run.yaml.\n"
+        (out / f"{net.id}.yaml").write_text(head + dumps_net(net))
     print(f"wrote the nets under {out}")
 
 

@@ -21,9 +21,9 @@ __all__ = ["CHANNEL_MODELS", "register"]
 
 #: Channel model names and their classes.
 CHANNEL_MODELS = {
-    "bus.serial": "petriflow.agents.bus.medium:SerialBus",
-    "bus.can": "petriflow.agents.bus.medium:CanBus",
-    "bus.zigbee": "petriflow.agents.bus.medium:ZigbeeBus",
+    "bus.serial": "petriflow.agents.bus.parameters:SerialBus",
+    "bus.can": "petriflow.agents.bus.parameters:CanBus",
+    "bus.zigbee": "petriflow.agents.bus.parameters:ZigbeeBus",
 }
 
 

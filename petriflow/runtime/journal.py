@@ -100,7 +100,7 @@ def _difference(journaled: str, event: Event) -> str:
     """
     try:
         before = json.loads(journaled)
-    except (ValueError, TypeError):  # not JSON, or not even text (a damaged file's NULL)
+    except (TypeError, ValueError):  # not text (a damaged row holds NULL or a number), or not JSON
         return "the journaled line is not an event"
     now = json.loads(event.to_json())
     found: list[str] = []

@@ -7,7 +7,7 @@ import random
 
 import pytest
 from petriflow.agents.bus.errors import BusError
-from petriflow.agents.bus.medium import CanBus, SerialBus, ZigbeeBus
+from petriflow.agents.bus import CanBus, SerialBus, ZigbeeBus
 
 from petriflow.errors import NetFormatError
 from petriflow.io.yaml import loads_net
@@ -120,7 +120,7 @@ def test_a_multicast_group_is_one_frame_read_by_each_receiver_when_it_reads():
     bus.send(Message("box_a_c", "a", "c", {"n": "c", **group}, 0.0, 9))
     clock.run(until=0.01)
     [frame] = bus.state.transmissions
-    assert frame.frame.receivers == (bus._carrier.numbers["b"], bus._carrier.numbers["c"])
+    assert frame.frame.receivers == (bus.carrier.numbers["b"], bus.carrier.numbers["c"])
     assert fates == [("delivered", "b", pytest.approx(SERIAL_FRAME)),
                      ("delivered", "c", pytest.approx(0.005))]
 

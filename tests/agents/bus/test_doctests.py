@@ -8,7 +8,8 @@ import importlib
 
 import pytest
 
-MODULES = ["errors", "frames", "packet", "radio", "medium", "channel", "cpg", "algorithms", "addressing", "plugin"]
+MODULES = ["errors", "frames", "packet", "radio", "records", "buffer", "parameters", "rs485", "can", "zigbee",
+           "network", "simulator", "channel", "nets", "cpg", "algorithms", "addressing", "plugin"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -8,7 +8,7 @@ import random
 import pytest
 from petriflow.agents.bus.errors import BusError
 from petriflow.agents.bus.frames import FrameError
-from petriflow.agents.bus.medium import BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
+from petriflow.agents.bus import BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
 from petriflow.runtime.kernel import Kernel
 from petriflow.runtime.media import ProcessClock
 

@@ -9,10 +9,10 @@ import yaml
 from petriflow import examples
 from petriflow.agents.bus.chain import front_is_free
 from petriflow.agents.bus.firmware import Module
-from petriflow.agents.bus.nets import build
+from petriflow.agents.bus.nets import build, main
 from petriflow.analysis import check_net
 from petriflow.io import load_net
-from petriflow.io.yaml import loads_net
+from petriflow.io.yaml import dumps_net, loads_net
 from petriflow.runtime.config import RunConfig
 from petriflow.testing import fire_one
 from petriflow.world import World
@@ -23,14 +23,36 @@ CAN = RunConfig(channels={"bus": {"model": "bus.can", "on_loss": "notify"}}, dt=
 @pytest.mark.parametrize("modules", [2, 3, 4])
 @pytest.mark.parametrize("algorithm", [1, 2])
 def test_nets_are_sound(modules, algorithm):
-    result = check_net(loads_net(build(modules, algorithm)))
+    result = check_net(build(modules, algorithm))
     assert result["workflow_net"] and result["sound"], result["violations"]
 
 
-def test_shipped_nets_are_the_builders():
+def test_shipped_nets_are_what_the_builder_writes(tmp_path):
+    """``python -m petriflow.agents.bus.nets`` writes the shipped nets: the same net, in
+    the same order, with the same run configuration."""
+    main(["--out", str(tmp_path)])
     for algorithm in (1, 2):
-        shipped = load_net(examples.path("bus", f"bus-algorithm{algorithm}-3.yaml"))
-        assert shipped.structure() == loads_net("run: run.yaml\n" + build(3, algorithm)).structure()
+        name = f"bus-algorithm{algorithm}-3.yaml"
+        shipped, written = load_net(examples.path("bus", name)), load_net(tmp_path / name)
+        assert dumps_net(written) == dumps_net(shipped) and written.run == shipped.run == "run.yaml"
+        assert list(written.places) == list(shipped.places) and list(written.arcs) == list(shipped.arcs)
+
+
+@pytest.mark.parametrize("algorithm", [1, 2])
+def test_a_built_net_reads_back_from_yaml_as_itself(algorithm):
+    net = build(4, algorithm)
+    again = loads_net(dumps_net(net))
+    assert dumps_net(again) == dumps_net(net) and list(again.transitions) == list(net.transitions)
+    assert again.initial_marking == net.initial_marking and again.final_marking == net.final_marking
+
+
+def test_changing_one_transitions_params_leaves_the_others_alone():
+    """A sweep may set a nested parameter of one transition: no other transition shares it."""
+    net = build(3, 2)
+    net.transitions["m1_send"].params["boxes"]["+1"] = "elsewhere"
+    net.transitions["m1_boot"].params["chain"].append("m4")
+    assert net.transitions["m1_send_overflow"].params["boxes"] == {"+1": "box_m1_m2"}
+    assert net.transitions["m2_boot"].params["chain"] == ["m1", "m2", "m3"]
 
 
 def test_builder_refuses_nonsense():
@@ -46,7 +68,7 @@ def _boot(net, name, config=CAN, world=None, seed=0):
 
 
 def test_algorithm_1_waits_its_delay_then_sends_one_frame_to_both_neighbours():
-    net = loads_net(build(3, 1))
+    net = build(3, 1)
     module = _boot(net, "m2")
     assert isinstance(module, Module) and module.address == 1 and 0.0 <= module.scheme.delay <= 1.0
     before = module.oscillator.phase
@@ -64,7 +86,7 @@ def test_algorithm_1_waits_its_delay_then_sends_one_frame_to_both_neighbours():
 
 
 def test_algorithm_2_sends_to_the_next_address_only_and_the_tail_to_nobody():
-    net = loads_net(build(3, 2))
+    net = build(3, 2)
     head = fire_one(net, "m1_boot", tokens={"m1_start": [None]}, config=CAN).tokens["m1_watch"][0]
     sent = fire_one(net, "m1_send", config=CAN, tokens={"m1_tx": [head], "slot_m1_m2": [None]})
     assert [e.data["place"] for e in sent.events if e.kind == "message"][0] == "box_m1_m2"
@@ -74,7 +96,7 @@ def test_algorithm_2_sends_to_the_next_address_only_and_the_tail_to_nobody():
 
 
 def test_bus_available_comes_after_a_random_quiet_time_and_overflow_sends_half_the_time():
-    net = loads_net(build(3, 2))
+    net = build(3, 2)
     module = fire_one(net, "m1_boot", tokens={"m1_start": [None]}, config=CAN).tokens["m1_watch"][0]
     available = fire_one(net, "m1_available", tokens={"m1_watch": [module]}, config=CAN)
     assert available.outcome == "ok" and 0.0 < available.time <= 3.0 + 0.003
@@ -91,7 +113,7 @@ def test_bus_available_comes_after_a_random_quiet_time_and_overflow_sends_half_t
 
 
 def test_reception_keeps_a_neighbours_phase_and_counts_a_lost_frame():
-    net = loads_net(build(3, 1))
+    net = build(3, 1)
     m2 = _boot(net, "m2")
     from petriflow.agents.bus.packet import Packet, encode
 
@@ -114,12 +136,12 @@ def test_a_middle_modules_message_is_one_frame_read_by_both_neighbours_at_their_
     from petriflow.runtime.scheduler import Scheduler
 
     config = RunConfig(channels={"bus": {"model": "bus.can", "on_loss": "notify", "logs": True}}, dt=0.002)
-    scheduler = Scheduler(loads_net(build(3, 1, messages=3)), config=config, seed=3)
+    scheduler = Scheduler(build(3, 1, messages=3), config=config, seed=3)
     events = []
     scheduler.on_event(events.append)
     assert scheduler.run(until=60).reason == "final"
     medium = scheduler.channels.models["bus"].state
-    carrier = scheduler.channels.models["bus"]._carrier
+    carrier = scheduler.channels.models["bus"].carrier
     by_number = {number: agent for agent, number in carrier.numbers.items()}
     frames = [(by_number[t.frame.sender], sorted(by_number[r] for r in t.frame.receivers))
               for t in medium.transmissions]
@@ -135,7 +157,7 @@ def test_a_middle_modules_message_is_one_frame_read_by_both_neighbours_at_their_
 
 def test_a_module_tells_the_bus_its_read_period_through_its_view():
     """bus.boot asks the bus through ctx.medium: the module reads every step (algorithm 2)."""
-    net = loads_net(build(3, 2))
+    net = build(3, 2)
     from petriflow.runtime.scheduler import Scheduler
 
     scheduler = Scheduler(net, config=CAN, seed=1)
@@ -155,7 +177,7 @@ def test_whole_runs_end_at_the_final_marking_with_every_message_counted(tmp_path
 
     for algorithm in (1, 2):
         events = []
-        scheduler = Scheduler(loads_net(build(3, algorithm, messages=8)), config=CAN, seed=2)
+        scheduler = Scheduler(build(3, algorithm, messages=8), config=CAN, seed=2)
         scheduler.on_event(events.append)
         result = scheduler.run(until=300)
         assert result.reason == "final"

@@ -8,9 +8,8 @@ import pytest
 
 from petriflow import run
 from petriflow.agents.bus import metrics
-from petriflow.agents.bus.medium import BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
+from petriflow.agents.bus import BusSimulator, CanBus, Frame, Loss, SerialBus, ZigbeeBus
 from petriflow.agents.bus.nets import build
-from petriflow.io.yaml import loads_net
 
 
 def frame(sender, receivers=(1,), data=bytes(8), tag=None):
@@ -88,7 +87,7 @@ def test_a_relay_whose_table_is_full_drops_the_broadcast_for_its_module():
     for k in range(8):
         sim.send(0.05 * k, frame(2, (1,), tag=k))   # fills every table with module 2's broadcasts
     medium = sim.run(until=1.5)
-    medium._btt[0].clear()                          # module 0's radio restarts: an empty table
+    medium.table(0).clear()                        # module 0's radio restarts: an empty table
     sim.send(1.6, frame(0, (1, 2), tag="new"))
     medium = sim.run()
     lost = [(loss.module, loss.reason) for loss in medium.losses if loss.frame.tag == "new"]
@@ -128,7 +127,7 @@ def test_an_end_device_sends_through_its_parent():
 # Whole runs: power-up in step, reception models, the sniffer's count ------------------------
 
 def _run(bus, algorithm, seed=1, **boot):
-    net = loads_net(build(3, algorithm, messages=20))
+    net = build(3, algorithm, messages=20)
     for k in (1, 2, 3):
         net.transitions[f"m{k}_boot"].params.update(boot)
     config = {"channels": {"bus": {"model": f"bus.{bus}", "on_loss": "notify"}}, "dt": 0.002, "until": 300}
