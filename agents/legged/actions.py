@@ -37,6 +37,7 @@ from petriflow.agents.legged.control import LeggedRobot, NotLeggedError
 from petriflow.agents.legged.gait import GaitError, gait_for
 from petriflow.agents.legged.righting import BACK_TILT, brace_point, lying_on, righting_motion
 
+from petriflow.capabilities import Bodies, Physics
 from petriflow.errors import NetFormatError
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
 
@@ -79,9 +80,10 @@ class _LeggedAction(Action):
 
     needs_world = True
     requires = frozenset({"world", "robot"})
+    uses = (Physics, Bodies)
 
     def setup(self, world: Any) -> None:
-        if world is None or not hasattr(world, "p"):
+        if world is None:
             raise ActionFailure(f"{type(self).__name__} needs a pybullet world (run with --world)")
         self.world = world
         self.robots: dict[str, LeggedRobot] = {}
