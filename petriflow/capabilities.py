@@ -12,7 +12,8 @@ it checks parameters and places, so an action never probes its world with
 capability               what the action may use                                                 :class:`~petriflow.world.World`
 =======================  ======================================================================  ===============================
 :class:`Distances`       ``distance``                                                            yes
-:class:`Poses`           ``pose``, ``position`` (and ``distance``)                               yes
+:class:`Positions`       ``position`` (and ``distance``)                                         yes
+:class:`Poses`           ``pose`` (and ``position``, ``distance``)                               yes
 :class:`Bodies`          ``bodies``, ``agents``, ``body``, ``remove``                            yes
 :class:`RayTests`        ``rays``, ``request_rays``, ``flush_sensors``                           yes
 :class:`Cameras`         ``cameras``, ``camera``                                                 yes
@@ -45,7 +46,7 @@ from __future__ import annotations
 
 from typing import Any, Protocol, runtime_checkable
 
-__all__ = ["Stepped", "Distances", "Poses", "Bodies", "RayTests", "Cameras", "KinematicDrive", "Physics", "Described",
+__all__ = ["Stepped", "Distances", "Positions", "Poses", "Bodies", "RayTests", "Cameras", "KinematicDrive", "Physics", "Described",
            "PoseArrays", "missing", "provides", "name_of", "CAPABILITIES"]
 
 
@@ -69,14 +70,20 @@ class Distances(Protocol):
 
 
 @runtime_checkable
-class Poses(Distances, Protocol):
-    """Where bodies and agents' robots are (and so how far apart: :class:`Distances`)."""
-
-    def pose(self, name: str) -> tuple[float, float, float]:
-        """``(x, y, yaw)`` of a body or an agent's robot."""
+class Positions(Distances, Protocol):
+    """Where agents' robots stand on the ground (and so how far apart: :class:`Distances`)."""
 
     def position(self, agent: str) -> tuple[float, float] | None:
         """``(x, y)`` of an agent's robot, ``None`` if the agent has no body."""
+
+
+@runtime_checkable
+class Poses(Positions, Protocol):
+    """Where bodies and agents' robots are, and which way they face (and where they
+    stand: :class:`Positions`)."""
+
+    def pose(self, name: str) -> tuple[float, float, float]:
+        """``(x, y, yaw)`` of a body or an agent's robot."""
 
 
 @runtime_checkable
@@ -181,7 +188,7 @@ class PoseArrays(Protocol):
 
 #: The capabilities an action may declare, with the words errors use for them.
 CAPABILITIES: dict[type, str] = {
-    Stepped: "steps", Distances: "distances", Poses: "poses", Bodies: "bodies", RayTests: "ray tests", Cameras: "cameras",
+    Stepped: "steps", Distances: "distances", Positions: "positions", Poses: "poses", Bodies: "bodies", RayTests: "ray tests", Cameras: "cameras",
     KinematicDrive: "kinematic drive", Physics: "physics", Described: "world file", PoseArrays: "pose arrays",
 }
 

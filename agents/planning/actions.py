@@ -59,6 +59,7 @@ from petriflow.agents.planning.maps import (
     robot_label,
 )
 from petriflow.agents.planning.tracking import check_track
+from petriflow.capabilities import Poses, Positions, provides
 from petriflow.runtime.action import Action, ActionContext, InstantAction, Param, Port, Status
 
 __all__ = ["PlanPath", "TrackPath", "plan_world_path", "scene_frame", "find_scene"]
@@ -310,10 +311,13 @@ class TrackPath(InstantAction):
                 if pose is not None:
                     return _point(pose, "pose")
         world = ctx.world
-        for method in ("pose", "position"):
-            if world is not None and hasattr(world, method) and robot is not None:
+        # a world is optional (tokens may carry the pose): its pose, else its position, if it has them
+        reads = [world.pose] if provides(world, Poses) else []
+        reads += [world.position] if provides(world, Positions) else []
+        if robot is not None:
+            for read in reads:
                 try:
-                    found = getattr(world, method)(robot)
+                    found = read(robot)
                 except Exception as exc:  # a world that does not know the body
                     raise PlanningError(f"cannot read the pose of {robot!r}: {exc}") from None
                 if found is not None:

@@ -103,6 +103,24 @@ class RunRecord:
         scheduler). A metric reads a scenario's settings here, not in ``world.meta``."""
         return {} if self.scheduler is None else self.scheduler.settings
 
+    def section(self, section: Any) -> dict[str, Any]:
+        """The values of the declared settings ``section`` (a
+        :class:`~petriflow.runtime.settings.Section`) for this run: as the run read them
+        (:attr:`settings`), else read now from the record's world file (a record made by
+        hand from a run's outcome and its world), else its defaults.
+
+        Raises:
+            NetFormatError: the world's settings do not check (``file:line``).
+        """
+        if section.name in self.settings:
+            return dict(self.settings[section.name])
+        from petriflow.capabilities import Described, provides
+        from petriflow.runtime.settings import read_settings
+
+        world = self.world if provides(self.world, Described) else None
+        meta = None if world is None else world.meta
+        return read_settings(meta, {section.name: section}, path=None if world is None else world.path)[section.name]
+
     @property
     def tokens(self) -> dict[str, list[Any]]:
         """``{place: [data, ...]}`` at the end."""

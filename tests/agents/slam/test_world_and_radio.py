@@ -103,6 +103,7 @@ class _Place:
     def __init__(self, positions):
         self.positions = positions
         self.meta = {"slam": {"nodes": [[0.0, 0.0], [20.0, 0.0]]}}
+        self.path = None  # a world described in code (capabilities.Described)
 
     def position(self, name):
         return self.positions.get(name)
