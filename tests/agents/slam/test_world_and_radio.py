@@ -108,6 +108,9 @@ class _Place:
     def position(self, name):
         return self.positions.get(name)
 
+    def distance(self, a, b):  # with position: what capabilities.Positions names
+        return math.dist(self.positions[a], self.positions[b])
+
 
 def test_the_channel_delivers_near_loses_far_and_reaches_the_central_unit_by_the_nodes():
     import random
