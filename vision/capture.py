@@ -133,7 +133,9 @@ class Capture(Action):
                                           self.params["height"])
             except (ValueError, PetriflowError) as exc:  # unknown camera, bad size
                 raise ActionFailure(str(exc)) from None
-        ctx.result = Frame.of(self._camera.capture(), self._camera)
+        with ctx.stopwatch.measure("render", keep=True):
+            image = self._camera.capture()
+        ctx.result = Frame.of(image, self._camera)
 
     def poll(self, ctx: ActionContext) -> Status:
         return Status.OK

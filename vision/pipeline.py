@@ -318,7 +318,8 @@ class Locate(Action):
         config = VisionConfig(mode_filter=self.params["mode_filter"], marker_z=self.params["marker_z"],
                               robot_side=self.params["robot_side"])
         try:
-            scene = process(frame, camera, config)
+            with ctx.stopwatch.measure("vision", keep=True):
+                scene = process(frame, camera, config)
         except ValueError as exc:
             raise ActionFailure(str(exc)) from None
         ctx.result = scene

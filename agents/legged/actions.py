@@ -40,6 +40,7 @@ from petriflow.agents.legged.righting import BACK_TILT, brace_point, lying_on, r
 from petriflow.capabilities import Bodies, Physics
 from petriflow.errors import NetFormatError
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+from petriflow.runtime.stopwatch import timed
 
 __all__ = ["Brace", "StandUp", "Turn", "Walk"]
 
@@ -206,6 +207,7 @@ class Walk(_LeggedAction):
             route.append(("face", self.params["heading"]))
         return route
 
+    @timed("control")
     def poll(self, ctx: ActionContext) -> Status:
         robot = self.robot
         self._track_yaw()
@@ -451,6 +453,7 @@ class StandUp(_LeggedAction):
         self.attempts += 1
         self.steps = list(righting_motion(robot.design, side))
 
+    @timed("control")
     def poll(self, ctx: ActionContext) -> Status:
         if self.wait > 0:
             self.wait -= self.dt

@@ -43,6 +43,7 @@ from petriflow.vision.capture import Capture as _VisionCapture
 from petriflow.capabilities import Bodies, Cameras, Physics, Poses
 from petriflow.errors import NetFormatError
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Port, Status
+from petriflow.runtime.stopwatch import timed
 
 __all__ = [
     "Avoid",
@@ -425,8 +426,9 @@ class Follow(Walk):
         position = self._pose_seen(ctx)
         if position is None:
             return
-        decision = check_track(self.path, position, step=self.step, radius=self.params["radius"],
-                               reach=self.reach)
+        with ctx.stopwatch.measure("planning"):
+            decision = check_track(self.path, position, step=self.step, radius=self.params["radius"],
+                                   reach=self.reach)
         record = {"t": round(ctx.now, 4), "decision": decision.kind.value, "dc": round(decision.distance, 4),
                   "position": [round(v, 4) for v in position]}
         if decision.point is not None:
@@ -454,6 +456,7 @@ class Follow(Walk):
         orders = ctx.latest("orders")
         return orders.get(self.colour) if isinstance(orders, Mapping) else None
 
+    @timed("control")
     def poll(self, ctx: ActionContext) -> Status:
         if self._holding is not None:
             order = self._orders(ctx)

@@ -115,11 +115,10 @@ class RunRecord:
         if section.name in self.settings:
             return dict(self.settings[section.name])
         from petriflow.capabilities import Described, provides
-        from petriflow.runtime.settings import read_settings
 
-        world = self.world if provides(self.world, Described) else None
-        meta = None if world is None else world.meta
-        return read_settings(meta, {section.name: section}, path=None if world is None else world.path)[section.name]
+        if not provides(self.world, Described):
+            return section.read(None)
+        return section.read((self.world.meta or {}).get(section.name), path=self.world.path)
 
     @property
     def tokens(self) -> dict[str, list[Any]]:
