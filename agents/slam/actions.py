@@ -285,6 +285,7 @@ class Install(Action):
     agent_state = Robot
     needs_world = False
     resources = {"air": AIR}
+    uses = (Physics, Bodies)  # the WA's box is put down where the RA stands
     params = {
         "index": Param(int, 1, "the installation number", low=1),
         "wa": Param(str, doc="the WA (its agent, and its box in the world)"),
