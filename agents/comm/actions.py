@@ -40,8 +40,8 @@ from typing import Any
 from petriflow.agents.comm.agent import CommAgent, Peer, vertex_id
 from petriflow.agents.comm.framework import History, addresses, dhcp_pools, dpp, grid_position, grid_size
 from petriflow.agents.comm.radio import RadioChannel, pick_threshold, threshold_sweep
-
 from petriflow.agents.mobile.maze import MAZE
+
 from petriflow.capabilities import Bodies, Physics, Positions, provides
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 from petriflow.runtime.resources import LIVENESS, Liveness
