@@ -89,6 +89,7 @@ from petriflow.runtime.registry import Registry
 from petriflow.runtime.resources import Liveness, ResourceContext, Resources
 from petriflow.runtime.result import RunResult
 from petriflow.runtime.services import RunServices
+from petriflow.runtime.stopwatch import UNTIMED, Timing
 from petriflow.runtime.tokens import TokenStore
 from petriflow.runtime.trace import EventKind
 from petriflow.runtime.validation import UNKNOWN, settings_of, validate
@@ -122,6 +123,9 @@ class Scheduler:
         settings: the world file's settings the actions read, checked
             (:class:`~petriflow.runtime.validation.CheckedRun`); default: read from the
             world's ``meta`` (:func:`~petriflow.runtime.validation.settings_of`).
+        stopwatch: what the actions report their work's wall-clock time to
+            (``ctx.stopwatch``; :mod:`~petriflow.runtime.stopwatch`); give the clock
+            the same one to time the world's steps.
 
     Raises:
         NetFormatError: an action, parameter, port or guard does not bind; a fault or
@@ -132,7 +136,8 @@ class Scheduler:
     @paused()  # indexing a large net makes no cycles (petriflow.collector)
     def __init__(self, net: Net, *, world: Any = None, config: RunConfig | dict | None = None, seed: int | None = None,
                  registry: Registry | None = None, path: str | None = None, binding: Binding | None = None,
-                 clock: Clock | None = None, settings: Mapping[str, Mapping[str, Any]] | None = None) -> None:
+                 clock: Clock | None = None, settings: Mapping[str, Mapping[str, Any]] | None = None,
+                 stopwatch: Timing = UNTIMED) -> None:
         self.net = net
         self.world = world
         self.config = config = RunConfig.from_dict(config) if isinstance(config, dict) else config or RunConfig()
@@ -164,7 +169,7 @@ class Scheduler:
         self.resources = Resources(self.registry, ResourceContext(world, Liveness(faults.alive, index.agents), config,
                                                                   self.settings))
         services = RunServices(agents=agents, tokens=tokens, channels=self.channels, resources=self.resources,
-                               liveness=faults, settings=self.settings)
+                               liveness=faults, settings=self.settings, stopwatch=stopwatch)
         self.firer = Firer(net, index, kernel, tokens, enabled, recorder=recorder, agents=agents,
                            channels=self.channels, services=services, world=world, seed=seed, running=running)
         self.runner = self.firer.runner

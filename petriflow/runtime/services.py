@@ -13,6 +13,7 @@ service                   used by                         made by the run as
 ``resources``             ``ctx.resource``                :class:`~.resources.Resources`
 ``liveness``              ``ctx.running``                 :class:`~.faults.Faults`
 ``settings``              ``ctx.settings``                the world file's checked settings
+``stopwatch``             ``ctx.stopwatch``               where wall-clock time goes (:mod:`~.stopwatch`)
 ========================  ==============================  =================================
 
 Each service is a small protocol here, so an action (and a test that makes a context
@@ -32,6 +33,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Protocol
+
+from petriflow.runtime.stopwatch import UNTIMED, Timing
 
 __all__ = ["RunServices", "AgentStates", "PortReader", "ChannelLookup", "ResourceSource", "AgentLiveness"]
 
@@ -93,6 +96,8 @@ class RunServices:
         liveness: which agents run now.
         settings: ``{section: {name: value}}``, the world file's settings the bound
             actions declare, checked (:mod:`petriflow.settings`).
+        stopwatch: what the actions report their work's wall-clock time to
+            (:data:`~petriflow.runtime.stopwatch.UNTIMED`: a run nobody times).
     """
 
     agents: AgentStates | None = None
@@ -101,3 +106,4 @@ class RunServices:
     resources: ResourceSource | None = None
     liveness: AgentLiveness | None = None
     settings: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    stopwatch: Timing = UNTIMED

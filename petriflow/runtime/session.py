@@ -57,6 +57,7 @@ from petriflow.runtime.observers import Progress, run_observed
 from petriflow.runtime.outputs import check_outputs, make_folders
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.result import RunResult
+from petriflow.runtime.stopwatch import Timing
 from petriflow.runtime.summary import RunExtras, extras_for
 from petriflow.runtime.trace import read_trace
 from petriflow.runtime.validation import UNKNOWN, CheckedRun, check_run, validate
@@ -122,11 +123,12 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
 
 def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | None, trace: Path | None,
              xes: Path | None, realtime: bool, gui: bool, progress: bool | float, max_firings: int | None,
-             keep_events: bool = False, extras: RunExtras | None = None) -> RunResult:
+             keep_events: bool = False, extras: RunExtras | None = None,
+             stopwatch: Timing | None = None) -> RunResult:
     """Put the checked run together and run it with its observers (step 3 and 4)."""
     extras = extras or RunExtras()
     keep = keep_events or extras.needs_events()
-    with open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime) as scheduler:
+    with open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime, stopwatch=stopwatch) as scheduler:
         if inputs.get("poses"):  # the world's body poses as trace events (petriflow.runtime.poses)
             from petriflow.runtime.poses import PoseSampler
 
@@ -175,7 +177,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
               xes: str | Path | None = None, db: str | Path | None = None, realtime: bool = False,
               gui: bool = False, registry: Registry | None = None, progress: bool | float = False,
               max_firings: int | None = None, keep_events: bool = False, metrics: list[str] | None = None,
-              picture: str | Path | None = None, poses: float | None = None) -> RunResult:
+              picture: str | Path | None = None, poses: float | None = None,
+              stopwatch: Timing | None = None) -> RunResult:
     """Run the net in ``net_path`` (what ``petriflow run`` does).
 
     The run configuration is ``config``, else the one the net names, else
@@ -187,6 +190,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     robots' trajectories at the end (see :mod:`petriflow.runtime.summary`). ``poses``:
     record the world's body poses as ``pose`` events every so many simulated seconds
     (:mod:`petriflow.runtime.poses`; what ``petriflow view`` draws the world from).
+    ``stopwatch``: where the run's wall-clock time goes, by category (the world's
+    steps as ``physics``, what the actions measure: :mod:`petriflow.runtime.stopwatch`).
 
     Raises:
         NetFormatError: a file is missing or malformed, an action is unknown...
@@ -215,7 +220,7 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     try:
         return _execute(checked, inputs, journal=journal, trace=None if trace is None else Path(trace),
                         xes=None if xes is None else Path(xes), realtime=realtime, gui=gui, progress=progress,
-                        max_firings=max_firings, keep_events=keep_events, extras=extras)
+                        max_firings=max_firings, keep_events=keep_events, extras=extras, stopwatch=stopwatch)
     except BaseException:
         if journal is not None and journal.journaled == 0:  # it never started: leave no journal behind
             journal.close()
