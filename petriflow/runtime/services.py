@@ -13,6 +13,7 @@ service                   used by                         made by the run as
 ``resources``             ``ctx.resource``                :class:`~.resources.Resources`
 ``liveness``              ``ctx.running``                 :class:`~.faults.Faults`
 ``settings``              ``ctx.settings``                the world file's checked settings
+``remote``                remote actions (the bridge)     :class:`~petriflow.bridge.dispatcher.Dispatcher`
 ========================  ==============================  =================================
 
 Each service is a small protocol here, so an action (and a test that makes a context
@@ -33,7 +34,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Protocol
 
-__all__ = ["RunServices", "AgentStates", "PortReader", "ChannelLookup", "ResourceSource", "AgentLiveness"]
+__all__ = ["RunServices", "AgentStates", "PortReader", "ChannelLookup", "ResourceSource", "AgentLiveness",
+           "RemoteGoals"]
 
 
 class AgentStates(Protocol):
@@ -78,6 +80,24 @@ class AgentLiveness(Protocol):
         """Whether ``agent`` runs now (not killed, not waiting to join)."""
 
 
+class RemoteGoals(Protocol):
+    """Where goals for agents outside the run's process go (:mod:`petriflow.bridge`)."""
+
+    run: str
+
+    def send(self, goal: Any) -> Any:
+        """Send a goal (again, with the same id, if it was sent before)."""
+
+    def goal(self, goal_id: str) -> Any:
+        """What is known of the goal ``goal_id`` (``None``: never sent)."""
+
+    def cancel(self, goal_id: str) -> None:
+        """Ask its agent to stop the goal ``goal_id``."""
+
+    def is_lost(self, agent: str) -> bool:
+        """Whether the remote ``agent`` stopped answering."""
+
+
 @dataclass(frozen=True, eq=False)
 class RunServices:
     """The services of one run that its actions' contexts reach (see the module).
@@ -93,6 +113,7 @@ class RunServices:
         liveness: which agents run now.
         settings: ``{section: {name: value}}``, the world file's settings the bound
             actions declare, checked (:mod:`petriflow.settings`).
+        remote: where goals for remote agents go (a run with a ``bridge:``).
     """
 
     agents: AgentStates | None = None
@@ -101,3 +122,4 @@ class RunServices:
     resources: ResourceSource | None = None
     liveness: AgentLiveness | None = None
     settings: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    remote: RemoteGoals | None = None

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import time as wallclock
 import warnings
+from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -122,11 +123,27 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
 
 def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | None, trace: Path | None,
              xes: Path | None, realtime: bool, gui: bool, progress: bool | float, max_firings: int | None,
-             keep_events: bool = False, extras: RunExtras | None = None) -> RunResult:
-    """Put the checked run together and run it with its observers (step 3 and 4)."""
+             keep_events: bool = False, extras: RunExtras | None = None,
+             wait_agents: float | None = None) -> RunResult:
+    """Put the checked run together and run it with its observers (step 3 and 4); a
+    configuration with a ``bridge:`` connects to its remote agents first
+    (:mod:`petriflow.bridge.orchestrator`; ``wait_agents``: seconds to wait for them)."""
     extras = extras or RunExtras()
     keep = keep_events or extras.needs_events()
-    with open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime) as scheduler:
+    with ExitStack() as stack:
+        remote, clock = None, None
+        spec = checked.config.bridge
+        if spec is not None:  # remote agents: connected and checked first, then in wall-clock time
+            from petriflow.bridge.orchestrator import AgentWatch, open_bridge
+            from petriflow.runtime.clock import RealtimeClock
+
+            remote = stack.enter_context(open_bridge(checked.binding, spec, wait=wait_agents,
+                                                     path=None if checked.path is None else str(checked.path)))
+            clock = RealtimeClock()
+        scheduler = stack.enter_context(open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime,
+                                                 clock=clock, remote=remote))
+        if remote is not None:
+            scheduler.on_instant(AgentWatch(remote, checked.net, spec))
         if inputs.get("poses"):  # the world's body poses as trace events (petriflow.runtime.poses)
             from petriflow.runtime.poses import PoseSampler
 
@@ -175,7 +192,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
               xes: str | Path | None = None, db: str | Path | None = None, realtime: bool = False,
               gui: bool = False, registry: Registry | None = None, progress: bool | float = False,
               max_firings: int | None = None, keep_events: bool = False, metrics: list[str] | None = None,
-              picture: str | Path | None = None, poses: float | None = None) -> RunResult:
+              picture: str | Path | None = None, poses: float | None = None,
+              wait_agents: float | None = None) -> RunResult:
     """Run the net in ``net_path`` (what ``petriflow run`` does).
 
     The run configuration is ``config``, else the one the net names, else
@@ -187,6 +205,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     robots' trajectories at the end (see :mod:`petriflow.runtime.summary`). ``poses``:
     record the world's body poses as ``pose`` events every so many simulated seconds
     (:mod:`petriflow.runtime.poses`; what ``petriflow view`` draws the world from).
+    ``wait_agents``: seconds to wait for a bridged run's remote agents (default: the
+    configuration's ``bridge: wait``).
 
     Raises:
         NetFormatError: a file is missing or malformed, an action is unknown...
@@ -215,7 +235,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     try:
         return _execute(checked, inputs, journal=journal, trace=None if trace is None else Path(trace),
                         xes=None if xes is None else Path(xes), realtime=realtime, gui=gui, progress=progress,
-                        max_firings=max_firings, keep_events=keep_events, extras=extras)
+                        max_firings=max_firings, keep_events=keep_events, extras=extras,
+                        wait_agents=wait_agents)
     except BaseException:
         if journal is not None and journal.journaled == 0:  # it never started: leave no journal behind
             journal.close()
