@@ -1,0 +1,178 @@
+"""Runs whose subnets execute on remote agents, over a real broker or router on loopback."""
+
+import json
+import textwrap
+
+import pytest
+
+from petriflow.bridge import protocol
+from petriflow.bridge.transport import Endpoint, from_agent, open_transport, to_agent
+from petriflow.errors import NetFormatError
+from petriflow.runtime.session import run_files
+
+NET = """\
+petriflow: 1
+net: relay
+subnets:
+  - id: r1
+    agent: r1
+    places: [{id: a, tokens: 1}, b]
+    transitions:
+      - {id: go, action: core.wait, params: {seconds: 0.2}, in: [a], out: [b]}
+      - {id: mark, action: core.set, params: {value: {x: 1}}, in: [b], out: [c]}
+  - id: here
+    agent: here
+    places: []
+    transitions:
+      - {id: finish, action: core.wait, params: {seconds: 0.1}, in: [c], out: [o]}
+places: [c, o, broken]
+final: {o: 1}
+"""
+
+
+def write(folder, kind, connect, net=NET, **bridge):
+    spec = {"transport": kind, "connect": connect, "agents": {"r1": "robot1"}, "wait": 10, **bridge}
+    (folder / "net.yaml").write_text(net)
+    (folder / "run.yaml").write_text(f"seed: 1\nbridge: {json.dumps(spec)}\n")
+    return folder / "net.yaml"
+
+
+def test_a_bridged_run_reaches_its_final_marking_with_the_agents_data(middleware, serve, tmp_path):
+    """The remote subnet's firings run on the agent; their data reaches the local transition; the
+    trace names the agent and the round trip of each remote firing."""
+    kind, server = middleware
+    agent = serve(kind, server.connect, ["robot1"], heartbeat=0.1)
+    net = write(tmp_path, kind, server.connect)
+    result = run_files(net, trace=tmp_path / "t.jsonl")
+    assert result.reason == "final" and result.marking.to_dict() == {"o": 1}
+    assert result.tokens["o"] == [{"x": 1}]
+    events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+    remote = [e for e in events if e["kind"] == "custom" and e["data"]["name"] == "remote"]
+    assert [(e["transition"], e["data"]["data"]["agent"]) for e in remote] == [("go", "robot1"), ("mark", "robot1")]
+    assert all(e["data"]["data"]["round_trip_ms"] > 0 for e in remote)
+    assert remote[0]["data"]["data"]["round_trip_ms"] >= 200  # core.wait 0.2 s ran on the agent
+    assert agent.server.executed == 2
+
+
+def test_a_parameter_the_agent_does_not_take_fails_at_bind_time_with_the_line(broker, serve, tmp_path):
+    """An action only the agent knows is checked against what it announced: file:line, no run."""
+    serve("mqtt", broker.connect, ["robot1"], heartbeat=0.1)
+    net = write(tmp_path, "mqtt", broker.connect,
+                net=NET.replace("action: core.set, params: {value: {x: 1}}", "action: robot.blink, params: {}"))
+    with pytest.raises(NetFormatError, match=r"net.yaml:9: 'mark': remote agent 'robot1' does not serve action"
+                                             r" 'robot.blink'"):
+        run_files(net)
+    net = write(tmp_path, "mqtt", broker.connect, net=NET.replace("{seconds: 0.2}", "{secnds: 0.2}"))
+    with pytest.raises(NetFormatError, match=r"net.yaml:\d+: 'go': .*'secnds' \(did you mean 'seconds'\?\)"):
+        run_files(net)
+
+
+def test_an_agent_that_never_announces_itself_is_named(broker, tmp_path):
+    net = write(tmp_path, "mqtt", broker.connect, wait=0.3)
+    with pytest.raises(NetFormatError, match="remote agent 'robot1' did not announce itself within 0.3 s"):
+        run_files(net)
+
+
+def test_an_agent_executes_a_goal_sent_twice_once(middleware, serve, tmp_path):
+    """The same goal id again (a re-send after a reconnect) gets the same result, not a second execution."""
+    kind, server = middleware
+    agent = serve(kind, server.connect, ["robot1"], heartbeat=0.1)
+    client = open_transport(kind, Endpoint(server.connect), "test")
+    got = []
+    client.subscribe(from_agent("robot1"), lambda topic, data: got.append(protocol.decode(data)))
+    try:
+        import time
+
+        deadline = time.monotonic() + 10
+        while not any(isinstance(m, protocol.Announce) for m in got) and time.monotonic() < deadline:
+            time.sleep(0.02)
+        goal = protocol.encode(protocol.Goal("run/1/1", "robot1", "core.set", {"value": 3}, "t"))
+        for _ in range(3):
+            client.publish(to_agent("robot1"), goal)
+            time.sleep(0.1)
+        deadline = time.monotonic() + 5
+        while sum(isinstance(m, protocol.Result) for m in got) < 3 and time.monotonic() < deadline:
+            time.sleep(0.02)
+        results = [m for m in got if isinstance(m, protocol.Result)]
+        assert agent.server.executed == 1
+        assert len(results) == 3 and {(r.outcome, r.data) for r in results} == {("ok", 3)}
+    finally:
+        client.close()
+
+
+LOSABLE = NET.replace("in: [a], out: [b]}", "in: [a], out: [b], outcomes: {failed: [broken]}}").replace(
+    "{seconds: 0.2}", "{seconds: 30}").replace("final: {o: 1}", "final: {broken: 1}")
+
+
+@pytest.mark.slow
+def test_an_agent_killed_mid_action_fails_its_firing_within_the_timeout(middleware, tmp_path):
+    """The agent process is killed (SIGKILL) while its action runs: the firing ends failed within
+    heartbeat_timeout + 1 s, the net's failure route fires, the agent is recorded lost."""
+    import subprocess
+    import sys
+    import threading
+    import time
+
+    kind, server = middleware
+    agent = subprocess.Popen([sys.executable, "-m", "petriflow.cli", "agent", "--name", "robot1", "--transport",
+                              kind, "--connect", server.connect, "--heartbeat", "0.1"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        net = write(tmp_path, kind, server.connect, net=LOSABLE, heartbeat=0.1, heartbeat_timeout=1.0)
+        killed = []
+
+        def kill_when_running():
+            while not killed:
+                time.sleep(0.05)
+                if agent.poll() is not None:
+                    return
+                if (tmp_path / "started").exists():
+                    agent.kill()
+                    killed.append(time.monotonic())
+
+        threading.Thread(target=kill_when_running, daemon=True).start()
+
+        def mark(event):
+            if event.kind == "start" and event.transition == "go":
+                (tmp_path / "started").write_text("")
+
+        result = session_run(net, tmp_path, mark)
+        assert killed, "the agent was never killed"
+        noticed = result[1]
+        assert result[0].reason == "final" and result[0].marking.to_dict() == {"broken": 1}
+        assert noticed - killed[0] < 1.0 + 1.0
+        events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+        end = next(e for e in events if e["kind"] == "end" and e["transition"] == "go")
+        assert end["data"]["outcome"] == "failed" and "lost" in end["data"]["reason"]
+        assert any(e["kind"] == "fault" and e["data"]["fault"] == "lost" for e in events)
+    finally:
+        agent.kill()
+        agent.wait(timeout=10)
+
+
+def session_run(net, folder, on_event):
+    """Run ``net`` as run_files does, calling ``on_event`` for each event; ``(result, wall time of the
+    failed end)``."""
+    import time
+
+    from petriflow.bridge.orchestrator import AgentWatch, open_bridge
+    from petriflow.runtime.assembly import open_run
+    from petriflow.runtime.clock import RealtimeClock
+    from petriflow.runtime.loading import read_run
+    from petriflow.runtime.observers import run_observed
+    from petriflow.runtime.validation import check_run
+
+    checked = check_run(read_run(net))
+    ended = []
+
+    def watch(event):
+        on_event(event)
+        if event.kind == "end" and event.transition == "go":
+            ended.append(time.monotonic())
+
+    with open_bridge(checked.binding, checked.config.bridge) as remote, \
+            open_run(checked, clock=RealtimeClock(), remote=remote) as scheduler:
+        scheduler.on_instant(AgentWatch(remote, checked.net, checked.config.bridge))
+        scheduler.on_event(watch)
+        result = run_observed(scheduler, trace=folder / "t.jsonl")
+    return result, ended[0]
