@@ -51,7 +51,7 @@ def announcement(registry: Registry) -> dict[str, dict[str, Any]]:
 
     Examples:
         >>> announcement(default_registry)["core.wait"]["seconds"]["type"]
-        'float or int'
+        'float'
     """
     actions: dict[str, dict[str, Any]] = {}
     for name in registry.names():

@@ -283,11 +283,11 @@ class Dispatcher:
             try:
                 for name in sorted(self.names):
                     self.transport.publish(to_agent(name), beat)
-                self._send_again()
+                self.send_again()
             except Exception as exc:  # a transport error must not end the heartbeats
                 log.warning("bridge: heartbeat failed: %s", exc)
 
-    def _send_again(self) -> None:
+    def send_again(self) -> None:
         """Send again each goal its agent does not hold (not in its last heartbeat) and
         each cancel not acknowledged, once a heartbeat has passed since the last send."""
         now, period = self.now(), self.spec.heartbeat

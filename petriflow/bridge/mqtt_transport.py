@@ -9,6 +9,7 @@ id, agents de-duplicating) makes up for it.
 
 from __future__ import annotations
 
+import logging
 import socket
 import threading
 import uuid
@@ -19,6 +20,7 @@ from petriflow.bridge.transport import DependencyNotInstalled, Endpoint, Handler
 __all__ = ["MqttTransport", "connect", "DEFAULT_PORT"]
 
 DEFAULT_PORT = 1883
+log = logging.getLogger("petriflow.bridge")
 
 
 def _mqtt() -> Any:
@@ -67,7 +69,10 @@ class MqttTransport:
         with self._lock:
             handlers = [handler for pattern, handler in self._subscriptions if _matches(pattern, message.topic)]
         for handler in handlers:
-            handler(message.topic, message.payload)
+            try:
+                handler(message.topic, message.payload)
+            except Exception:  # a handler's error must never end the network loop
+                log.exception("bridge: handling a message on %s failed", message.topic)
 
     def subscribe(self, pattern: str, handler: Handler) -> None:
         with self._lock:

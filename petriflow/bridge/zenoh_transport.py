@@ -8,6 +8,7 @@ itself when the router comes back, and keeps its subscriptions.
 from __future__ import annotations
 
 import json
+import logging
 from typing import Any
 
 from petriflow.bridge.transport import DependencyNotInstalled, Endpoint, Handler
@@ -15,6 +16,7 @@ from petriflow.bridge.transport import DependencyNotInstalled, Endpoint, Handler
 __all__ = ["ZenohTransport", "connect", "serve_router", "DEFAULT_PORT"]
 
 DEFAULT_PORT = 7447
+log = logging.getLogger("petriflow.bridge")
 
 
 def _zenoh() -> Any:
@@ -57,7 +59,10 @@ class ZenohTransport:
 
     def subscribe(self, pattern: str, handler: Handler) -> None:
         def receive(sample: Any) -> None:
-            handler(str(sample.key_expr), sample.payload.to_bytes())
+            try:
+                handler(str(sample.key_expr), sample.payload.to_bytes())
+            except Exception:  # a handler's error must never reach Zenoh's threads
+                log.exception("bridge: handling a message on %s failed", sample.key_expr)
 
         self._subscribers.append(self.session.declare_subscriber(pattern, receive))
 

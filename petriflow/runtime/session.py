@@ -155,6 +155,8 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
                               until=inputs["until"], max_firings=max_firings)
         result.cpu = wallclock.process_time() - cpu
         extras.finish(scheduler, result, checked.config)
+        if remote is not None:  # what the bridge dropped, by reason (docs/bridge.md)
+            result.metrics["bridge.dropped"] = dict(sorted(remote.dropped.items()))
     if not keep_events:
         result.events = []
     if journal is not None:

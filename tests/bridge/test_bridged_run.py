@@ -176,3 +176,95 @@ def session_run(net, folder, on_event):
         scheduler.on_event(watch)
         result = run_observed(scheduler, trace=folder / "t.jsonl")
     return result, ended[0]
+
+
+CHAIN = """\
+petriflow: 1
+net: chain
+subnets:
+  - id: r1
+    agent: r1
+    places: [{id: a, tokens: 1}]
+    transitions:
+""" + "".join(f"      - {{id: s{i}, action: core.wait, params: {{seconds: 0.3}}, in: [{'a' if i == 0 else f'p{i}'}],"
+              f" out: [p{i + 1}]}}\n" for i in range(10)) + """\
+places: [""" + ", ".join(f"p{i}" for i in range(1, 11)) + """]
+final: {p10: 1}
+"""
+
+
+@pytest.mark.slow
+def test_a_broker_or_router_restarted_mid_run_is_survived_with_every_firing_once(middleware, serve, tmp_path):
+    """The middleware goes away for a second and comes back: the run completes, every firing is in the
+    trace once, and the agent executed each goal once."""
+    import threading
+    import time
+
+    kind, server = middleware
+    agent = serve(kind, server.connect, ["robot1"], heartbeat=0.1, log_file=open(tmp_path / "agent.log", "w"))
+    net = write(tmp_path, kind, server.connect, net=CHAIN, heartbeat=0.2, heartbeat_timeout=5)
+
+    def restart():
+        time.sleep(1.0)
+        if kind == "mqtt":
+            server.stop()
+            time.sleep(1.0)
+            server.start()
+        else:
+            from petriflow.bridge.transport import Endpoint
+            from petriflow.bridge.zenoh_transport import serve_router
+
+            server.stop()
+            time.sleep(1.0)
+            server.session = serve_router(Endpoint(server.connect))
+
+    threading.Thread(target=restart, daemon=True).start()
+    result = run_files(net, trace=tmp_path / "t.jsonl")
+    assert result.reason == "final" and result.firings == 10
+    events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+    ends = [e["transition"] for e in events if e["kind"] == "end"]
+    assert sorted(ends) == sorted(f"s{i}" for i in range(10)) and len(set(ends)) == 10
+    agent.server.log_file.flush()
+    goals = [json.loads(line)["goal"] for line in (tmp_path / "agent.log").read_text().splitlines()]
+    assert len(goals) == len(set(goals)) == 10
+
+
+@pytest.mark.slow
+def test_hostile_messages_leave_the_run_unchanged_and_are_counted(broker, serve, tmp_path):
+    """Malformed JSON, 10 MB, an unknown goal id, a replayed result and an unknown agent, sent while the
+    run runs: it ends as it would have, and each is counted by reason."""
+    import threading
+    import time
+
+    serve("mqtt", broker.connect, ["robot1"], heartbeat=0.1)
+    net = write(tmp_path, "mqtt", broker.connect, net=CHAIN.replace("seconds: 0.3", "seconds: 0.1"))
+    mallory = open_transport("mqtt", Endpoint(broker.connect), "mallory")
+    seen = []
+
+    def overhear(topic, data):
+        try:
+            seen.append(protocol.decode(data))
+        except protocol.Refused:  # its own garbage
+            pass
+
+    mallory.subscribe(from_agent("robot1"), overhear)
+
+    def attack():
+        time.sleep(0.6)
+        mallory.publish(from_agent("robot1"), b"{oops")
+        mallory.publish(from_agent("robot1"), b"[" * (10 << 20))
+        mallory.publish(from_agent("robot1"), protocol.encode(protocol.Result("nobody/1/1", "robot1", "ok")))
+        result = next(m for m in seen if isinstance(m, protocol.Result))
+        mallory.publish(from_agent("robot1"), protocol.encode(result))
+        mallory.publish(from_agent("eve"), protocol.encode(protocol.Announce("eve", {})))
+
+    try:
+        threading.Thread(target=attack, daemon=True).start()
+        result = run_files(net, trace=tmp_path / "t.jsonl")
+    finally:
+        mallory.close()
+    assert result.reason == "final" and result.firings == 10
+    dropped = result.metrics["bridge.dropped"]
+    assert {reason: dropped.get(reason, 0) for reason in ("malformed", "oversized", "unknown_goal", "unknown_agent")} \
+        == {"malformed": 1, "oversized": 1, "unknown_goal": 1, "unknown_agent": 1}
+    assert dropped.get("replayed", 0) >= 1

@@ -59,11 +59,11 @@ def test_a_goal_the_agent_does_not_hold_is_sent_again_with_the_same_id():
         bridge.receive(from_agent("red"), protocol.encode(protocol.Heartbeat("red", ["r/1/1"])))
         spec_beat = spec.heartbeat
         now[0] += 3 * spec_beat
-        bridge._send_again()
+        bridge.send_again()
         assert len(bridge.transport.sent) == 1  # the agent holds it: not sent again
         bridge.receive(from_agent("red"), protocol.encode(protocol.Heartbeat("red", [])))
         now[0] += 3 * spec_beat
-        bridge._send_again()
+        bridge.send_again()
         again = [m for _, m in bridge.transport.sent if isinstance(m, protocol.Goal)]
         assert [g.id for g in again] == ["r/1/1", "r/1/1"] and bridge.goal("r/1/1").resent == 1
     finally:
