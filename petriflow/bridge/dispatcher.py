@@ -120,6 +120,7 @@ class Dispatcher:
         self.dropped: Counter[str] = Counter()
         self._lock = threading.Lock()
         self._announced = threading.Condition(self._lock)
+        self._ended = threading.Condition(self._lock)
         self._lost: set[str] = set()
         self._stop = threading.Event()
         self.transport = transport or open_transport(spec.transport, spec.endpoint(), "orchestrator")
@@ -193,7 +194,10 @@ class Dispatcher:
                     state.data, state.reason, state.answered = message.data, message.reason, now
                 elif isinstance(message, protocol.Cancelled):
                     state.phase, state.answered = Phase.CANCELLED, now
-        if replayed and not isinstance(message, (protocol.Accepted, protocol.Feedback)):
+                if state.ended:
+                    self._ended.notify_all()
+        # an answer to a goal sent again is expected twice; otherwise an ended goal's answer is a replay
+        if replayed and state.resent == 0 and not isinstance(message, (protocol.Accepted, protocol.Feedback)):
             self.drop(Drop.REPLAYED, f"{message.kind.value} for goal {state.goal.id!r}, which had ended")
 
     # what the run's thread calls --------------------------------------------------------
@@ -230,6 +234,17 @@ class Dispatcher:
         """The state of the goal ``goal_id``."""
         with self._lock:
             return self.goals.get(goal_id)
+
+    def wait_goal(self, goal_id: str, seconds: float) -> GoalState | None:
+        """The goal's state once it ended, or after ``seconds`` (``None``: never sent)."""
+        deadline = self.now() + seconds
+        with self._lock:
+            while True:
+                state = self.goals.get(goal_id)
+                left = deadline - self.now()
+                if state is None or state.ended or left <= 0:
+                    return state
+                self._ended.wait(left)
 
     def cancel(self, goal_id: str) -> None:
         """Ask the agent to stop the goal (again after a heartbeat until acknowledged)."""
