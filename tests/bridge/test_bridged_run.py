@@ -268,3 +268,31 @@ def test_hostile_messages_leave_the_run_unchanged_and_are_counted(broker, serve,
     assert {reason: dropped.get(reason, 0) for reason in ("malformed", "oversized", "unknown_goal", "unknown_agent")} \
         == {"malformed": 1, "oversized": 1, "unknown_goal": 1, "unknown_agent": 1}
     assert dropped.get("replayed", 0) >= 1
+
+
+@pytest.mark.slow
+def test_a_robot_in_plain_python_drives_a_net(broker, tmp_path):
+    """examples/plain_robot_mqtt.py imports no petriflow, yet serves the net's remote transitions."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[2] / "examples" / "plain_robot_mqtt.py"
+    assert "petriflow" not in "".join(line for line in script.read_text().splitlines()
+                                      if line.startswith(("import", "from")))
+    assert len(script.read_text().splitlines()) < 100
+    robot = subprocess.Popen([sys.executable, str(script), "--name", "robot1", "--port", str(broker.port)],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        net = write(tmp_path, "mqtt", broker.connect, net=NET.replace(
+            "action: core.wait, params: {seconds: 0.2}", "action: robot.blink, params: {times: 2}").replace(
+            "action: core.set, params: {value: {x: 1}}", "action: robot.blink, params: {}"))
+        result = run_files(net)
+        assert result.reason == "final" and result.tokens["o"] == [{"blinked": 3}]
+        bad = write(tmp_path, "mqtt", broker.connect, net=NET.replace(
+            "action: core.wait, params: {seconds: 0.2}", "action: robot.beep, params: {}"))
+        with pytest.raises(NetFormatError, match="'go': action robot.beep on agent 'robot1' needs parameter 'hz'"):
+            run_files(bad)
+    finally:
+        robot.kill()
+        robot.wait(timeout=10)
