@@ -12,10 +12,13 @@ import logging
 from typing import Any
 
 from petriflow.bridge.transport import DependencyNotInstalled, Endpoint, Handler
+from petriflow.errors import PetriflowError
 
 __all__ = ["ZenohTransport", "connect", "serve_router", "DEFAULT_PORT"]
 
 DEFAULT_PORT = 7447
+#: How long opening a client session waits for the router (milliseconds).
+CONNECT_TIMEOUT_MS = 10_000
 log = logging.getLogger("petriflow.bridge")
 
 
@@ -37,9 +40,10 @@ def _config(mode: str, endpoint: Endpoint, *, listen: bool = False) -> Any:
     config.insert_json5("scouting/multicast/enabled", "false")
     config.insert_json5("listen/endpoints" if listen else "connect/endpoints", address)
     if not listen:
-        # keep trying the router for ever, quickly: a restarted router is found again at once
-        config.insert_json5("connect/timeout_ms", "-1")
-        config.insert_json5("connect/exit_on_failure", "false")
+        # the router must answer within the timeout at the start (a wrong password or address is
+        # an error, not a wait for ever); once connected, a restarted router is found again quickly
+        config.insert_json5("connect/timeout_ms", str(CONNECT_TIMEOUT_MS))
+        config.insert_json5("connect/exit_on_failure", "true")
         config.insert_json5("connect/retry", json.dumps({"period_init_ms": 100, "period_max_ms": 500,
                                                           "period_increase_factor": 1.5}))
     if endpoint.user is not None:
@@ -53,7 +57,11 @@ class ZenohTransport:
 
     def __init__(self, endpoint: Endpoint) -> None:
         zenoh = _zenoh()
-        self.session = zenoh.open(_config("client", endpoint))
+        try:
+            self.session = zenoh.open(_config("client", endpoint))
+        except zenoh.ZError as exc:
+            raise PetriflowError(f"cannot connect to the Zenoh router at {endpoint.connect}"
+                                 f"{' as ' + endpoint.user if endpoint.user else ''}: {exc}") from None
         self._subscribers: list[Any] = []
         self._publishers: dict[str, Any] = {}
 

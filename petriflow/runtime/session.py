@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from petriflow.collector import paused
-from petriflow.errors import NetFormatError
+from petriflow.errors import NetFormatError, PetriflowError
 from petriflow.net import Net
 from petriflow.runtime.assembly import open_run
 from petriflow.runtime.binding import Binding, bind
@@ -266,6 +266,10 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
     """
     journal = Journal(db)
     try:
+        if (journal.inputs.get("config") or {}).get("bridge") is not None:
+            raise PetriflowError(f"{db}: this run had remote agents (bridge:), and resuming such a run is not"
+                                 " supported yet: its goals ran in wall-clock time and do not re-execute to"
+                                 " the same events (docs/bridge.md)")
         if journal.finished:  # killed after its end was journaled, before it was done with its outputs
             warnings.warn(f"{db}: the run already finished ({journal.journaled} events); re-executing it,"
                           " checked against the journal, to write its outputs", stacklevel=2)

@@ -6,6 +6,7 @@ the broker ``scripts/setup.sh`` installs, the Zenoh router a session of this pro
 
 from __future__ import annotations
 
+import getpass
 import shutil
 import socket
 import subprocess
@@ -31,13 +32,16 @@ def mosquitto_binary() -> str | None:
 class Broker:
     """A mosquitto on a free loopback port (small messages at once: TCP_NODELAY)."""
 
-    def __init__(self, folder: Path) -> None:
+    def __init__(self, folder: Path, passwords: Path | None = None) -> None:
         binary = mosquitto_binary()
         if binary is None:
             pytest.skip("mosquitto is not installed (scripts/setup.sh installs it)")
         self.binary, self.port = binary, free_port()
         self.conf = folder / "mosquitto.conf"
-        self.conf.write_text(f"listener {self.port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\n")
+        access = "allow_anonymous true\n" if passwords is None else f"allow_anonymous false\npassword_file {passwords}\n"
+        # as root, mosquitto would become user 'mosquitto', who cannot read the test's files
+        self.conf.write_text(f"listener {self.port} 127.0.0.1\n{access}set_tcp_nodelay true\n"
+                             f"user {getpass.getuser()}\n")
         self.process: subprocess.Popen | None = None
         self.start()
 
@@ -119,10 +123,11 @@ def middleware(request, tmp_path):
 class ServedAgent:
     """An agent server in a thread of the test, with its own connection."""
 
-    def __init__(self, kind: str, connect: str, names: list[str], **options) -> None:
+    def __init__(self, kind: str, connect: str, names: list[str], user: str | None = None,
+                 password: str | None = None, **options) -> None:
         from petriflow.bridge.agent import AgentServer
 
-        self.transport = open_transport(kind, Endpoint(connect), "-".join(names))
+        self.transport = open_transport(kind, Endpoint(connect, user, password), "-".join(names))
         self.server = AgentServer(names, self.transport, **options)
         self.thread = threading.Thread(target=self.server.serve, daemon=True)
         self.thread.start()

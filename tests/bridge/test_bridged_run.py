@@ -296,3 +296,59 @@ def test_a_robot_in_plain_python_drives_a_net(broker, tmp_path):
     finally:
         robot.kill()
         robot.wait(timeout=10)
+
+
+@pytest.mark.slow
+def test_a_configured_kill_of_a_remote_agent_cancels_its_firing(broker, serve, tmp_path):
+    """A kill fault on a remote agent cancels its running goal on the agent (acknowledged)."""
+    agent = serve("mqtt", broker.connect, ["robot1"], heartbeat=0.1)
+    net = write(tmp_path, "mqtt", broker.connect, net=LOSABLE.replace("final: {broken: 1}", "final: {o: 1}"))
+    (tmp_path / "run.yaml").write_text((tmp_path / "run.yaml").read_text() + "faults: [{kill: r1, at: 0.5}]\n")
+    result = run_files(net, trace=tmp_path / "t.jsonl")
+    assert result.reason == "dead"
+    events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+    end = next(e for e in events if e["kind"] == "end" and e["transition"] == "go")
+    assert end["data"]["outcome"] == "cancelled" and end["time"] < 2.0
+    assert not agent.server.running  # the agent stopped it
+
+
+@pytest.mark.slow
+def test_authentication_is_required_when_configured(tmp_path, serve, monkeypatch):
+    """A mosquitto with a password file: the run and the agent get in with their passwords; an agent
+    without one does not (the run says it never announced itself)."""
+    import subprocess
+
+    from tests.bridge.conftest import Broker
+
+    pytest.importorskip("paho.mqtt")
+    passwords = tmp_path / "passwords"
+    for user, password in (("orchestrator", "o-secret"), ("robot1", "r-secret")):
+        subprocess.run(["mosquitto_passwd", "-b", *(["-c"] if user == "orchestrator" else []), str(passwords),
+                        user, password], check=True)
+    broker = Broker(tmp_path, passwords)
+    try:
+        monkeypatch.setenv("BRIDGE_PW", "o-secret")
+        anonymous = serve("mqtt", broker.connect, ["robot1"], heartbeat=0.1)
+        net = write(tmp_path, "mqtt", broker.connect, user="orchestrator", password_env="BRIDGE_PW", wait=1)
+        with pytest.raises(NetFormatError, match="did not announce itself"):
+            run_files(net)
+        anonymous.stop()
+        serve("mqtt", broker.connect, ["robot1"], user="robot1", password="r-secret", heartbeat=0.1)
+        net = write(tmp_path, "mqtt", broker.connect, user="orchestrator", password_env="BRIDGE_PW", wait=10)
+        assert run_files(net).reason == "final"
+    finally:
+        broker.stop()
+
+
+def test_resuming_a_bridged_run_is_refused_in_one_line(broker, serve, tmp_path):
+    """Not supported yet: said so, the journal left as it was."""
+    from petriflow.errors import PetriflowError
+    from petriflow.runtime.session import resume
+
+    serve("mqtt", broker.connect, ["robot1"], heartbeat=0.1)
+    net = write(tmp_path, "mqtt", broker.connect, net=NET.replace("seconds: 0.2", "seconds: 0.01"))
+    run_files(net, db=tmp_path / "run.sqlite")
+    before = (tmp_path / "run.sqlite").read_bytes()
+    with pytest.raises(PetriflowError, match="resuming such a run is not supported yet"):
+        resume(tmp_path / "run.sqlite")
+    assert (tmp_path / "run.sqlite").read_bytes() == before
