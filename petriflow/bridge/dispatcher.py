@@ -75,6 +75,9 @@ class GoalState:
     reason: str = ""
     cancel_sent: float | None = None
     feedback: Any = None
+    #: On resume, the simulated time the journal shows it ended at (its ending is taken
+    #: then, as journaled: :mod:`petriflow.bridge.resume`); ``None``: a live goal.
+    at: float | None = None
 
     @property
     def ended(self) -> bool:
@@ -284,6 +287,12 @@ class Dispatcher:
                     self._lost.discard(name)
                     back.append(name)
         return lost, back
+
+    def mark_lost(self, agent: str) -> None:
+        """Hold ``agent`` lost (the run had lost it before a resume) until it announces itself."""
+        with self._lock:
+            self._lost.add(agent)
+            self.agents[agent].announced = False
 
     def silence(self, agent: str) -> float:
         """Seconds since ``agent`` was last heard from."""

@@ -13,7 +13,8 @@ silent for ``heartbeat_timeout`` is lost (:meth:`Scheduler.agent_lost
 
 from __future__ import annotations
 
-from contextlib import contextmanager
+import uuid
+from contextlib import ExitStack, contextmanager
 from typing import Any, Iterator
 
 from petriflow.bridge.dispatcher import Dispatcher
@@ -22,7 +23,12 @@ from petriflow.bridge.spec import BridgeSpec
 from petriflow.net import Net
 from petriflow.runtime.binding import Binding
 
-__all__ = ["open_bridge", "AgentWatch"]
+__all__ = ["open_bridge", "AgentWatch", "connect_run", "new_run_name"]
+
+
+def new_run_name() -> str:
+    """A new run's name in its goal ids (journaled, so a resume re-attaches by it)."""
+    return uuid.uuid4().hex[:12]
 
 
 @contextmanager
@@ -69,3 +75,27 @@ class AgentWatch:
         for remote in back:
             for agent in self.runs.get(remote, []):
                 scheduler.agent_back(agent)
+
+
+def connect_run(stack: ExitStack, checked: Any, *, run: str | None, wait: float | None,
+                journal: Any = None) -> tuple[Any, Any, Any]:
+    """A checked bridged run's ``(remote service, clock, watcher after each instant)``,
+    its connection closed with ``stack``; with a ``journal`` that holds events (a resume),
+    the remote firings and agent faults it journaled are replayed up to its end and the
+    firings still running are re-attached (:mod:`petriflow.bridge.resume`)."""
+    from petriflow.runtime.clock import RealtimeClock
+
+    spec = checked.config.bridge
+    dispatcher = stack.enter_context(open_bridge(checked.binding, spec, wait=wait, run=run,
+                                                 path=None if checked.path is None else str(checked.path)))
+    watch = AgentWatch(dispatcher, checked.net, spec)
+    if journal is None or not journal.journaled:
+        return dispatcher, RealtimeClock(), watch
+    from petriflow.bridge.remote import RemoteAction
+    from petriflow.bridge.resume import Replay, ReplayingRemote, ReplayWatch, ResumeClock
+
+    remote_ids = {tid for tid, bound in checked.binding.transitions.items()
+                  if isinstance(bound.action, type) and issubclass(bound.action, RemoteAction)}
+    replay = Replay(journal.events(), remote_ids)
+    remote = ReplayingRemote(dispatcher, replay)
+    return remote, ResumeClock(replay.until), ReplayWatch(remote, watch, watch.runs)

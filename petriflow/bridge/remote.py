@@ -74,6 +74,8 @@ class RemoteAction(Action):
     def poll(self, ctx: ActionContext) -> Status:
         dispatcher = self._dispatcher(ctx)
         state = dispatcher.goal(self.goal_id)
+        if state is not None and state.at is not None:  # a resume replays the journaled ending
+            return self._replayed(ctx, state)
         if state is not None and state.ended:
             self._record(ctx, state)
             if state.phase == Phase.OK:
@@ -89,6 +91,9 @@ class RemoteAction(Action):
 
     def cancel(self, ctx: ActionContext) -> bool:
         dispatcher = self._dispatcher(ctx)
+        state = dispatcher.goal(self.goal_id)
+        if state is not None and state.at is not None:  # a resume replays the journaled ending
+            return self._replayed(ctx, state) is not Status.RUNNING
         if dispatcher.is_lost(self.remote_agent):  # nobody to ask: the outcome is unknown
             dispatcher.forget(self.goal_id)
             ctx.reason = self._lost_reason(dispatcher)
@@ -101,6 +106,18 @@ class RemoteAction(Action):
             self._record(ctx, state)
             return True
         return False
+
+    def _replayed(self, ctx: ActionContext, state: Any) -> Status:
+        """The journaled ending of a resumed run's firing, at its journaled time."""
+        if ctx.now < state.at - 1e-9:
+            return Status.RUNNING
+        if state.answered is not None or state.resent:
+            self._record(ctx, state)
+        if state.phase == Phase.OK:
+            ctx.result = state.data
+            return Status.OK
+        ctx.reason = state.reason
+        return Status.FAILED
 
     def _lost_reason(self, dispatcher: Dispatcher) -> str:
         return (f"agent {self.remote_agent!r} lost: no message for {dispatcher.silence(self.remote_agent):.1f} s"

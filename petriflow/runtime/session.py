@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from petriflow.collector import paused
-from petriflow.errors import NetFormatError, PetriflowError
+from petriflow.errors import NetFormatError
 from petriflow.net import Net
 from petriflow.runtime.assembly import open_run
 from petriflow.runtime.binding import Binding, bind
@@ -131,19 +131,17 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
     extras = extras or RunExtras()
     keep = keep_events or extras.needs_events()
     with ExitStack() as stack:
-        remote, clock = None, None
+        remote, clock, watch = None, None, None
         spec = checked.config.bridge
         if spec is not None:  # remote agents: connected and checked first, then in wall-clock time
-            from petriflow.bridge.orchestrator import AgentWatch, open_bridge
-            from petriflow.runtime.clock import RealtimeClock
+            from petriflow.bridge.orchestrator import connect_run
 
-            remote = stack.enter_context(open_bridge(checked.binding, spec, wait=wait_agents,
-                                                     path=None if checked.path is None else str(checked.path)))
-            clock = RealtimeClock()
+            remote, clock, watch = connect_run(stack, checked, run=inputs.get("bridge_run"), wait=wait_agents,
+                                               journal=journal)
         scheduler = stack.enter_context(open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime,
                                                  clock=clock, remote=remote))
         if remote is not None:
-            scheduler.on_instant(AgentWatch(remote, checked.net, spec))
+            scheduler.on_instant(watch)
         if inputs.get("poses"):  # the world's body poses as trace events (petriflow.runtime.poses)
             from petriflow.runtime.poses import PoseSampler
 
@@ -156,7 +154,8 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
         result.cpu = wallclock.process_time() - cpu
         extras.finish(scheduler, result, checked.config)
         if remote is not None:  # what the bridge dropped, by reason (docs/bridge.md)
-            result.metrics["bridge.dropped"] = dict(sorted(remote.dropped.items()))
+            dropped = getattr(remote, "dispatcher", remote).dropped
+            result.metrics["bridge.dropped"] = dict(sorted(dropped.items()))
     if not keep_events:
         result.events = []
     if journal is not None:
@@ -220,6 +219,10 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     _warn_unbound(checked.net, net_path)
     inputs = journal_inputs(files, seed=seed, until=until)
     inputs["max_firings"] = max_firings
+    if files.config.bridge is not None:  # the run's name in its goal ids: a resume re-attaches by it
+        from petriflow.bridge.orchestrator import new_run_name
+
+        inputs["bridge_run"] = new_run_name()
     if poses is not None:  # journaled, so a resumed run samples them too
         inputs["poses"] = _pose_interval(poses)
     inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())
@@ -266,10 +269,6 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
     """
     journal = Journal(db)
     try:
-        if (journal.inputs.get("config") or {}).get("bridge") is not None:
-            raise PetriflowError(f"{db}: this run had remote agents (bridge:), and resuming such a run is not"
-                                 " supported yet: its goals ran in wall-clock time and do not re-execute to"
-                                 " the same events (docs/bridge.md)")
         if journal.finished:  # killed after its end was journaled, before it was done with its outputs
             warnings.warn(f"{db}: the run already finished ({journal.journaled} events); re-executing it,"
                           " checked against the journal, to write its outputs", stacklevel=2)

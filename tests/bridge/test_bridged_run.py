@@ -340,15 +340,40 @@ def test_authentication_is_required_when_configured(tmp_path, serve, monkeypatch
         broker.stop()
 
 
-def test_resuming_a_bridged_run_is_refused_in_one_line(broker, serve, tmp_path):
-    """Not supported yet: said so, the journal left as it was."""
-    from petriflow.errors import PetriflowError
+@pytest.mark.slow
+@pytest.mark.parametrize("kill_after", [1.0, 1.45])
+def test_an_orchestrator_killed_mid_run_resumes_and_reattaches(broker, serve, tmp_path, kill_after):
+    """The run process is killed (SIGKILL) while a goal runs on the agent; --resume replays the journal,
+    re-attaches to the goal still running, and completes: every firing once, every goal executed once."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
     from petriflow.runtime.session import resume
 
-    serve("mqtt", broker.connect, ["robot1"], heartbeat=0.1)
-    net = write(tmp_path, "mqtt", broker.connect, net=NET.replace("seconds: 0.2", "seconds: 0.01"))
-    run_files(net, db=tmp_path / "run.sqlite")
-    before = (tmp_path / "run.sqlite").read_bytes()
-    with pytest.raises(PetriflowError, match="resuming such a run is not supported yet"):
-        resume(tmp_path / "run.sqlite")
-    assert (tmp_path / "run.sqlite").read_bytes() == before
+    agent = serve("mqtt", broker.connect, ["robot1"], heartbeat=0.1, log_file=open(tmp_path / "agent.log", "w"))
+    net = write(tmp_path, "mqtt", broker.connect, net=CHAIN, heartbeat=0.1, heartbeat_timeout=5)
+    db = tmp_path / "run.sqlite"
+    run = subprocess.Popen([sys.executable, "-m", "petriflow.cli", "run", str(net), "--db", str(db), "--quiet"],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 30
+    while not db.exists() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    time.sleep(kill_after)
+    os.kill(run.pid, signal.SIGKILL)
+    run.wait(timeout=10)
+    from petriflow.runtime.journal import Journal
+
+    with Journal(db) as journal:
+        assert 0 < journal.journaled and not journal.finished
+        assert [e.kind for e in journal.events()].count("end") < 10
+    result = resume(db, trace=tmp_path / "t.jsonl")
+    assert result.reason == "final" and result.firings == 10
+    events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+    ends = [e["transition"] for e in events if e["kind"] == "end"]
+    assert sorted(ends) == sorted(f"s{i}" for i in range(10))
+    agent.server.log_file.flush()
+    goals = [json.loads(line)["goal"] for line in (tmp_path / "agent.log").read_text().splitlines()]
+    assert len(goals) == len(set(goals)) == 10
