@@ -58,7 +58,7 @@ def start_middleware(kind: str, folder: Path) -> tuple[subprocess.Popen, str]:
         binary = shutil.which("mosquitto") or "/usr/sbin/mosquitto"
         conf = folder / "mosquitto.conf"
         conf.write_text(f"listener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\n"
-                        "max_queued_messages 100000\n")
+                        "max_queued_messages 100000\nmax_inflight_messages 1000\n")
         process = subprocess.Popen([binary, "-c", str(conf)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     else:
         process = subprocess.Popen([sys.executable, "-m", "petriflow.cli", "router", "--listen",

@@ -20,6 +20,10 @@ from petriflow.bridge.transport import DependencyNotInstalled, Endpoint, Handler
 __all__ = ["MqttTransport", "connect", "DEFAULT_PORT"]
 
 DEFAULT_PORT = 1883
+#: QoS 1 messages a client keeps in flight (unacknowledged by the broker) at once.
+MAX_INFLIGHT = 1000
+#: The MQTT quality of service of every message.
+QOS = 1
 log = logging.getLogger("petriflow.bridge")
 
 
@@ -44,6 +48,8 @@ class MqttTransport:
         if endpoint.user is not None:
             self.client.username_pw_set(endpoint.user, endpoint.password)
         self.client.reconnect_delay_set(min_delay=0.1, max_delay=1)
+        # QoS 1 messages in flight before paho queues the rest (its default of 20 halves a burst's rate)
+        self.client.max_inflight_messages_set(MAX_INFLIGHT)
         self.client.on_connect = self._on_connect
         self.client.on_disconnect = self._on_disconnect
         self.client.on_message = self._on_message
@@ -59,7 +65,7 @@ class MqttTransport:
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         with self._lock:
             for pattern, _ in self._subscriptions:
-                client.subscribe(_mqtt_pattern(pattern), qos=1)
+                client.subscribe(_mqtt_pattern(pattern), qos=QOS)
         self.connected.set()
 
     def _on_disconnect(self, *args: Any) -> None:
@@ -78,10 +84,10 @@ class MqttTransport:
         with self._lock:
             self._subscriptions.append((pattern, handler))
         if self.connected.is_set():
-            self.client.subscribe(_mqtt_pattern(pattern), qos=1)
+            self.client.subscribe(_mqtt_pattern(pattern), qos=QOS)
 
     def publish(self, topic: str, payload: bytes) -> None:
-        self.client.publish(topic, payload, qos=1)
+        self.client.publish(topic, payload, qos=QOS)
 
     def close(self) -> None:
         self.client.disconnect()
