@@ -114,7 +114,15 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
         run_config.import_actions()
     pending = [] if import_actions else run_config.unimported_actions()
     try:
-        binding = bind(net, registry, path=str(files.path), unimported=pending)
+        if run_config.bridge is not None:  # remote subnets: checked against their agents when the run connects
+            from petriflow.bridge.remote import bind_remote
+            from petriflow.runtime.registry import default_registry
+
+            binding = bind_remote(net, run_config.bridge, registry or default_registry,
+                                  lambda local: bind(local, registry, path=str(files.path), unimported=pending),
+                                  str(files.path))
+        else:
+            binding = bind(net, registry, path=str(files.path), unimported=pending)
     except NetFormatError as exc:
         raise run_config.blame(exc) from None
     run_config.check(net)
