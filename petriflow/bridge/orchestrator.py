@@ -20,10 +20,10 @@ from typing import Any, Iterator
 from petriflow.bridge.dispatcher import Dispatcher
 from petriflow.bridge.remote import check_announced
 from petriflow.bridge.spec import BridgeSpec
-from petriflow.net import Net
+from petriflow.bridge.watch import AgentWatch, Listen
 from petriflow.runtime.binding import Binding
 
-__all__ = ["open_bridge", "AgentWatch", "connect_run", "new_run_name"]
+__all__ = ["open_bridge", "AgentWatch", "Listen", "connect_run", "new_run_name"]
 
 
 def new_run_name() -> str:
@@ -47,34 +47,6 @@ def open_bridge(binding: Binding, spec: BridgeSpec, *, wait: float | None = None
         yield dispatcher
     finally:
         dispatcher.close()
-
-
-class AgentWatch:
-    """After each instant: agents lost or back become the run's (see the module).
-
-    Args:
-        dispatcher: the run's bridge.
-        net: the net (which subnets each remote agent runs).
-        spec: the ``bridge:`` section.
-    """
-
-    def __init__(self, dispatcher: Dispatcher, net: Net, spec: BridgeSpec) -> None:
-        self.dispatcher = dispatcher
-        self.runs: dict[str, list[str]] = {}
-        for subnet, remote in spec.agents.items():
-            found = net.subnets.get(subnet) or next((s for s in net.subnets.values() if s.agent == subnet), None)
-            if found is not None:
-                self.runs.setdefault(remote, []).append(found.agent or found.id)
-
-    def __call__(self, scheduler: Any) -> None:
-        lost, back = self.dispatcher.watch()
-        for remote in lost:
-            why = f"no message from {remote!r} for {self.dispatcher.spec.heartbeat_timeout:g} s"
-            for agent in self.runs.get(remote, []):
-                scheduler.agent_lost(agent, why)
-        for remote in back:
-            for agent in self.runs.get(remote, []):
-                scheduler.agent_back(agent)
 
 
 def connect_run(stack: ExitStack, checked: Any, *, run: str | None, wait: float | None,

@@ -21,6 +21,7 @@ from typing import Any
 
 from petriflow.bridge import protocol
 from petriflow.bridge.dispatcher import Dispatcher, GoalState, Phase
+from petriflow.bridge.watch import Listen
 from petriflow.runtime.kernel import Kernel
 from petriflow.runtime.trace import Event
 
@@ -141,10 +142,12 @@ class ReplayWatch:
         self.runs = runs
         self.owner = {agent: name for name, agents in runs.items() for agent in agents}
         self.faults = list(remote.replay.faults)
+        self.listening: set[int] = set()
 
     def __call__(self, scheduler: Any) -> None:
         remote, now = self.remote, scheduler.now
         if remote.replaying:
+            self._listen(scheduler)
             while self.faults and self.faults[0][0] <= now + 1e-9:
                 _, kind, agent, why = self.faults.pop(0)
                 name = self.owner.get(agent, agent)
@@ -165,3 +168,15 @@ class ReplayWatch:
                     remote.dispatcher.mark_lost(name)
             return
         self.live(scheduler)
+
+    def _listen(self, scheduler: Any) -> None:
+        """An instant at the next journaled loss or return, and at the journal's end (the
+        original run had one there)."""
+        kernel = scheduler.kernel
+        times = [self.faults[0][0]] if self.faults else []
+        times.append(self.remote.replay.until)
+        for at in times:
+            tick = kernel.ticks_at(at)
+            if tick > kernel.tick and tick not in self.listening:
+                self.listening.add(tick)
+                kernel.schedule(tick, Listen())

@@ -9,6 +9,7 @@
       heartbeat: 0.5                # seconds between heartbeats, both ways
       heartbeat_timeout: 3          # an agent silent this long is lost
       wait: 10                      # seconds to wait for the agents to announce themselves
+      rejoin: 30                    # seconds a run with nothing else to do waits for a lost agent
       user: robot                   # authenticate as (optional)
       password_env: PETRIFLOW_BRIDGE_PASSWORD   # the password, from this environment variable
 
@@ -36,7 +37,8 @@ from petriflow.errors import NetFormatError, did_you_mean
 
 __all__ = ["BridgeSpec", "DEFAULT_CONNECT"]
 
-_KEYS = ("transport", "connect", "agents", "heartbeat", "heartbeat_timeout", "wait", "user", "password_env")
+_KEYS = ("transport", "connect", "agents", "heartbeat", "heartbeat_timeout", "wait", "rejoin", "user",
+         "password_env")
 #: Where each transport connects by default: loopback.
 DEFAULT_CONNECT = {"zenoh": "tcp/127.0.0.1:7447", "mqtt": "tcp/127.0.0.1:1883"}
 
@@ -52,6 +54,8 @@ class BridgeSpec:
         heartbeat: seconds between heartbeats.
         heartbeat_timeout: seconds of silence after which an agent is lost.
         wait: seconds to wait for the agents to announce themselves before binding.
+        rejoin: seconds a run waits for a lost agent to come back (when nothing else is
+            to happen; afterwards it may end ``dead``).
         user: the user to authenticate as (``None``: none).
         password_env: the environment variable holding its password.
     """
@@ -62,6 +66,7 @@ class BridgeSpec:
     heartbeat: float = 0.5
     heartbeat_timeout: float = 3.0
     wait: float = 10.0
+    rejoin: float = 30.0
     user: str | None = None
     password_env: str | None = None
 
@@ -94,7 +99,7 @@ class BridgeSpec:
                 refuse(f"agents: {subnet!r}: an agent name is letters, digits, '_', '.', '-' (at most 64),"
                        f" got {name!r}")
         times = {}
-        for key, default in (("heartbeat", 0.5), ("heartbeat_timeout", 3.0), ("wait", 10.0)):
+        for key, default in (("heartbeat", 0.5), ("heartbeat_timeout", 3.0), ("wait", 10.0), ("rejoin", 30.0)):
             value = data.get(key, default)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
                     or not 0 < value <= 3600:
@@ -108,7 +113,7 @@ class BridgeSpec:
             if value is not None and not isinstance(value, str):
                 refuse(f"{key} must be a string, got {value!r}")
         return cls(transport, connect.strip(), {str(k): v for k, v in agents.items()}, times["heartbeat"],
-                   times["heartbeat_timeout"], times["wait"], user, password_env)
+                   times["heartbeat_timeout"], times["wait"], times["rejoin"], user, password_env)
 
     def endpoint(self) -> Endpoint:
         """Where to connect, with the credentials (the password read from
@@ -120,7 +125,7 @@ class BridgeSpec:
         """Plain data (what the journal keeps; the password is never in it)."""
         data: dict[str, Any] = {"transport": self.transport, "connect": self.connect, "agents": dict(self.agents),
                                 "heartbeat": self.heartbeat, "heartbeat_timeout": self.heartbeat_timeout,
-                                "wait": self.wait}
+                                "wait": self.wait, "rejoin": self.rejoin}
         if self.user is not None:
             data["user"] = self.user
         if self.password_env is not None:

@@ -377,3 +377,60 @@ def test_an_orchestrator_killed_mid_run_resumes_and_reattaches(broker, serve, tm
     agent.server.log_file.flush()
     goals = [json.loads(line)["goal"] for line in (tmp_path / "agent.log").read_text().splitlines()]
     assert len(goals) == len(set(goals)) == 10
+
+
+RETRY = """\
+petriflow: 1
+net: retry
+subnets:
+  - id: r1
+    agent: r1
+    places: [{id: a, tokens: 1}, again]
+    transitions:
+      - {id: go, action: core.wait, params: {seconds: 30}, in: [a], out: [o], outcomes: {failed: [again]}}
+      - {id: retry, action: core.set, params: {value: retried}, in: [again], out: [o]}
+places: [o]
+final: {o: 1}
+"""
+
+
+@pytest.mark.slow
+def test_a_lost_agent_that_comes_back_is_a_late_joiner(broker, tmp_path):
+    """Killed mid-action: its firing fails, it is lost; a new agent process of the same name announces
+    itself: it is back, and its next transition fires on it."""
+    import subprocess
+    import sys
+    import threading
+    import time
+
+    log = tmp_path / "agent.log"
+
+    def start():
+        return subprocess.Popen([sys.executable, "-m", "petriflow.cli", "agent", "--name", "robot1", "--transport",
+                                 "mqtt", "--connect", broker.connect, "--heartbeat", "0.1", "--log", str(log)],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    agents = [start()]
+    try:
+        net = write(tmp_path, "mqtt", broker.connect, net=RETRY, heartbeat=0.1, heartbeat_timeout=1.0)
+
+        def kill_then_restart():
+            deadline = time.monotonic() + 60
+            while not (log.exists() and log.read_text()) and time.monotonic() < deadline:
+                time.sleep(0.05)  # until the goal runs on it
+            agents[0].kill()
+            time.sleep(2.0)  # lost by now
+            agents.append(start())
+
+        threading.Thread(target=kill_then_restart, daemon=True).start()
+        result = run_files(net, trace=tmp_path / "t.jsonl")
+        assert result.reason == "final" and result.tokens["o"] == ["retried"]
+        events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+        kinds = [(e["kind"], e["data"].get("fault") or e["transition"]) for e in events
+                 if e["kind"] in ("fault", "end")]
+        assert kinds == [("fault", "lost"), ("end", "go"), ("fault", "back"), ("end", "retry")] or \
+            kinds == [("end", "go"), ("fault", "lost"), ("fault", "back"), ("end", "retry")]
+    finally:
+        for agent in agents:
+            agent.kill()
+            agent.wait(timeout=10)
