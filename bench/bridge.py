@@ -9,6 +9,8 @@ router`` for Zenoh, ``mosquitto`` for MQTT) and measures:
   that ends at once (``core.noop``): goal sent -> result received, median and p99;
   beside it, the peer: the same transport's bare ping-pong (an echo process, no
   protocol, no agent), so the ratio is what the protocol and the agent add;
+* **cancel**: a goal that runs a minute, cancelled once accepted: cancel sent ->
+  ``cancelled`` received (100 times);
 * **burst**: ``--burst`` goals sent at once to ``--names`` agent names served by
   ``--processes`` agent processes: goals per second, and how many were lost (no result
   within 60 s) or executed twice (the agents' logs).
@@ -130,7 +132,7 @@ def agents(kind: str, connect: str, names: list[str], processes: int, folder: Pa
     return started
 
 
-def measure(kind: str, goals: int, burst: int, names: int, processes: int) -> dict:
+def measure(kind: str, goals: int, burst: int, names: int, processes: int, cancels: int = 100) -> dict:
     folder = Path(tempfile.mkdtemp(prefix="petriflow-bench-bridge-"))
     middleware, connect = start_middleware(kind, folder)
     row: dict = {"transport": kind}
@@ -154,6 +156,19 @@ def measure(kind: str, goals: int, burst: int, names: int, processes: int) -> di
                     trips.append(state.round_trip if state.ended else float("inf"))
                 row["median_ms"] = statistics.median(trips) * 1e3
                 row["p99_ms"] = percentile(trips, 0.99) * 1e3
+                acks = []
+                for i in range(cancels):  # a goal that runs a minute, cancelled once it runs
+                    goal = protocol.Goal(protocol.goal_id(dispatcher.run, goals + burst + i), "a0", "core.wait",
+                                         {"seconds": 60.0})
+                    state = dispatcher.send(goal)
+                    while state.phase != "accepted" and not state.ended:
+                        time.sleep(0.001)
+                    began = time.perf_counter()
+                    dispatcher.cancel(goal.id)
+                    state = dispatcher.wait_goal(goal.id, 5)
+                    acks.append(time.perf_counter() - began if state.phase == "cancelled" else float("inf"))
+                row["cancel_median_ms"] = statistics.median(acks) * 1e3
+                row["cancel_max_ms"] = max(acks) * 1e3
                 began = time.perf_counter()
                 ids = []
                 for i in range(burst):
@@ -199,13 +214,13 @@ def main(argv: list[str] | None = None) -> list[dict]:
     print(f"round trip of a goal whose action ends at once ({args.goals} goals), and a burst of {args.burst:,}"
           f" goals to {args.names} agent names in {args.processes} processes; load {os.getloadavg()[0]:.1f}")
     print()
-    print("| transport | median ms | p99 ms | bare transport median ms | ÷ bare | burst goals/s | lost |"
-          " executed twice |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    print("| transport | median ms | p99 ms | bare transport median ms | ÷ bare | cancel acknowledged ms"
+          " (median / max) | burst goals/s | lost | executed twice |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for row in rows:
         print(f"| {row['transport']} | {row['median_ms']:.3f} | {row['p99_ms']:.3f} | {row['bare_median_ms']:.3f} |"
-              f" {row['median_ms'] / row['bare_median_ms']:.1f}× | {row['burst_goals_per_s']:,.0f} | {row['lost']} |"
-              f" {row['duplicated']} |")
+              f" {row['median_ms'] / row['bare_median_ms']:.1f}× | {row['cancel_median_ms']:.2f} /"
+              f" {row['cancel_max_ms']:.2f} | {row['burst_goals_per_s']:,.0f} | {row['lost']} | {row['duplicated']} |")
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=1))
     return rows

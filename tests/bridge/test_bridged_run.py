@@ -43,9 +43,11 @@ def test_a_bridged_run_reaches_its_final_marking_with_the_agents_data(middleware
     kind, server = middleware
     agent = serve(kind, server.connect, ["robot1"], heartbeat=0.1)
     net = write(tmp_path, kind, server.connect)
-    result = run_files(net, trace=tmp_path / "t.jsonl")
+    result = run_files(net, trace=tmp_path / "t.jsonl", xes=tmp_path / "run.xes")
     assert result.reason == "final" and result.marking.to_dict() == {"o": 1}
     assert result.tokens["o"] == [{"x": 1}]
+    xes = (tmp_path / "run.xes").read_text()
+    assert xes.count('key="petriflow:transition"') == 3 and 'value="r1"' in xes  # org:resource: the subnet
     events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
     remote = [e for e in events if e["kind"] == "custom" and e["data"]["name"] == "remote"]
     assert [(e["transition"], e["data"]["data"]["agent"]) for e in remote] == [("go", "robot1"), ("mark", "robot1")]
