@@ -15,7 +15,7 @@ import threading
 import uuid
 from typing import Any
 
-from petriflow.bridge.transport import DependencyNotInstalled, Endpoint, Handler
+from petriflow.bridge.transport import Endpoint, Handler, require
 
 __all__ = ["MqttTransport", "connect", "DEFAULT_PORT"]
 
@@ -28,11 +28,7 @@ log = logging.getLogger("petriflow.bridge")
 
 
 def _mqtt() -> Any:
-    try:
-        import paho.mqtt.client as mqtt
-    except ImportError:
-        raise DependencyNotInstalled("the mqtt transport needs paho-mqtt: pip install petriflow[bridge]") from None
-    return mqtt
+    return require("paho.mqtt.client", "paho-mqtt", "mqtt")
 
 
 class MqttTransport:

@@ -50,7 +50,7 @@ from petriflow.errors import PetriflowError
 from petriflow.outcome import Name
 
 __all__ = ["VERSION", "MAX_MESSAGE", "Kind", "Drop", "Refused", "Announce", "Heartbeat", "Goal", "Accepted",
-           "Rejected", "Feedback", "Result", "Cancel", "Cancelled", "Message", "encode", "decode", "goal_id",
+           "Rejected", "Feedback", "Result", "Cancel", "Cancelled", "Message", "About", "encode", "decode", "goal_id",
            "to_data"]
 
 #: The protocol version this code speaks (a message of another version is dropped).
@@ -159,64 +159,50 @@ class Goal(Message):
 
 
 @dataclass(frozen=True)
-class Accepted(Message):
-    """The goal ``id`` runs."""
+class About(Message):
+    """A message about the goal ``id`` of ``agent`` (the answers, and a cancel)."""
 
-    kind: ClassVar[Kind] = Kind.ACCEPTED
     id: str
     agent: str
 
 
 @dataclass(frozen=True)
-class Rejected(Message):
+class Rejected(About):
     """The goal ``id`` cannot run, and why."""
 
     kind: ClassVar[Kind] = Kind.REJECTED
-    id: str
-    agent: str
     reason: str = ""
 
 
 @dataclass(frozen=True)
-class Feedback(Message):
+class Feedback(About):
     """Progress of the goal ``id``."""
 
     kind: ClassVar[Kind] = Kind.FEEDBACK
-    id: str
-    agent: str
     data: Any = None
 
 
 @dataclass(frozen=True)
-class Result(Message):
+class Result(About):
     """The goal ``id`` ended: ``outcome`` ``ok`` (``data``: the output tokens' data) or
     ``failed`` (``reason``)."""
 
     kind: ClassVar[Kind] = Kind.RESULT
-    id: str
-    agent: str
     outcome: str
     data: Any = None
     reason: str = ""
 
 
-@dataclass(frozen=True)
-class Cancel(Message):
-    """Stop the goal ``id``."""
-
-    kind: ClassVar[Kind] = Kind.CANCEL
-    id: str
-    agent: str
+def _bare(name: str, kind: Kind, doc: str) -> type[About]:
+    """A message about a goal with no field of its own."""
+    cls = type(name, (About,), {"__doc__": doc, "__module__": __name__, "__annotations__": {"kind": "ClassVar[Kind]"},
+                                "kind": kind})
+    return dataclass(frozen=True)(cls)
 
 
-@dataclass(frozen=True)
-class Cancelled(Message):
-    """The goal ``id`` stopped (acknowledges :class:`Cancel`)."""
-
-    kind: ClassVar[Kind] = Kind.CANCELLED
-    id: str
-    agent: str
-
+Accepted = _bare("Accepted", Kind.ACCEPTED, "The goal ``id`` runs.")
+Cancel = _bare("Cancel", Kind.CANCEL, "Stop the goal ``id``.")
+Cancelled = _bare("Cancelled", Kind.CANCELLED, "The goal ``id`` stopped (acknowledges :class:`Cancel`).")
 
 _TYPES: dict[str, type[Message]] = {cls.kind.value: cls for cls in
                                     (Announce, Heartbeat, Goal, Accepted, Rejected, Feedback, Result, Cancel,

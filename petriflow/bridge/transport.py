@@ -23,13 +23,15 @@ from __future__ import annotations
 
 import importlib
 import re
+import socket
+import time
 from dataclasses import dataclass
-from typing import Callable, Protocol
+from typing import Any, Callable, Protocol
 
 from petriflow.errors import PetriflowError
 
 __all__ = ["Transport", "Endpoint", "Handler", "open_transport", "to_agent", "from_agent", "agent_of",
-           "TRANSPORTS", "DependencyNotInstalled", "AGENT_NAME"]
+           "TRANSPORTS", "DependencyNotInstalled", "AGENT_NAME", "require", "wait_for_port"]
 
 PREFIX = "petriflow/v1"
 #: What an agent name may be (it is one level of a topic).
@@ -42,6 +44,34 @@ Handler = Callable[[str, bytes], None]
 
 class DependencyNotInstalled(PetriflowError):
     """The transport's Python package is missing."""
+
+
+def require(module: str, package: str, transport: str) -> Any:
+    """Import ``module`` (a transport's library), or say which package to install.
+
+    Raises:
+        DependencyNotInstalled: it is missing (``pip install petriflow[bridge]``).
+    """
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise DependencyNotInstalled(f"the {transport} transport needs {package}: pip install petriflow[bridge]")\
+            from None
+
+
+def wait_for_port(port: int, seconds: float = 10.0, host: str = "127.0.0.1") -> None:
+    """Wait until something listens on ``host:port`` (a router or broker just started).
+
+    Raises:
+        PetriflowError: nothing listens there after ``seconds``.
+    """
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        with socket.socket() as sock:
+            if sock.connect_ex((host, port)) == 0:
+                return
+        time.sleep(0.02)
+    raise PetriflowError(f"nothing listens on {host}:{port} after {seconds:g} s")
 
 
 def to_agent(agent: str) -> str:

@@ -11,7 +11,7 @@ import json
 import logging
 from typing import Any
 
-from petriflow.bridge.transport import DependencyNotInstalled, Endpoint, Handler
+from petriflow.bridge.transport import Endpoint, Handler, require
 from petriflow.errors import PetriflowError
 
 __all__ = ["ZenohTransport", "connect", "serve_router", "DEFAULT_PORT"]
@@ -23,12 +23,7 @@ log = logging.getLogger("petriflow.bridge")
 
 
 def _zenoh() -> Any:
-    try:
-        import zenoh
-    except ImportError:
-        raise DependencyNotInstalled("the zenoh transport needs eclipse-zenoh: pip install petriflow[bridge]") \
-            from None
-    return zenoh
+    return require("zenoh", "eclipse-zenoh", "zenoh")
 
 
 def _config(mode: str, endpoint: Endpoint, *, listen: bool = False) -> Any:

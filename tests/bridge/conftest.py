@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from petriflow.bridge.transport import Endpoint, open_transport
+from petriflow.bridge.transport import Endpoint, open_transport, wait_for_port
 
 
 def free_port() -> int:
@@ -80,16 +80,6 @@ class Router:
         if self.session is not None:
             self.session.close()
             self.session = None
-
-
-def wait_for_port(port: int, seconds: float = 10.0) -> None:
-    deadline = time.monotonic() + seconds
-    while time.monotonic() < deadline:
-        with socket.socket() as sock:
-            if sock.connect_ex(("127.0.0.1", port)) == 0:
-                return
-        time.sleep(0.02)
-    raise RuntimeError(f"nothing listens on port {port}")
 
 
 @pytest.fixture

@@ -22,10 +22,11 @@ class Loopback:
         pass
 
 
-def dispatcher(**spec) -> Dispatcher:
+def dispatcher(now=None, **spec) -> Dispatcher:
+    """A dispatcher over a transport that keeps what it sends (``now``: its clock)."""
     spec = BridgeSpec.from_dict({"transport": "mqtt", "agents": {"red": "red"}, "heartbeat": 1000,
                                  "heartbeat_timeout": 2000, **spec})
-    return Dispatcher(spec, Loopback(), run="r")
+    return Dispatcher(spec, Loopback(), run="r", **({} if now is None else {"now": lambda: now[0]}))
 
 
 def test_hostile_messages_are_dropped_and_counted_by_reason():
@@ -51,13 +52,11 @@ def test_hostile_messages_are_dropped_and_counted_by_reason():
 def test_a_goal_the_agent_does_not_hold_is_sent_again_with_the_same_id():
     """After a heartbeat that does not list it (lost in a broker restart), the same goal goes again."""
     now = [0.0]
-    spec = BridgeSpec.from_dict({"transport": "mqtt", "agents": {"red": "red"}, "heartbeat": 1000,
-                                 "heartbeat_timeout": 2000})
-    bridge = Dispatcher(spec, Loopback(), run="r", now=lambda: now[0])
+    bridge = dispatcher(now)
     try:
         bridge.send(protocol.Goal("r/1/1", "red", "core.noop", {}))
         bridge.receive(from_agent("red"), protocol.encode(protocol.Heartbeat("red", ["r/1/1"])))
-        spec_beat = spec.heartbeat
+        spec_beat = bridge.spec.heartbeat
         now[0] += 3 * spec_beat
         bridge.send_again()
         assert len(bridge.transport.sent) == 1  # the agent holds it: not sent again
@@ -72,9 +71,7 @@ def test_a_goal_the_agent_does_not_hold_is_sent_again_with_the_same_id():
 
 def test_an_agent_silent_past_the_timeout_is_lost_and_back_when_it_announces():
     now = [0.0]
-    spec = BridgeSpec.from_dict({"transport": "mqtt", "agents": {"red": "red"}, "heartbeat": 1,
-                                 "heartbeat_timeout": 3})
-    bridge = Dispatcher(spec, Loopback(), run="r", now=lambda: now[0])
+    bridge = dispatcher(now, heartbeat=1, heartbeat_timeout=3)
     try:
         bridge.receive(from_agent("red"), protocol.encode(protocol.Announce("red", {})))
         assert bridge.watch() == ([], [])
