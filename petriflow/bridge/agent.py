@@ -7,8 +7,9 @@ classes (and ``@action`` functions) a local run uses, in wall-clock time: ``star
 when the goal comes, ``poll`` at every step of its own world (``--world``, a pybullet
 stand-in for the hardware) or when the action asked (``wake_at``), ``cancel`` when
 the run cancels the goal. Its context has the goal's transition, agent, parameters,
-input tokens and seed (so ``ctx.rng`` draws as in a local run), and its world; it has
-no run services (an action that reads another agent's state or a port runs locally).
+input tokens and seed (so ``ctx.rng`` draws as in a local run), its world, and the
+world file's settings the action declares (``ctx.settings``); it has no other run
+services (an action that reads another agent's state or a port runs locally).
 
 Goals are de-duplicated by id: a goal sent again (the run re-sends after a broker
 restart) is answered from what the server holds of that id (``accepted`` while it
@@ -37,6 +38,7 @@ from petriflow.errors import NetFormatError
 from petriflow.runtime.action import REQUIRED, Action, ActionContext, Status, first_data, type_names
 from petriflow.runtime.registry import Registry, UnknownActionError, default_registry
 from petriflow.runtime.services import RunServices
+from petriflow.runtime.settings import read_settings
 
 __all__ = ["AgentServer", "announcement"]
 
@@ -265,9 +267,16 @@ class AgentServer:
                 action.setup(self.world)
             except Exception as exc:
                 setup_error = f"setup: {type(exc).__name__}: {exc}"
+        section = getattr(cls, "settings", None)
+        try:  # the world file's settings the action declares, as a local run reads them
+            settings = {} if section is None else read_settings(getattr(self.world, "meta", None),
+                                                                 {section.name: section})
+        except NetFormatError as exc:
+            self._remember(goal.id, protocol.Rejected(goal.id, goal.agent, f"the world's settings: {exc}"))
+            return
         now = self.now
         ctx = ActionContext(goal.transition or goal.action, goal.agent, params, dict(goal.inputs), self.world,
-                            goal.seed or goal.id, now, now, services=RunServices(), action=cls)
+                            goal.seed or goal.id, now, now, services=RunServices(settings=settings), action=cls)
         self.executed += 1
         if self.log_file is not None:
             self.log_file.write(json.dumps({"goal": goal.id, "agent": goal.agent, "action": goal.action,

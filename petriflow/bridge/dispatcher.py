@@ -163,6 +163,8 @@ class Dispatcher:
             seen = self.agents[sender]
             seen.last = now
             if isinstance(message, protocol.Announce):
+                if seen.instance and message.instance != seen.instance:
+                    self._restarted(seen, now)
                 seen.actions, seen.instance, seen.announced = message.actions, message.instance, True
                 self._announced.notify_all()
                 return
@@ -179,6 +181,16 @@ class Dispatcher:
                                         f" {state.goal.agent!r}")
             return
         self._apply(state, message, now)
+
+    def _restarted(self, seen: AgentSeen, now: float) -> None:
+        """``seen`` announced itself as a new process: the goals its old one held died
+        with it (they fail; sending them again would run them a second time). Holds
+        the lock."""
+        for state in self.goals.values():
+            if state.goal.agent == seen.name and not state.ended:
+                state.phase, state.answered = Phase.FAILED, now
+                state.reason = "the agent restarted while the goal ran (its outcome is unknown)"
+        self._ended.notify_all()
 
     def _apply(self, state: GoalState, message: protocol.Message, now: float) -> None:
         with self._lock:

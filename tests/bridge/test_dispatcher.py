@@ -85,3 +85,22 @@ def test_an_agent_silent_past_the_timeout_is_lost_and_back_when_it_announces():
         assert bridge.watch() == ([], ["red"]) and not bridge.is_lost("red")
     finally:
         bridge.close()
+
+
+def test_goals_held_by_an_agent_that_restarted_fail_and_are_not_sent_again():
+    """A new instance announcing itself means the old process died: its goals fail, never run twice."""
+    now = [0.0]
+    bridge = dispatcher(now)
+    try:
+        bridge.receive(from_agent("red"), protocol.encode(protocol.Announce("red", {}, "first")))
+        bridge.send(protocol.Goal("r/1/1", "red", "core.noop", {}))
+        bridge.receive(from_agent("red"), protocol.encode(protocol.Announce("red", {}, "first")))
+        assert not bridge.goal("r/1/1").ended  # the same process again: nothing happened
+        bridge.receive(from_agent("red"), protocol.encode(protocol.Announce("red", {}, "second")))
+        state = bridge.goal("r/1/1")
+        assert state.phase == Phase.FAILED and "restarted" in state.reason
+        now[0] += 10 * bridge.spec.heartbeat
+        bridge.send_again()
+        assert sum(isinstance(m, protocol.Goal) for _, m in bridge.transport.sent) == 1
+    finally:
+        bridge.close()
