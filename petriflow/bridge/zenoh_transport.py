@@ -56,7 +56,8 @@ class ZenohTransport:
             self.session = zenoh.open(_config("client", endpoint))
         except zenoh.ZError as exc:
             raise PetriflowError(f"cannot connect to the Zenoh router at {endpoint.connect}"
-                                 f"{' as ' + endpoint.user if endpoint.user else ''}: {exc}") from None
+                                 f"{' as ' + endpoint.user if endpoint.user else ''}: {str(exc).split(' at /')[0]}")\
+                from None
         self._subscribers: list[Any] = []
         self._publishers: dict[str, Any] = {}
 

@@ -217,6 +217,7 @@ class RunConfig:
         bindings = _bindings(data.get("bind"), bind_fail)
         lines.update({f"bind/{name}": getattr(binds, "key_lines", {}).get(name) for name in bindings})
         lines["actions"] = getattr(data, "key_lines", {}).get("actions")
+        lines["bridge"] = getattr(data, "key_lines", {}).get("bridge")
         lines["metrics"] = getattr(data, "key_lines", {}).get("metrics")
         lines = {key: at or getattr(data, "key_lines", {}).get(key.split("/")[0]) or line
                  for key, at in lines.items()}
@@ -326,7 +327,8 @@ class RunConfig:
         return {name: build_channel(name, spec, registry=registry) for name, spec in self.channels.items()}
 
     def check(self, net: Net) -> None:
-        """Check that faults name agents and channels name channels of ``net``.
+        """Check that faults name agents, channels name channels and the bridge names
+        subnets of ``net``.
 
         Raises:
             NetFormatError: naming the configuration file and the unknown name.
@@ -339,6 +341,12 @@ class RunConfig:
                         f"fault {fault.kind} names unknown agent {agent!r}{did_you_mean(agent, agents)}",
                         path=self.path, line=self.lines.get(f"faults/{i}"),
                     )
+        if self.bridge is not None:
+            names = {*net.subnets, *agents}
+            for subnet in self.bridge.agents:
+                if subnet not in names:
+                    raise NetFormatError(f"bridge: agents: {subnet!r} is no subnet of net {net.id!r}"
+                                         f"{did_you_mean(subnet, names)}", path=self.path, line=self.lines.get("bridge"))
         used = {p.channel for p in net.places.values() if p.channel}
         for name in self.channels:
             if name not in used:

@@ -118,6 +118,7 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
             from petriflow.bridge.remote import bind_remote
             from petriflow.runtime.registry import default_registry
 
+            run_config.check(net)  # the subnets it names, at the configuration's line
             binding = bind_remote(net, run_config.bridge, registry or default_registry,
                                   lambda local: bind(local, registry, path=str(files.path), unimported=pending),
                                   str(files.path))

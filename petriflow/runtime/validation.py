@@ -110,6 +110,8 @@ def validate(net: Net, config: RunConfig, *, binding: Binding | None = None, reg
         try:
             if config.bridge is not None:  # the remote subnets' transitions: goals to their agents
                 from petriflow.bridge.remote import bind_remote
+
+                config.check(net)  # the subnets it names, at the configuration's line
                 from petriflow.runtime.registry import default_registry
 
                 binding = bind_remote(net, config.bridge, registry or default_registry,

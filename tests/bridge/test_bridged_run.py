@@ -436,3 +436,20 @@ def test_a_lost_agent_that_comes_back_is_a_late_joiner(broker, tmp_path):
         for agent in agents:
             agent.kill()
             agent.wait(timeout=10)
+
+
+@pytest.mark.parametrize("bridge, message", [
+    ("{transport: tcp, agents: {r1: x}}", r"run.yaml:2: bridge: unknown transport 'tcp' \(one of: zenoh, mqtt\)"),
+    ("{transport: mqtt, agents: {rr1: x}}", r"run.yaml:2: bridge: agents: 'rr1' is no subnet of net 'relay'"
+                                           r" \(did you mean 'r1'\?\)"),
+    ("{transport: mqtt, agents: {r1: 'a b'}}", r"run.yaml:2: bridge: agents: 'r1': an agent name is"),
+    ("{transport: mqtt, agents: {r1: x}, heartbeat: 2, heartbeat_timeout: 1}",
+     r"run.yaml:2: bridge: heartbeat_timeout \(1 s\) must be longer than heartbeat \(2 s\)"),
+    ("{transport: mqtt, agents: {r1: x}, wiat: 3}", r"run.yaml:2: bridge: unknown key 'wiat' \(did you mean 'wait'\?\)"),
+])
+def test_a_bad_bridge_section_is_one_line_at_its_line(tmp_path, bridge, message):
+    (tmp_path / "net.yaml").write_text(NET)
+    (tmp_path / "run.yaml").write_text(f"seed: 1\nbridge: {bridge}\n")
+    with pytest.raises(NetFormatError, match=message):
+        run_files(tmp_path / "net.yaml", db=tmp_path / "run.sqlite")
+    assert not (tmp_path / "run.sqlite").exists()
