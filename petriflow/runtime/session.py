@@ -164,7 +164,8 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
         extras.finish(scheduler, result, checked.config)
         if remote is not None:  # what the bridge dropped, by reason (docs/bridge.md)
             dropped = getattr(remote, "dispatcher", remote).dropped
-            result.metrics["bridge.dropped"] = dict(sorted(dropped.items()))
+            result.metrics["bridge.dropped"] = sum(dropped.values())
+            result.metrics.update({f"bridge.dropped.{why}": count for why, count in sorted(dropped.items())})
     if not keep_events:
         result.events = []
     if journal is not None:
