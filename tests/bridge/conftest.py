@@ -7,6 +7,7 @@ the broker ``scripts/setup.sh`` installs, the Zenoh router a session of this pro
 from __future__ import annotations
 
 import getpass
+import os
 import shutil
 import socket
 import subprocess
@@ -80,6 +81,32 @@ class Router:
         if self.session is not None:
             self.session.close()
             self.session = None
+
+
+def children() -> set[int]:
+    """The live processes whose parent is this one (from /proc; zombies count as gone)."""
+    found = set()
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == os.getpid() and fields[0] != "Z":
+            found.add(int(entry.name))
+    return found
+
+
+@pytest.fixture(autouse=True)
+def no_process_left():
+    """Every bridge test stops every process it started (the broker, agents, a run)."""
+    before = children()
+    yield
+    deadline = time.monotonic() + 10
+    while children() - before and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not children() - before, "a test left processes running"
 
 
 @pytest.fixture
