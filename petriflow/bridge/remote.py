@@ -24,7 +24,7 @@ from petriflow.bridge.dispatcher import Dispatcher, Phase
 from petriflow.bridge.spec import BridgeSpec
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
-from petriflow.runtime.action import Action, ActionContext, Param, Status
+from petriflow.runtime.action import Action, ActionContext, Param, Port, Status
 from petriflow.runtime.binding import Binding, BoundTransition
 from petriflow.runtime.registry import Registry, UnknownActionError
 
@@ -177,10 +177,8 @@ def bind_remote(net: Net, spec: BridgeSpec, registry: Registry, bind_local: Any,
             try:
                 params = local.check_params(transition.params, tid)
             except NetFormatError as exc:
-                param = getattr(exc, "param", None)
-                line = net.lines.get(f"{tid}/params/{param}") or net.lines.get(f"{tid}/params") or \
-                    net.lines.get(tid)
-                raise NetFormatError(exc.message, path=path or net.path, line=line, element=tid) from None
+                raise _at(net, tid, path, exc.message, getattr(exc, "param", None)) from None
+            _check_places(net, tid, path, name, local, params)
         cls = classes.get((agent, name))
         if cls is None:
             cls = classes[agent, name] = type(f"Remote[{agent}:{name}]", (RemoteAction,),
@@ -190,6 +188,26 @@ def bind_remote(net: Net, spec: BridgeSpec, registry: Registry, bind_local: Any,
         old = transitions[tid]
         transitions[tid] = BoundTransition(tid, cls, params, old.guard, None, old.reads)
     return dataclasses.replace(binding, net=net, transitions=transitions)
+
+
+def _at(net: Net, tid: str, path: str | None, message: str, param: str | None = None) -> NetFormatError:
+    """An error about transition ``tid`` (its parameter ``param``) at the net's line."""
+    line = net.lines.get(f"{tid}/params/{param}") or net.lines.get(f"{tid}/params") or net.lines.get(tid)
+    return NetFormatError(message, path=path or net.path, line=line, element=tid)
+
+
+def _check_places(net: Net, tid: str, path: str | None, name: str, local: type[Action],
+                  params: dict[str, Any]) -> None:
+    """The places a remote action's parameters name must be the net's; a port (a place
+    the action reads while it runs) cannot be read on a remote agent."""
+    for pname, declared in getattr(local, "params", {}).items():
+        if isinstance(declared, Port):
+            raise _at(net, tid, path, f"action {name} reads place {params.get(pname)!r} through its port {pname!r}"
+                      " while it runs, which a remote agent cannot (leave its subnet out of bridge: agents)", pname)
+        for place in declared.place_names(params.get(pname)):
+            if not isinstance(place, str) or place not in net.places:
+                hint = did_you_mean(place, net.places) if isinstance(place, str) else ""
+                raise _at(net, tid, path, f"parameter {pname!r} names unknown place {place!r}{hint}", pname)
 
 
 def check_announced(binding: Binding, dispatcher: Dispatcher, path: str | None = None) -> None:

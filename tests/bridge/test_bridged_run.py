@@ -455,3 +455,22 @@ def test_a_bad_bridge_section_is_one_line_at_its_line(tmp_path, bridge, message)
     with pytest.raises(NetFormatError, match=message):
         run_files(tmp_path / "net.yaml", db=tmp_path / "run.sqlite")
     assert not (tmp_path / "run.sqlite").exists()
+
+
+def test_an_action_reading_ports_cannot_be_put_on_a_remote_agent(tmp_path):
+    """A port is read while the action runs, from the run's places: refused at bind time, at the line."""
+    from petriflow import Param, Port
+    from petriflow.runtime.registry import Registry
+
+    registry = Registry()
+
+    @registry.action("demo.watch", {"scene": Port("the place watched"), "every": Param(float, 1.0)})
+    def watch(ctx):
+        return ctx.latest("scene")
+
+    (tmp_path / "net.yaml").write_text(NET.replace("action: core.set, params: {value: {x: 1}}",
+                                                   "action: demo.watch, params: {scene: c}"))
+    (tmp_path / "run.yaml").write_text("seed: 1\nbridge: {transport: mqtt, agents: {r1: x}}\n")
+    with pytest.raises(NetFormatError, match=r"net.yaml:9: 'mark': action demo.watch reads place 'c' through its"
+                                             r" port 'scene'"):
+        run_files(tmp_path / "net.yaml", registry=registry)
