@@ -23,12 +23,12 @@ all of it.
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 from petriflow.agents.comm.framework import Code, History, Packet, plan
 from petriflow.runtime.agents import AgentState
+from petriflow.runtime.outbox import Outbox
 
 __all__ = ["CommAgent", "Peer", "vertex_id"]
 
@@ -68,7 +68,7 @@ class CommAgent(AgentState):
     explored: bool = False
     explored_at: float | None = None
     final: dict[int, int] = field(default_factory=dict)      # source -> items it has in all
-    outbox: dict[str, deque] = field(default_factory=dict)  # peer -> messages waiting
+    outbox: Outbox = field(init=False, repr=False)          # peer -> packets waiting
     asked: set = field(default_factory=set)                  # (peer, source) queries answered by no reply yet
     in_range: set = field(default_factory=set)
     last_seen: dict[int, tuple[float, float]] = field(default_factory=dict)  # source -> last vertex position
@@ -94,6 +94,7 @@ class CommAgent(AgentState):
 
     def __post_init__(self) -> None:
         AgentState.__init__(self)
+        self.outbox = Outbox(self)
 
     def to_token(self) -> dict[str, Any]:
         """What a trace records of this state: who it is and how far it got (cheap,
@@ -175,8 +176,7 @@ class CommAgent(AgentState):
         message = replace(message, id_bytes=self.id_bytes, stopped=self.broken)
         peer = self.by_address(message.receiver)
         if peer is not None:
-            self.outbox.setdefault(peer.name, deque()).append(message)
-            self.touch(f"outbox/{peer.name}")
+            self.outbox.put(peer.name, message)
 
     def hear(self, names: set[str]) -> None:
         """The peers heard now (above the threshold and running); the send guards of
@@ -233,17 +233,15 @@ class CommAgent(AgentState):
         return self.lost.pop(peer, [])
 
     def take(self, peer: str) -> Packet | None:
-        box = self.outbox.get(peer)
-        if not box:
+        message = self.outbox.take(peer)
+        if message is None:
             return None
-        message = box.popleft()
-        self.touch(f"outbox/{peer}")
         self.sent_bytes += message.size
         self.payload_bytes += message.payload
         return message
 
     def has_for(self, peer: str) -> bool:
-        return bool(self.outbox.get(peer)) and peer in self.in_range
+        return self.outbox.waiting(peer) > 0 and peer in self.in_range
 
     def receive(self, message: Packet, now: float) -> list[int]:
         """Handle one message that arrived at simulated time ``now``; returns the ids of

@@ -140,6 +140,13 @@ class Rule(Name):
 class History:
     """One agent's data array ``Ad`` and history array ``Ah`` (see the module).
 
+    The history model of the comm and swarm scenarios (the swarm's
+    :class:`~petriflow.agents.swarm.agent.SwarmHistory` is this model, kept in arrays for
+    a large team, with the same answers): what this agent knows, from whom, and what
+    went to which peer. The SLAM scenario's
+    :class:`~petriflow.agents.slam.history.History` is a different model (its docstring
+    says how).
+
     ``data`` holds ``(source, item, via)``: ``via`` is the agent it came from (the
     agent itself for its own data), so nothing goes back where it came from.
     ``rows`` holds ``[from, to, sent, pending]`` in the order they were made. Both are

@@ -17,10 +17,12 @@ of each RA (metadata of the same kind, so that the network knows within seconds 
 anyone still hears an RA). The data itself travels as
 frames, tokens of the shared ``air`` place.
 
-Frames are plain mappings: ``from``, ``to``, ``kind`` (``data``, ``pull``, ``greet``,
-``report``, ``decision``, ``alert``, ``finished``), ``size`` (bytes), ``counts`` (the
-sender's nodes per block), ``payload`` (rows, pending paths, links), ``seen`` (the
-latest time the sender knows each RA was heard).
+Frames (:func:`frame`) are the payload of the runtime's
+:class:`~petriflow.runtime.channel_models.Message` through the ``air`` place: plain
+mappings (the token data a trace records) with ``from``, ``to``, ``kind`` (a
+:class:`FrameKind`), ``size`` (bytes), ``counts`` (the sender's nodes per block),
+``payload`` (rows, pending paths, links: the history's rows, not a message), ``seen``
+(the latest time the sender knows each RA was heard).
 """
 
 from __future__ import annotations
@@ -30,9 +32,30 @@ from dataclasses import dataclass
 from typing import Any
 
 from petriflow.agents.slam.history import History
+from petriflow.outcome import Name
 from petriflow.runtime.agents import AgentState
 
-__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "Robot", "Wireless", "frame", "merge_seen", "payload_size"]
+__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "FrameKind", "Robot", "Wireless", "frame", "merge_seen",
+           "payload_size"]
+
+
+class FrameKind(Name):
+    """What a frame is (its ``kind``; a ``str`` enum, so a trace writes the text)."""
+
+    DATA = "data"
+    """History rows the receiver lacks (Algorithm 2's sender)."""
+    PULL = "pull"
+    """A request for the rows the sender lacks (the node holds more)."""
+    GREET = "greet"
+    """Nothing but the time stamps (equal holders)."""
+    REPORT = "report"
+    """An RA's sensor event, to the central unit."""
+    DECISION = "decision"
+    """The central unit's direction for an RA."""
+    ALERT = "alert"
+    """A WA's alert to the base: an RA not heard for too long."""
+    FINISHED = "finished"
+    """The end of the map, to the base."""
 
 
 @dataclass
@@ -145,9 +168,9 @@ def payload_size(payload: dict[str, Any] | None) -> int:
     return 8 * rows + 2 * pending + 2 * links
 
 
-def frame(sender: str, receiver: str, kind: str, **fields: Any) -> dict[str, Any]:
+def frame(sender: str, receiver: str, kind: FrameKind, **fields: Any) -> dict[str, Any]:
     """A frame (see the module): 12 bytes of header, then its payload."""
-    data = {"from": sender, "to": receiver, "kind": kind, **fields}
+    data = {"from": sender, "to": receiver, "kind": FrameKind(kind), **fields}
     data["size"] = 12 + payload_size(fields.get("payload")) + 4 * len(fields.get("seen", {}) or {})
     return data
 

@@ -135,6 +135,15 @@ class Vertex:
 class History:
     """A history array: the rows, by id, in the order they were learnt.
 
+    Not the history model of :class:`petriflow.agents.comm.framework.History` (which
+    the swarm shares): that one records, per source and per peer, what was sent to
+    whom and what is pending (the exchange is driven by *whom* this agent told what).
+    This one keeps no record of peers: it is the map itself (vertices with their
+    pending paths and links), and what a peer lacks is read from the peer's own
+    counts per block of ids, which its beacon and frames carry (Algorithm 2 compares
+    holdings, then sends the difference). The two papers' exchanges differ in just
+    this, so each scenario keeps its own.
+
     Args:
         block: the RA's block of ids (its own new vertices are numbered
             ``block * BLOCK``, ``+ 1``, ...); a WA's array has no block of its own.
