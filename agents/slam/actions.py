@@ -44,7 +44,7 @@ from typing import Any
 
 from petriflow.agents.slam.agent import Air, Base, Central, FrameKind, Robot, Wireless, frame, merge_seen
 from petriflow.agents.slam.corridors import HALF_WIDTH, to_map
-from petriflow.agents.slam.history import choose, exchange_role, read_node, update
+from petriflow.agents.slam.history import Exchange, ReadingRule, choose, exchange_role, read_node, update
 from petriflow.capabilities import Bodies, Physics, Poses
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 from petriflow.runtime.settings import Section, Setting
@@ -183,10 +183,10 @@ def _evaluate(ctx: ActionContext, state: Robot, air_place: str, boot: bool = Fal
     rssi, nearest, beacon = heard[0]
     role = exchange_role(state.history.counts(), beacon.counts)
     seen = {state.name: ctx.now}
-    if role == "send":
+    if role == Exchange.SEND:
         state.queue(frame(state.name, nearest, FrameKind.DATA, counts=state.history.counts(),
                           payload=state.history.payload(beacon.counts), seen=seen))
-    elif role == "pull":
+    elif role == Exchange.PULL:
         state.queue(frame(state.name, nearest, FrameKind.PULL, counts=state.history.counts(), seen=seen))
         state.awaiting = nearest
         state.touch("plan")
@@ -428,13 +428,13 @@ class Scan(Action):
                 merge_seen(state.seen, heard[2].seen)
         if state.role == "client":
             aps = [h for h in neighbours if h[2].role == "ap"]
-            role = exchange_role(state.history.counts(), aps[0][2].counts) if aps else "greet"
-            if role != "greet":  # the nearest access point holds other nodes: exchange (Algorithm 2)
+            role = exchange_role(state.history.counts(), aps[0][2].counts) if aps else Exchange.GREET
+            if role != Exchange.GREET:  # the nearest access point holds other nodes: exchange (Algorithm 2)
                 _, peer, beacon = aps[0]
                 mine = state.history.counts()
-                extra = {"payload": state.history.payload(beacon.counts)} if role == "send" else {}
-                state.queue(frame(state.name, peer, FrameKind.DATA if role == "send" else FrameKind.PULL, counts=mine,
-                                  seen=dict(state.seen), **extra))
+                extra = {"payload": state.history.payload(beacon.counts)} if role == Exchange.SEND else {}
+                kind = FrameKind.DATA if role == Exchange.SEND else FrameKind.PULL
+                state.queue(frame(state.name, peer, kind, counts=mine, seen=dict(state.seen), **extra))
                 state.connected_at = ctx.now
                 state.exchanges += 1
                 state.role = "ap"
@@ -541,9 +541,9 @@ def _robot_hears(ctx: ActionContext, state: Robot, data: dict[str, Any]) -> None
             beacon = air.beacons.get(data["from"])
             ssid = beacon.ssid if beacon else data["from"]
             reading = read_node(state.history, ssid, state.last_read)
-            if reading.kind != "ignore":
+            if reading.kind != ReadingRule.IGNORE:
                 state.last_read = ssid
-            if reading.kind == "follow" and new:
+            if reading.kind == ReadingRule.FOLLOW and new:
                 state.goal = reading.path
                 state.history.take(*reading.path)
                 ctx.emit("slam.reading", node=ssid, rule=reading.kind, path=list(reading.path))
