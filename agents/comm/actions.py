@@ -340,7 +340,7 @@ class Explore(Action):
             return
         stopped = {state.peers[name].address for name in state.stopped if name in state.peers}
         waiting_for = [s for s in waiting_for if s not in stopped]
-        owed = state.untold(state.acted_at) + [name for name, box in state.outbox.items() if box and name not in state.stopped]
+        owed = state.untold(ctx.now) + [name for name, box in state.outbox.items() if box and name not in state.stopped]
         waiting_for += [state.peers[name].address for name in owed if state.peers[name].address not in waiting_for]
         if state.parked and tuple(waiting_for) != state.parked_for:
             state.parked = False  # someone else to meet now (or no longer): choose the place again

@@ -35,8 +35,8 @@ from petriflow.agents.slam.history import History
 from petriflow.outcome import Name
 from petriflow.runtime.agents import AgentState
 
-__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "FrameKind", "Robot", "Wireless", "frame", "merge_seen",
-           "payload_size"]
+__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "FrameKind", "FrameSender", "Robot", "Wireless", "frame",
+           "merge_seen", "payload_size"]
 
 
 class FrameKind(Name):
@@ -185,7 +185,28 @@ def merge_seen(mine: dict[str, float], theirs: dict[str, float] | None) -> bool:
     return changed
 
 
-class Robot(AgentState):
+class FrameSender(AgentState):
+    """The part of a state with a radio: its frames waiting to go into the air, oldest
+    first, in one queue whatever their receivers (the air carries one frame at a
+    time, in the order they were queued). A change touches the key ``outbox``."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.outbox: list[dict[str, Any]] = []
+
+    def queue(self, data: dict[str, Any]) -> None:
+        self.outbox.append(data)
+        self.touch("outbox")
+
+    def take(self) -> dict[str, Any] | None:
+        if not self.outbox:
+            return None
+        data = self.outbox.pop(0)
+        self.touch("outbox")
+        return data
+
+
+class Robot(FrameSender):
     """An RA's state (see the module)."""
 
     def __init__(self, name: str, *, slot: int = 0, mode: str = "decentralised", radius: float = 1.0) -> None:
@@ -204,7 +225,6 @@ class Robot(AgentState):
         self.decision: dict[str, Any] | None = None
         self.awaiting: str | None = None  # a peer whose answer it waits for before moving
         self.last_read: str | None = None
-        self.outbox: list[dict[str, Any]] = []
         self.needs_wa = False
         self.installed = 0
         self.finished = False
@@ -217,17 +237,6 @@ class Robot(AgentState):
             return False
         return self.mode == "decentralised" or self.here is None or self.decision is not None
 
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
-
     def beacon(self) -> Beacon:
         return Beacon("ra", self.name, "client", self.history.counts())
 
@@ -235,7 +244,7 @@ class Robot(AgentState):
         return {"ra": self.name, "vertices": len(self.history), "installed": self.installed}
 
 
-class Wireless(AgentState):
+class Wireless(FrameSender):
     """A WA's state (see the module)."""
 
     def __init__(self, name: str, ssid: str, owner: str, position: tuple[float, float], *, radius: float = 1.0,
@@ -253,19 +262,7 @@ class Wireless(AgentState):
         self.seen: dict[str, float] = {}
         self.alerted: set[tuple[str, float]] = set()
         self.alerts: list[dict[str, Any]] = []
-        self.outbox: list[dict[str, Any]] = []
         self.exchanges = 0
-
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
 
     def beacon(self) -> Beacon:
         return Beacon("wa", self.ssid, self.role, self.history.counts(), dict(self.seen), self.spot)
@@ -274,7 +271,7 @@ class Wireless(AgentState):
         return {"wa": self.ssid, "role": self.role, "vertices": len(self.history)}
 
 
-class Central(AgentState):
+class Central(FrameSender):
     """The central unit's state (see the module)."""
 
     def __init__(self, name: str = "central", *, radius: float = 1.0) -> None:
@@ -285,20 +282,8 @@ class Central(AgentState):
         self.heard: dict[str, float] = {}
         self.alerted: set[tuple[str, float]] = set()
         self.alerts: list[dict[str, Any]] = []
-        self.outbox: list[dict[str, Any]] = []
         self.done = False
         self.broken = False
-
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
 
     def to_token(self) -> dict[str, Any]:
         return {"central": self.name, "vertices": len(self.history)}
