@@ -17,10 +17,12 @@ of each RA (metadata of the same kind, so that the network knows within seconds 
 anyone still hears an RA). The data itself travels as
 frames, tokens of the shared ``air`` place.
 
-Frames are plain mappings: ``from``, ``to``, ``kind`` (``data``, ``pull``, ``greet``,
-``report``, ``decision``, ``alert``, ``finished``), ``size`` (bytes), ``counts`` (the
-sender's nodes per block), ``payload`` (rows, pending paths, links), ``seen`` (the
-latest time the sender knows each RA was heard).
+Frames (:func:`frame`) are the payload of the runtime's
+:class:`~petriflow.runtime.channel_models.Message` through the ``air`` place: plain
+mappings (the token data a trace records) with ``from``, ``to``, ``kind`` (a
+:class:`FrameKind`), ``size`` (bytes), ``counts`` (the sender's nodes per block),
+``payload`` (rows, pending paths, links: the history's rows, not a message), ``seen``
+(the latest time the sender knows each RA was heard).
 """
 
 from __future__ import annotations
@@ -30,20 +32,59 @@ from dataclasses import dataclass
 from typing import Any
 
 from petriflow.agents.slam.history import History
+from petriflow.outcome import Name
 from petriflow.runtime.agents import AgentState
 
-__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "Robot", "Wireless", "frame", "merge_seen", "payload_size"]
+__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "FrameKind", "FrameSender", "RadioKind", "Robot", "Role",
+           "Wireless", "frame", "merge_seen", "payload_size"]
+
+
+class RadioKind(Name):
+    """Whose radio a beacon is."""
+
+    RA = "ra"
+    """A robot agent's."""
+    WA = "wa"
+    """A wireless agent's (a node an RA put down)."""
+
+
+class Role(Name):
+    """A radio's Algorithm 2 role."""
+
+    CLIENT = "client"
+    """Looking for an access point to exchange with."""
+    AP = "ap"
+    """An access point: others connect to it."""
+
+
+class FrameKind(Name):
+    """What a frame is (its ``kind``; a ``str`` enum, so a trace writes the text)."""
+
+    DATA = "data"
+    """History rows the receiver lacks (Algorithm 2's sender)."""
+    PULL = "pull"
+    """A request for the rows the sender lacks (the node holds more)."""
+    GREET = "greet"
+    """Nothing but the time stamps (equal holders)."""
+    REPORT = "report"
+    """An RA's sensor event, to the central unit."""
+    DECISION = "decision"
+    """The central unit's direction for an RA."""
+    ALERT = "alert"
+    """A WA's alert to the base: an RA not heard for too long."""
+    FINISHED = "finished"
+    """The end of the map, to the base."""
 
 
 @dataclass
 class Beacon:
-    """What a scan hears of a radio: ``kind`` (``ra``, ``wa``), ``ssid``, ``role``
-    (``client``, ``ap``), ``counts`` (nodes per block of ids) and, for a WA, ``seen``
+    """What a scan hears of a radio: ``kind`` (:class:`RadioKind`), ``ssid``, ``role``
+    (:class:`Role`), ``counts`` (nodes per block of ids) and, for a WA, ``seen``
     (when it last heard of each RA)."""
 
-    kind: str
+    kind: RadioKind
     ssid: str
-    role: str
+    role: Role
     counts: dict[int, int]
     seen: dict[str, float] | None = None
     position: tuple[float, float] | None = None  # where a radio that does not move stands (world)
@@ -85,7 +126,7 @@ class Air:
             cached = self._moving[name] = (now, radio.position(name))
         return cached[1]
 
-    def heard(self, name: str, radio: Any, kinds: tuple[str, ...] = ("wa",),
+    def heard(self, name: str, radio: Any, kinds: tuple[RadioKind, ...] = (RadioKind.WA,),
               now: float | None = None) -> list[tuple[float, str, Beacon]]:
         """``(RSSI, radio, beacon)`` of the radios of ``kinds`` that ``name`` hears (a
         frame has some chance to pass), strongest first. ``now``: positions of moving
@@ -145,9 +186,9 @@ def payload_size(payload: dict[str, Any] | None) -> int:
     return 8 * rows + 2 * pending + 2 * links
 
 
-def frame(sender: str, receiver: str, kind: str, **fields: Any) -> dict[str, Any]:
+def frame(sender: str, receiver: str, kind: FrameKind, **fields: Any) -> dict[str, Any]:
     """A frame (see the module): 12 bytes of header, then its payload."""
-    data = {"from": sender, "to": receiver, "kind": kind, **fields}
+    data = {"from": sender, "to": receiver, "kind": FrameKind(kind), **fields}
     data["size"] = 12 + payload_size(fields.get("payload")) + 4 * len(fields.get("seen", {}) or {})
     return data
 
@@ -162,7 +203,28 @@ def merge_seen(mine: dict[str, float], theirs: dict[str, float] | None) -> bool:
     return changed
 
 
-class Robot(AgentState):
+class FrameSender(AgentState):
+    """The part of a state with a radio: its frames waiting to go into the air, oldest
+    first, in one queue whatever their receivers (the air carries one frame at a
+    time, in the order they were queued). A change touches the key ``outbox``."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.outbox: list[dict[str, Any]] = []
+
+    def queue(self, data: dict[str, Any]) -> None:
+        self.outbox.append(data)
+        self.touch("outbox")
+
+    def take(self) -> dict[str, Any] | None:
+        if not self.outbox:
+            return None
+        data = self.outbox.pop(0)
+        self.touch("outbox")
+        return data
+
+
+class Robot(FrameSender):
     """An RA's state (see the module)."""
 
     def __init__(self, name: str, *, slot: int = 0, mode: str = "decentralised", radius: float = 1.0) -> None:
@@ -181,7 +243,6 @@ class Robot(AgentState):
         self.decision: dict[str, Any] | None = None
         self.awaiting: str | None = None  # a peer whose answer it waits for before moving
         self.last_read: str | None = None
-        self.outbox: list[dict[str, Any]] = []
         self.needs_wa = False
         self.installed = 0
         self.finished = False
@@ -194,29 +255,18 @@ class Robot(AgentState):
             return False
         return self.mode == "decentralised" or self.here is None or self.decision is not None
 
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
-
     def beacon(self) -> Beacon:
-        return Beacon("ra", self.name, "client", self.history.counts())
+        return Beacon(RadioKind.RA, self.name, Role.CLIENT, self.history.counts())
 
     def to_token(self) -> dict[str, Any]:
         return {"ra": self.name, "vertices": len(self.history), "installed": self.installed}
 
 
-class Wireless(AgentState):
+class Wireless(FrameSender):
     """A WA's state (see the module)."""
 
     def __init__(self, name: str, ssid: str, owner: str, position: tuple[float, float], *, radius: float = 1.0,
-                 role: str = "client") -> None:
+                 role: Role = Role.CLIENT) -> None:
         super().__init__()
         self.name = name
         self.ssid = ssid
@@ -230,28 +280,16 @@ class Wireless(AgentState):
         self.seen: dict[str, float] = {}
         self.alerted: set[tuple[str, float]] = set()
         self.alerts: list[dict[str, Any]] = []
-        self.outbox: list[dict[str, Any]] = []
         self.exchanges = 0
 
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
-
     def beacon(self) -> Beacon:
-        return Beacon("wa", self.ssid, self.role, self.history.counts(), dict(self.seen), self.spot)
+        return Beacon(RadioKind.WA, self.ssid, self.role, self.history.counts(), dict(self.seen), self.spot)
 
     def to_token(self) -> dict[str, Any]:
         return {"wa": self.ssid, "role": self.role, "vertices": len(self.history)}
 
 
-class Central(AgentState):
+class Central(FrameSender):
     """The central unit's state (see the module)."""
 
     def __init__(self, name: str = "central", *, radius: float = 1.0) -> None:
@@ -262,20 +300,8 @@ class Central(AgentState):
         self.heard: dict[str, float] = {}
         self.alerted: set[tuple[str, float]] = set()
         self.alerts: list[dict[str, Any]] = []
-        self.outbox: list[dict[str, Any]] = []
         self.done = False
         self.broken = False
-
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
 
     def to_token(self) -> dict[str, Any]:
         return {"central": self.name, "vertices": len(self.history)}

@@ -33,8 +33,8 @@ from petriflow.runtime.binding import Binding
 from petriflow.runtime.clock import Clock, RealtimeClock, SimulatedClock
 from petriflow.runtime.config import RunConfig
 from petriflow.runtime.scheduler import Scheduler
-from petriflow.runtime.stopwatch import UNTIMED, Timing
 from petriflow.runtime.services import RemoteGoals
+from petriflow.runtime.stopwatch import UNTIMED, Timing
 from petriflow.runtime.validation import CheckedRun, validate
 
 __all__ = ["open_run", "CheckedRun", "validate"]
