@@ -63,7 +63,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     from petriflow.sweep import load_sweep, run_sweep
-    from petriflow.sweep.report import plot, text_table, write_csv
+    from petriflow.sweep.report import plot, status_counts, status_notes, text_table, write_csv
 
     if args.workers is not None and args.workers < 1:
         raise PetriflowError(f"--workers must be at least 1, got {args.workers}")
@@ -117,6 +117,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         print(f"{title}: {_count(len(result.trials), 'trial')} in {_count(len(result.rows), 'row')}"
               f" ({result.ran} run now in {result.wall:.1f} s wall, {len(result.failures)} failed)")
         print(text_table(result.rows, result.names, parameters))
+        notes = status_notes(result.rows, result.names, parameters)
+        if notes:
+            counts = status_counts([{**r, "paper": {k: v for k, v in r["paper"].items() if k in result.names}}
+                                    for r in result.rows])
+            print("  published values: " + ", ".join(f"{n} {k.replace('-', ' ')}" for k, n in counts.items() if n))
+            for note in notes:
+                print(f"  {note}")
         if result.wall_clock():
             print(f"  wall-clock (not reproducible between runs, unlike the other metrics):"
                   f" {', '.join(result.wall_clock())}")
