@@ -146,28 +146,34 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     return 1 if result.failures else 0
 
 
+#: ``petriflow reproduce``'s options: (flags, argparse keywords).
+_REPRODUCE_OPTIONS = (
+    (("root",), {"nargs": "?", "default": "nets", "help": "the folder of scenarios (default: nets)"}),
+    (("--quick",), {"action": "store_true", "help": "one trial a row (a quick pass)"}),
+    (("--only",), {"metavar": "NAMES", "help": "only these scenarios (comma-separated folder names)"}),
+    (("--out",), {"help": "results databases and pages (default: out/reproduction, or out/reproduction-quick"
+                          " with --quick)"}),
+    (("--report",), {"metavar": "FILE.md", "help": "the report (default: docs/reproduction.md; with --quick or"
+                                                    " --only, OUT/reproduction.md)"}),
+    (("--no-pages",), {"action": "store_true", "help": "write no sweep pages"}),
+    (("--list",), {"action": "store_true", "help": "run nothing: list every published value and its status"}),
+    (("--commit",), {"help": "the commit to name in the report (scripts/reproduce.sh passes it)"}),
+)
+
+
 def add_reproduce_parser(sub) -> argparse.ArgumentParser:
     """Add the ``reproduce`` command to the ``petriflow`` subcommands ``sub``."""
     from petriflow.limits import integer_argument
 
-    command = sub.add_parser(
-        "reproduce", help="Run every published table of the scenarios and write the reproduction report.",
-        description="Run every sweep file with paper: values under ROOT/*/experiments/ (each scenario's"
-        " published tables), keep each one's results database and page under --out, and write the report"
-        " (Markdown): every published value beside the measured mean ± sd, its status (predicted, built in,"
-        " missed) and the deviation. Exit 0 when every trial ran, 1 when some failed, 2 on bad input.")
-    command.add_argument("root", nargs="?", default="nets", help="the folder of scenarios (default: nets)")
-    command.add_argument("--quick", action="store_true", help="one trial a row (a quick pass)")
-    command.add_argument("--only", metavar="NAMES", help="only these scenarios (comma-separated folder names)")
-    command.add_argument("--out", help="results databases and pages (default: out/reproduction, or"
-                         " out/reproduction-quick with --quick)")
-    command.add_argument("--report", metavar="FILE.md", help="the report (default: docs/reproduction.md;"
-                         " with --quick or --only, OUT/reproduction.md)")
+    summary = ("Run every sweep file with paper: values under ROOT/*/experiments/ (each scenario's published"
+               " tables), keep each one's results database and page under --out, and write the report"
+               " (Markdown): every published value beside the measured mean ± sd, its status (predicted, built"
+               " in, missed) and the deviation. Exit 0 when every trial ran, 1 when some failed, 2 on bad input.")
+    command = sub.add_parser("reproduce", description=summary,
+                             help="Run every published table of the scenarios and write the reproduction report.")
+    for flags, keywords in _REPRODUCE_OPTIONS:
+        command.add_argument(*flags, **keywords)
     command.add_argument("--workers", type=integer_argument, help="processes (default: every CPU)")
-    command.add_argument("--no-pages", action="store_true", help="write no sweep pages")
-    command.add_argument("--list", action="store_true", help="run nothing: list every published value and its"
-                         " status (the report's tables without measurements)")
-    command.add_argument("--commit", help="the commit to name in the report (scripts/reproduce.sh passes it)")
     command.set_defaults(handler=cmd_reproduce)
     return command
 

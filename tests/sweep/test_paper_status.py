@@ -84,24 +84,34 @@ def test_the_command_prints_the_statuses(folder, tmp_path, capsys):
     assert rows[0]["paper_status"]["n"] == {"status": "predicted"}
 
 
-@pytest.mark.parametrize("body, fragment, line", [
-    ("paper: {rows: [{values: {t: {value: 1, status: guessed}}}]}\n", "status must be one of predicted,"
-     " built-in, missed, not 'guessed'", 6),
-    ("paper:\n  rows:\n    - values:\n        t: {value: 1, status: missed}\n", "a missed value needs because:", 9),
-    ("paper:\n  rows:\n    - status: built-in\n      values: {t: 1}\n", "a built-in value needs because:", 8),
-    ("paper:\n  rows:\n    - values:\n        t: {status: predicted}\n", "(no value:)", 9),
-    ("paper:\n  rows:\n    - values:\n        t: {value: 1, stat: predicted}\n", "unknown key 'stat'", 9),
-    ("paper:\n  rows:\n    - values:\n        n: 2\n        t: [1]\n", "paper: t: a value is a number or text", 10),
-    ("paper:\n  rows:\n    - values:\n        t: {value: 1, status: missed, because: ''}\n", "because must be text", 9),
-    ("rows: [{w: 3, paper: {t: {value: 1, status: built-in}}}]\n", "a built-in value needs because:", 6),
-])
-def test_bad_statuses_name_the_file_and_line(folder, tmp_path, body, fragment, line):
+BAD = [  # what the file's paper part says, the error, and the line it names
+    dict(line=6, says="status must be one of predicted, built-in, missed, not 'guessed'",
+         paper="paper: {rows: [{values: {t: {value: 1, status: guessed}}}]}\n"),
+    dict(line=9, says="a missed value needs because:", paper="paper:\n  rows:\n    - values:\n        t: {value: 1, status: missed}\n"),
+    dict(line=8, says="a built-in value needs because:", paper="paper:\n  rows:\n    - status: built-in\n      values: {t: 1}\n"),
+    dict(line=9, says="(no value:)", paper="paper:\n  rows:\n    - values:\n        t: {status: predicted}\n"),
+    dict(line=9, says="unknown key 'stat'", paper="paper:\n  rows:\n    - values:\n        t: {value: 1, stat: predicted}\n"),
+    dict(line=10, says="paper: t: a value is a number or text", paper="paper:\n  rows:\n    - values:\n        n: 2\n        t: [1]\n"),
+    dict(line=9, says="because must be text", paper="paper:\n  rows:\n    - values:\n        t: {value: 1, status: missed, because: ''}\n"),
+    dict(line=6, says="a built-in value needs because:", paper="rows: [{w: 3, paper: {t: {value: 1, status: built-in}}}]\n"),
+]
+
+
+def refusal(folder, tmp_path, body: str) -> NetFormatError:
+    """The error reading a sweep file with ``body`` gives."""
     path = write(tmp_path, "bad.yaml", sweep_text(folder, body))
-    with pytest.raises(NetFormatError) as caught:
+    try:
         load_sweep(path)
-    assert fragment in caught.value.message
-    assert caught.value.path == str(path)
-    assert caught.value.line == line
+    except NetFormatError as exc:
+        assert exc.path == str(path)
+        return exc
+    raise AssertionError(f"accepted: {body!r}")
+
+
+def test_bad_statuses_name_the_file_and_line(folder, tmp_path):
+    for case in BAD:
+        exc = refusal(folder, tmp_path, case["paper"])
+        assert case["says"] in exc.message and exc.line == case["line"], (case, exc)
 
 
 def test_a_bad_status_exits_2_with_one_line(folder, tmp_path, capsys):
