@@ -64,7 +64,7 @@ def test_reports_show_each_status_and_reason(folder, tmp_path):
     assert lines[1].split(",")[header.index("t_status")] == "built-in"
     assert lines[2].split(",")[header.index("n_status")] == ""
 
-    from petriflow.view import sweep_page
+    from petriflow.view.sweep_page import sweep_page
 
     page = sweep_page(tmp_path / "r.db", sweep=sweep.path)
     data = page[page.index('"status_notes"'):]
