@@ -578,9 +578,10 @@ def build_parser() -> argparse.ArgumentParser:
                        " T-semiflows, 100 steps per state and edge explored (10,000,000 to"
                        " 100,000,000); beyond it they are 'not computed (over budget)'")
     from petriflow.bridge.command import add_parser as add_bridge
-    from petriflow.sweep.command import add_parser as add_sweep
+    from petriflow.sweep.command import add_parser as add_sweep, add_reproduce_parser
 
     add_sweep(sub)
+    add_reproduce_parser(sub)
     add_bridge(sub)
     add_view(sub)
     return parser

@@ -111,6 +111,9 @@ class Boot(InstantAction):
         "compass_deg": Param(float, 1.0, "compass resolution (degrees)", low=0),
         "sensor_range": Param(float, 4.0, "distance sensors' range (m)", low=0.1),
         "match": Param(float, 1.0, "two positions nearer than this (m) are one vertex", low=0.01),
+        "install_rule": Param(str, "none-heard", "install a WA at a vertex where no WA is heard above the"
+                              " threshold (none-heard), or where the last one installed no longer is (last-in-range)",
+                              choices=("none-heard", "last-in-range")),
     }
 
     @classmethod
@@ -145,6 +148,7 @@ class Boot(InstantAction):
         state.body = body
         state.origin = origin
         state.hopper = p["was"]
+        state.install_rule = p["install_rule"]
         state.settings = LegSettings(speed=p["speed"], turn_rate=p["turn_rate"], stop=half, centre=half,
                                      open=2 * half, graze=half / 2)
         ctx.state = state
@@ -163,6 +167,8 @@ def _evaluate(ctx: ActionContext, state: Robot, air_place: str, boot: bool = Fal
     radio = _radio(ctx, air_place)
     heard = air.heard(state.name, radio, (RadioKind.WA,), now=ctx.now)
     in_range = any(rssi >= radio.threshold_dbm for rssi, _, _ in heard)
+    if state.install_rule == "last-in-range" and state.last_wa is not None:
+        in_range = any(rssi >= radio.threshold_dbm and name == state.last_wa for rssi, name, _ in heard)
     if not boot and not in_range and state.installed < getattr(state, "hopper", 0) and not state.needs_wa:
         state.needs_wa = True
         state.touch("install")
@@ -331,6 +337,7 @@ class Install(Action):
         ctx.put(p["on"], {"ssid": ssid, "owner": state.name, "position": position,
                           "payload": self.payload, "seen": {state.name: ctx.now}})
         state.installed += 1
+        state.last_wa = p["wa"]
         state.needs_wa = False
         state.touch("install")
         ctx.emit("slam.installed", wa=p["wa"], ssid=ssid, position=position,

@@ -245,6 +245,8 @@ class Robot(FrameSender):
         self.last_read: str | None = None
         self.needs_wa = False
         self.installed = 0
+        self.last_wa: str | None = None  # the WA it installed last (the in-range rule reads its signal)
+        self.install_rule = "none-heard"
         self.finished = False
         self.broken = False
         self.legs = 0

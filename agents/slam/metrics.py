@@ -19,6 +19,10 @@ and compares the corridors through the pairs.
 ``slam.edges_extra``       edges of the map that are no corridor
 ``slam.second_ra_s``       from the reserve RA's dispatch to the map done
 ``slam.alert_s``           the first alert the base received
+``slam.handover_s``        when the base sent the reserve RA in (the failure's hand-over)
+``slam.wa_spacing_m``      each WA's distance to the nearest WA installed before it (true
+                           positions): ``max``, ``mean``, and ``over_5m`` (how many lie
+                           beyond the 5 m threshold range)
 ``slam.odometry_error_m``  the finishing RA's odometry error when it finished
 ``slam.dead_reckoning_m``  its encoder-only (x, y, heading) estimate's error then
 ``slam.umbmark_m``         UMBmark's E_max on the 4 m square with the wheels the RA believes
@@ -222,6 +226,20 @@ def alert_s(record: Any) -> float | None:
     return round(alerts[0].time, 3) if alerts else None
 
 
+def handover_s(record: Any) -> float | None:
+    sent = _custom(record, "slam.dispatched")
+    return round(sent[0].time, 3) if sent else None
+
+
+def wa_spacing_m(record: Any, threshold_m: float = 5.0) -> dict[str, float] | None:
+    spots = [e.data["data"]["true"] for e in _custom(record, "slam.installed")]
+    gaps = [min(math.dist(spots[k], spots[j]) for j in range(k)) for k in range(1, len(spots))]
+    if not gaps:
+        return None
+    return {"max": round(max(gaps), 3), "mean": round(sum(gaps) / len(gaps), 3),
+            "over_5m": sum(1 for g in gaps if g > threshold_m)}
+
+
 def odometry_error_m(record: Any) -> float | None:
     done = _custom(record, "slam.finished")
     return done[0].data["data"].get("odometry_error_m") if done else None
@@ -257,7 +275,8 @@ METRICS = {
     "slam.time_s": time_s, "slam.completed": completed, "slam.was_used": was_used,
     "slam.vertices_missing": vertices_missing, "slam.vertex_error_m": vertex_error_m,
     "slam.vertices_extra": vertices_extra, "slam.edges_missing": edges_missing, "slam.edges_extra": edges_extra,
-    "slam.second_ra_s": second_ra_s, "slam.alert_s": alert_s, "slam.odometry_error_m": odometry_error_m,
+    "slam.second_ra_s": second_ra_s, "slam.alert_s": alert_s, "slam.handover_s": handover_s,
+    "slam.wa_spacing_m": wa_spacing_m, "slam.odometry_error_m": odometry_error_m,
     "slam.dead_reckoning_m": dead_reckoning_m, "slam.umbmark_m": umbmark_m, "slam.distance_m": distance_m, "slam.wa_exchanges": wa_exchanges,
 }
 

@@ -63,7 +63,8 @@ __all__ = ["build", "main"]
 def build(mode: str = "decentralised", robots: int = 1, reserves: int = 1, was: int = 16,
           fail_at: float | None = None, *, speed: float = 0.325, umbmark: bool = True, ed: float = 1.003,
           eb: float = 1.015, alert_after: float = 60.0, scan_period: float = 1.0, window: float = 5.0,
-          drop_s: float = 10.0, connect_s: float = 3.0, match: float = 1.0, **ignored: Any) -> Net:
+          drop_s: float = 10.0, connect_s: float = 3.0, match: float = 1.0, install_rule: str = "none-heard",
+          **ignored: Any) -> Net:
     """The mission's net (see the module).
 
     Args:
@@ -73,7 +74,7 @@ def build(mode: str = "decentralised", robots: int = 1, reserves: int = 1, was: 
         reserves: RAs waiting at the base to replace one that alerts say is gone.
         was: WAs each RA carries (decentralised).
         fail_at: seconds at which ``ra1`` (and, centralised, the central unit) fails.
-        speed ... match: the agents' parameters (see their actions).
+        speed ... match, install_rule: the agents' parameters (see their actions).
         ignored: other sweep parameters (they go elsewhere).
     """
     if mode not in ("decentralised", "centralised"):
@@ -132,7 +133,8 @@ def build(mode: str = "decentralised", robots: int = 1, reserves: int = 1, was: 
         r.done("out", "listen")
         r.transition("boot", label="body, wheels (UMBmark), history", action="slam.boot",
                      params={"slot": j - 1, "mode": mode, "was": was, "air": air.id, "speed": speed,
-                             "umbmark": umbmark, "ed": ed, "eb": eb, "match": match},
+                             "umbmark": umbmark, "ed": ed, "eb": eb, "match": match,
+                             **({"install_rule": install_rule} if install_rule != "none-heard" else {})},
                      inputs=["start"], outputs=["ready"])
         r.transition("explore", label="a leg of Algorithm 1", action="slam.explore",
                      params={"air": air.id, "fail_at": fail_at if j == 1 else None}, guard="slam.can_move",

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from petriflow.errors import PetriflowError
 
-__all__ = ["add_parser", "cmd_sweep"]
+__all__ = ["add_parser", "cmd_sweep", "add_reproduce_parser", "cmd_reproduce"]
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -63,7 +63,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     from petriflow.sweep import load_sweep, run_sweep
-    from petriflow.sweep.report import plot, text_table, write_csv
+    from petriflow.sweep.report import plot, status_counts, status_notes, text_table, write_csv
 
     if args.workers is not None and args.workers < 1:
         raise PetriflowError(f"--workers must be at least 1, got {args.workers}")
@@ -117,6 +117,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         print(f"{title}: {_count(len(result.trials), 'trial')} in {_count(len(result.rows), 'row')}"
               f" ({result.ran} run now in {result.wall:.1f} s wall, {len(result.failures)} failed)")
         print(text_table(result.rows, result.names, parameters))
+        notes = status_notes(result.rows, result.names, parameters)
+        if notes:
+            counts = status_counts([{**r, "paper": {k: v for k, v in r["paper"].items() if k in result.names}}
+                                    for r in result.rows])
+            print("  published values: " + ", ".join(f"{n} {k.replace('-', ' ')}" for k, n in counts.items() if n))
+            for note in notes:
+                print(f"  {note}")
         if result.wall_clock():
             print(f"  wall-clock (not reproducible between runs, unlike the other metrics):"
                   f" {', '.join(result.wall_clock())}")
@@ -137,6 +144,71 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             if path:
                 print(f"  wrote {path}")
     return 1 if result.failures else 0
+
+
+#: ``petriflow reproduce``'s options: (flags, argparse keywords).
+_REPRODUCE_OPTIONS = (
+    (("root",), {"nargs": "?", "default": "nets", "help": "the folder of scenarios (default: nets)"}),
+    (("--quick",), {"action": "store_true", "help": "one trial a row (a quick pass)"}),
+    (("--only",), {"metavar": "NAMES", "help": "only these scenarios (comma-separated folder names)"}),
+    (("--out",), {"help": "results databases and pages (default: out/reproduction, or out/reproduction-quick"
+                          " with --quick)"}),
+    (("--report",), {"metavar": "FILE.md", "help": "the report (default: docs/reproduction.md; with --quick or"
+                                                    " --only, OUT/reproduction.md)"}),
+    (("--no-pages",), {"action": "store_true", "help": "write no sweep pages"}),
+    (("--list",), {"action": "store_true", "help": "run nothing: list every published value and its status"}),
+    (("--commit",), {"help": "the commit to name in the report (scripts/reproduce.sh passes it)"}),
+)
+
+
+def add_reproduce_parser(sub) -> argparse.ArgumentParser:
+    """Add the ``reproduce`` command to the ``petriflow`` subcommands ``sub``."""
+    from petriflow.limits import integer_argument
+
+    summary = ("Run every sweep file with paper: values under ROOT/*/experiments/ (each scenario's published"
+               " tables), keep each one's results database and page under --out, and write the report"
+               " (Markdown): every published value beside the measured mean ± sd, its status (predicted, built"
+               " in, missed) and the deviation. Exit 0 when every trial ran, 1 when some failed, 2 on bad input.")
+    command = sub.add_parser("reproduce", description=summary,
+                             help="Run every published table of the scenarios and write the reproduction report.")
+    for flags, keywords in _REPRODUCE_OPTIONS:
+        command.add_argument(*flags, **keywords)
+    command.add_argument("--workers", type=integer_argument, help="processes (default: every CPU)")
+    command.set_defaults(handler=cmd_reproduce)
+    return command
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from petriflow.io.files import write_atomic
+    from petriflow.sweep.reproduce import markdown, reproduce
+
+    if args.workers is not None and args.workers < 1:
+        raise PetriflowError(f"--workers must be at least 1, got {args.workers}")
+    root = Path(args.root)
+    if not root.is_dir():
+        raise PetriflowError(f"{root}: no such folder of scenarios")
+    out = Path(args.out or ("out/reproduction-quick" if args.quick else "out/reproduction"))
+    only = [n.strip() for n in args.only.split(",") if n.strip()] if args.only else None
+    report = Path(args.report) if args.report else (out / "reproduction.md" if args.quick or only
+                                                     else Path("docs/reproduction.md"))
+    if report.suffix.lower() != ".md":
+        raise PetriflowError(f"--report writes Markdown: name a .md file, not {str(report)!r}")
+    if args.list and not args.report:
+        report = out / "published.md"
+    outcome = reproduce(root, out, quick=args.quick, only=only, workers=args.workers,
+                        pages=not (args.no_pages or args.list), measure=not args.list,
+                        progress=lambda line: print(line, file=sys.stderr, flush=True))
+    words = ["petriflow reproduce", *(["--quick"] if args.quick else []), *([f"--only {args.only}"] if only else []),
+             *(["--list"] if args.list else [])]
+    try:
+        report.parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(report, markdown(outcome, root, commit=args.commit, command=" ".join(words)))
+    except OSError as exc:
+        raise PetriflowError(f"{report}: cannot write the report ({exc.strerror or exc})") from None
+    failed = sum(t.failed for s in outcome.scenarios for t in s.tables)
+    print(f"wrote {report} ({sum(len(s.tables) for s in outcome.scenarios)} tables,"
+          f" {failed} failed trials, {outcome.wall / 60:.1f} min)")
+    return 1 if failed else 0
 
 
 def _job_working_dir() -> str | None:

@@ -8,7 +8,12 @@ Examples:
     ...           {"row": 0, "status": "ok", "metrics": {"t": 12.0}},
     ...           {"row": 0, "status": "timeout", "metrics": {}}]
     >>> summary(rows, trials, ["t"])[0]
-    {'params': {'n': 1}, 'trials': 3, 'failed': 1, 'status': {'ok': 2, 'timeout': 1}, 'metrics': {'t': {'mean': 11.0, 'sd': 1.414214, 'n': 2}}, 'paper': {'t': 9.0}}
+    {'params': {'n': 1}, 'trials': 3, 'failed': 1, 'status': {'ok': 2, 'timeout': 1}, 'metrics': {'t': {'mean': 11.0, 'sd': 1.414214, 'n': 2}}, 'paper': {'t': 9.0}, 'paper_status': {}}
+
+A published value's status (``paper_status``, from the sweep file) is ``predicted``,
+``built-in`` or ``missed`` (:data:`petriflow.sweep.spec.PAPER_STATUSES`), with the
+reason (``because``); the text table shows it beside the value and lists the reasons
+under the table (:func:`status_notes`).
 
 A trial's status is ``ok``, ``run failed`` (it ran, and the run ended ``failed``: an
 action failed with no failure route), ``error`` (it could not run: a bad parameter, a
@@ -28,7 +33,8 @@ from typing import Any
 
 from petriflow.sweep.spec import Row
 
-__all__ = ["summary", "metric_names", "text_table", "write_csv", "plot", "trial_status", "fixed", "deviation"]
+__all__ = ["summary", "metric_names", "text_table", "write_csv", "plot", "trial_status", "fixed", "deviation",
+           "status_label", "status_notes", "status_counts"]
 
 #: A trial that ran and whose run ended ``failed`` (an action failure with no route).
 RUN_FAILED = "run failed"
@@ -82,7 +88,8 @@ def summary(rows: list[Row], trials: list[dict[str, Any]], names: list[str]) -> 
         metrics = {name: _stats([t["metrics"][name] for t in measured if t["metrics"].get(name) is not None])
                    for name in names}
         out.append({"params": row.params, "trials": len(done), "failed": len(done) - statuses.get("ok", 0),
-                    "status": dict(sorted(statuses.items())), "metrics": metrics, "paper": dict(row.paper)})
+                    "status": dict(sorted(statuses.items())), "metrics": metrics, "paper": dict(row.paper),
+                    "paper_status": {k: dict(v) for k, v in row.paper_status.items()}})
     return out
 
 
@@ -126,6 +133,52 @@ def deviation(mean: float | None, paper: Any) -> str:
     return text if paper == 0 else f"{text} ({100 * difference / abs(paper):+.1f}%)"
 
 
+def status_label(status: dict[str, str] | None) -> str:
+    """A published value's status as the reports write it (``-`` for none given).
+
+    Examples:
+        >>> status_label({"status": "built-in", "because": "x"}), status_label(None)
+        ('built in', '-')
+    """
+    return "-" if not status else status["status"].replace("-", " ")
+
+
+def status_notes(rows: list[dict[str, Any]], names: list[str], parameters: list[str]) -> list[str]:
+    """One line per published value whose status has a reason: ``status: metric (row): because``.
+
+    Examples:
+        >>> status_notes([{"params": {"n": 1}, "paper": {"t": 9.0},
+        ...                "paper_status": {"t": {"status": "built-in", "because": "t sets the speed"}}}],
+        ...              ["t"], ["n"])
+        ['built in: t (n=1): t sets the speed']
+    """
+    lines = []
+    for row in rows:
+        where = ", ".join(f"{p}={_number(row['params'].get(p))}" for p in parameters)
+        for name in names:
+            status = row.get("paper_status", {}).get(name)
+            if name in row["paper"] and status and status.get("because"):
+                lines.append(f"{status_label(status)}: {name}{f' ({where})' if where else ''}: {status['because']}")
+    return lines
+
+
+def status_counts(rows: list[dict[str, Any]]) -> dict[str, int]:
+    """How many published values are predicted, built in, missed, or have no status.
+
+    Examples:
+        >>> status_counts([{"paper": {"a": 1, "b": 2}, "paper_status": {"a": {"status": "missed"}}}])
+        {'predicted': 0, 'built-in': 0, 'missed': 1, 'unstated': 1}
+    """
+    from petriflow.sweep.spec import PAPER_STATUSES
+
+    counts = dict.fromkeys((*PAPER_STATUSES, "unstated"), 0)
+    for row in rows:
+        for name in row["paper"]:
+            status = row.get("paper_status", {}).get(name)
+            counts[status["status"] if status else "unstated"] += 1
+    return counts
+
+
 def _cell(stats: dict[str, Any]) -> str:
     if stats.get("counts"):
         return " ".join(f"{k}:{v}" for k, v in stats["counts"].items())
@@ -138,8 +191,9 @@ def _cell(stats: dict[str, Any]) -> str:
 
 def text_table(rows: list[dict[str, Any]], names: list[str], parameters: list[str], width: int = 100) -> str:
     """The report as aligned text: parameters, trials, failures (with their statuses),
-    and per metric ``mean ± sd``, and where the paper gives a value, the paper's value and
-    the deviation (measured − paper, and %). A table wider than ``width`` characters is
+    and per metric ``mean ± sd``, and where the paper gives a value, the paper's value,
+    the deviation (measured − paper, and %) and the value's status where the file gives
+    one (predicted, built in, missed). A table wider than ``width`` characters is
     split into blocks of metrics, each repeating the parameter columns."""
     lead = [*parameters, "trials", "failed"]
     lead_cells = []
@@ -159,6 +213,10 @@ def text_table(rows: list[dict[str, Any]], names: list[str], parameters: list[st
             header += ["paper", "deviation"]
             for cell, row in zip(cells, rows):
                 cell += [_number(row["paper"].get(name)), deviation(row["metrics"][name]["mean"], row["paper"].get(name))]
+            if any(r.get("paper_status", {}).get(name) for r in rows if name in r["paper"]):
+                header.append("status")
+                for cell, row in zip(cells, rows):
+                    cell.append(status_label(row.get("paper_status", {}).get(name)) if name in row["paper"] else "")
         blocks.append((header, cells))
     lead_width = _width([lead] + lead_cells)
     tables, current = [], []
@@ -192,12 +250,13 @@ def _width(lines: list[list[str]]) -> int:
 
 
 def write_csv(path: str | Path, rows: list[dict[str, Any]], names: list[str], parameters: list[str]) -> None:
-    """The report as CSV: a line per row; per metric ``_mean``, ``_sd``, ``_n`` and ``_paper``."""
+    """The report as CSV: a line per row; per metric ``_mean``, ``_sd``, ``_n``, ``_paper``
+    and ``_status`` (the published value's: predicted, built-in, missed)."""
     from petriflow.io.files import write_atomic
 
     header = [*parameters, "trials", "failed"]
     for name in names:
-        header += [f"{name}_mean", f"{name}_sd", f"{name}_n", f"{name}_paper"]
+        header += [f"{name}_mean", f"{name}_sd", f"{name}_n", f"{name}_paper", f"{name}_status"]
     import io
 
     buffer = io.StringIO()
@@ -208,7 +267,8 @@ def write_csv(path: str | Path, rows: list[dict[str, Any]], names: list[str], pa
         for name in names:
             stats = row["metrics"][name]
             mean = stats["mean"] if not stats.get("counts") else " ".join(f"{k}:{v}" for k, v in stats["counts"].items())
-            line += [mean, stats["sd"], stats["n"], row["paper"].get(name)]
+            status = row.get("paper_status", {}).get(name) if name in row["paper"] else None
+            line += [mean, stats["sd"], stats["n"], row["paper"].get(name), status["status"] if status else None]
         writer.writerow(["" if v is None else v for v in line])
     write_atomic(path, buffer.getvalue())
 

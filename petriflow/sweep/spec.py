@@ -57,12 +57,16 @@ from typing import Any
 from petriflow.errors import NetFormatError
 from petriflow.runtime.metrics import MetricRef, parse_refs
 
-__all__ = ["Sweep", "Row", "Trial", "MetricRef", "substitute", "FORMAT_VERSION", "SET_ROOTS"]
+__all__ = ["Sweep", "Row", "Trial", "MetricRef", "substitute", "FORMAT_VERSION", "SET_ROOTS", "PAPER_STATUSES"]
 
 #: The sweep format version this reader understands (``petriflow-sweep: 1``).
 FORMAT_VERSION = 1
 #: What a ``set:`` target may start with.
 SET_ROOTS = ("run", "world", "net")
+#: What a published value can be to a sweep: the simulation's output with no published
+#: value used to get it; a published value was an input (the ``because`` says which); or
+#: not reproduced (the ``because`` names the mechanism the source leaves unstated).
+PAPER_STATUSES = ("predicted", "built-in", "missed")
 #: Wall seconds a trial may take unless the file says otherwise.
 DEFAULT_TIMEOUT = 600.0
 #: The most trials one sweep may hold (rows x seeds).
@@ -96,6 +100,9 @@ class Row:
     index: int
     params: dict[str, Any]
     paper: dict[str, Any] = field(default_factory=dict)
+    #: per paper value: ``{"status": predicted | built-in | missed, "because": TEXT}``
+    #: (a value given without a status has none here).
+    paper_status: dict[str, dict[str, str]] = field(default_factory=dict)
 
 
 def canonical(value: Any) -> str:
@@ -370,7 +377,12 @@ def _rows(data: dict, fail) -> list[Row]:
             paper = entry.get("paper", {})
             if not isinstance(paper, dict):
                 fail("rows: paper must map metric names to values", item=entry)
-            rows.append(Row(len(rows), _check_params(params, fail, entry, f"row {len(rows) + 1}"), dict(paper)))
+            row = Row(len(rows), _check_params(params, fail, entry, f"row {len(rows) + 1}"))
+            for name, value in paper.items():
+                row.paper[name], status = _paper_value(name, value, None, fail, paper)
+                if status:
+                    row.paper_status[name] = status
+            rows.append(row)
     if not rows:
         rows.append(Row(0, {}))
     seen: dict[str, int] = {}
@@ -392,6 +404,53 @@ def _metrics(data: dict, fail) -> list[MetricRef]:
     return parse_refs(data.get("metrics", ["core.end_time", "core.firings", "core.outcome"]), fail)
 
 
+def _paper_value(name: Any, value: Any, default: dict[str, str] | None, fail, item: Any) \
+        -> tuple[Any, dict[str, str] | None]:
+    """A published value and its status: ``value`` is a number or text, or
+    ``{value: V, status: S, because: TEXT}``; ``default`` is the paper row's own
+    ``status``/``because`` (for values that give none)."""
+    where = f"paper: {name}"
+    status = default
+    if isinstance(value, dict):
+        unknown = sorted(set(value) - {"value", "status", "because"})
+        if unknown or "value" not in value:
+            fail(f"{where}: a value with a status is {{value: V, status: {' | '.join(PAPER_STATUSES)},"
+                 f" because: TEXT}}" + (f" (unknown key {unknown[0]!r})" if unknown else " (no value:)"),
+                 item=value)
+        status = _status(value, where, fail, value, inherited=default)
+        value = value["value"]
+    elif isinstance(item, dict) and getattr(item, "key_lines", None):
+        item = _Where(item.key_lines.get(name, getattr(item, "line", None)))
+    if not _plain_value(value) or isinstance(value, (list, dict)):
+        fail(f"{where}: a value is a number or text", item=item)
+    return value, status
+
+
+@dataclass
+class _Where:
+    """A line to name in an error."""
+
+    line: int | None
+
+
+def _status(holder: dict, where: str, fail, item: Any, inherited: dict[str, str] | None = None) \
+        -> dict[str, str] | None:
+    """``{"status", "because"}`` from ``holder``'s ``status:`` and ``because:`` (or
+    ``inherited`` where it gives neither); ``None`` where there is none."""
+    if "status" not in holder and "because" not in holder:
+        return inherited
+    status = holder.get("status", (inherited or {}).get("status"))
+    because = holder.get("because", (inherited or {}).get("because") if "status" not in holder else None)
+    if status not in PAPER_STATUSES:
+        fail(f"{where}: status must be one of {', '.join(PAPER_STATUSES)}, not {status!r}", item=item)
+    if because is not None and (not isinstance(because, str) or not because.strip()):
+        fail(f"{where}: because must be text", item=item)
+    if status != "predicted" and because is None:
+        fail(f"{where}: a {status} value needs because: (which published value went in, or which mechanism"
+             " the paper leaves unstated)", item=item)
+    return {"status": status, "because": " ".join(because.split())} if because else {"status": status}
+
+
 def _paper(data: dict, rows: list[Row], metric_names: set[str], fail) -> str | None:
     paper = data.get("paper")
     source = None
@@ -405,15 +464,24 @@ def _paper(data: dict, rows: list[Row], metric_names: set[str], fail) -> str | N
         if not isinstance(entries, list):
             fail("paper: rows must be a list", key="paper")
         for entry in entries:
-            if not isinstance(entry, dict) or not set(entry) <= {"params", "values"} \
+            if not isinstance(entry, dict) or not set(entry) <= {"params", "values", "status", "because"} \
                     or not isinstance(entry.get("params", {}), dict) or not isinstance(entry.get("values"), dict):
-                fail("paper: each row is {params: {name: value}, values: {metric: value}}", item=entry, key="paper")
+                fail("paper: each row is {params: {name: value}, values: {metric: value}} (and optionally"
+                     " status:, because: for its values)", item=entry, key="paper")
             params = entry.get("params", {})
             matched = [row for row in rows if all(k in row.params and row.params[k] == v for k, v in params.items())]
             if not matched:
                 fail(f"paper: no row has the parameters {canonical(params)}", item=entry, key="paper")
+            default = _status(entry, f"paper: row {canonical(params)}", fail, entry)
+            values = entry["values"]
+            parsed = {name: _paper_value(name, value, default, fail, values) for name, value in values.items()}
             for row in matched:
-                row.paper.update(entry["values"])
+                for name, (value, status) in parsed.items():
+                    row.paper[name] = value
+                    if status:
+                        row.paper_status[name] = status
+                    else:
+                        row.paper_status.pop(name, None)
     for row in rows:
         for name, value in row.paper.items():
             if not any(name == m or name.startswith(m + ".") for m in metric_names):
@@ -421,6 +489,4 @@ def _paper(data: dict, rows: list[Row], metric_names: set[str], fail) -> str | N
 
                 fail(f"paper: {name!r} is not one of the sweep's metrics{did_you_mean(name, metric_names)}",
                      key="paper" if paper is not None else "rows")
-            if not _plain_value(value) or isinstance(value, (list, dict)):
-                fail(f"paper: {name}: a value is a number or text", key="paper" if paper is not None else "rows")
     return source

@@ -1,4 +1,5 @@
-"""A sweep's page: the report's table with the paper's values beside the measured ones,
+"""A sweep's page: the report's table with the paper's values beside the measured ones
+(each with its status, predicted / built in / missed, and the reason under the table),
 and each metric against the first parameter with error bars (± one standard
 deviation), one line per value of the other parameters, the paper's values as their
 own dashed lines, drawn with dygraphs (zoom by dragging, values under the pointer).
@@ -17,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from petriflow.errors import PetriflowError
-from petriflow.sweep.report import deviation, fixed, metric_names, summary, trial_status
+from petriflow.sweep.report import deviation, fixed, metric_names, status_counts, status_notes, summary, trial_status
 from petriflow.sweep.spec import Row
 from petriflow.sweep.store import FORMAT
 from petriflow.view.page import render
@@ -110,6 +111,8 @@ def sweep_page(db: str | Path, *, sweep: str | Path | None = None) -> str:
         "metrics": names,
         "rows": table,
         "statuses": statuses,
+        "status_notes": status_notes(table, names, parameters),
+        "status_counts": status_counts(table),
         "trials": [{"row": t["row"], "params": t["params"], "seed": t["seed"], "status": trial_status(t),
                     "metrics": t["metrics"], "wall": t["wall"], "error": t["error"]} for t in trials],
     }
@@ -140,7 +143,8 @@ _BODY = """
 </header>
 <main>
   <section class="panel"><h2>Report <small>mean ± standard deviation over the trials that ran; the paper's value and the deviation beside it</small></h2>
-    <div id="table-box"><table id="report"></table></div></section>
+    <div id="table-box"><table id="report"></table></div>
+    <ul id="status-notes"></ul></section>
   <section class="panel"><h2>Each metric against the first parameter <small>error bars: ± one standard deviation; dashed: the paper; drag to zoom, double click to reset</small></h2>
     <div id="plots"></div></section>
   <section class="panel"><h2>Trials</h2>

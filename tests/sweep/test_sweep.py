@@ -119,7 +119,7 @@ def test_cli_report_json_csv_and_plot(folder, tmp_path, capsys):
     assert code == 0
     report = json.loads(capsys.readouterr().out)
     assert report["spec"] == str(path.resolve())
-    assert [set(row) for row in report["rows"]] == [{"params", "trials", "failed", "status", "metrics", "paper"}] * 2
+    assert [set(row) for row in report["rows"]] == [{"params", "trials", "failed", "status", "metrics", "paper", "paper_status"}] * 2
     assert report["rows"][1]["paper"] == {"time_s": 3.5}
     assert set(report["rows"][0]["metrics"]["time_s"]) == {"mean", "sd", "n"}
     lines = (tmp_path / "r.csv").read_text().splitlines()

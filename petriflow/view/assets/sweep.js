@@ -29,10 +29,12 @@
   function reportTable() {
     const table = document.getElementById("report");
     const withPaper = D.metrics.filter(m => D.rows.some(r => m in r.paper));
+    const withStatus = withPaper.filter(m => D.rows.some(r => m in r.paper && (r.paper_status || {})[m]));
     const cols = D.parameters.map(p => [p, "text"]).concat([["trials"], ["failed"]]);
     for (const m of D.metrics) {
       cols.push([m]);
       if (withPaper.includes(m)) { cols.push([m + " (paper)"]); cols.push(["deviation"]); }
+      if (withStatus.includes(m)) cols.push(["status", "text"]);
     }
     header(table, cols);
     const body = document.createElement("tbody");
@@ -47,10 +49,19 @@
           cell(tr, m in row.paper ? row.paper[m] : "–", "paper");
           cell(tr, row.deviations[m], "dev");
         }
+        if (withStatus.includes(m)) {
+          const st = m in row.paper ? (row.paper_status || {})[m] : null;
+          const td = cell(tr, st ? st.status.replace("-", " ") : "", "text status" + (st ? " st-" + st.status : ""));
+          if (st && st.because) td.title = st.because;
+        }
       }
       body.appendChild(tr);
     }
     table.appendChild(body);
+    const notes = document.getElementById("status-notes");
+    for (const row of D.status_notes || []) {
+      const li = document.createElement("li"); li.textContent = row; notes.appendChild(li);
+    }
   }
 
   function plotMetric(name) {
@@ -146,7 +157,9 @@
     const failed = D.trials.filter(t => t.status !== "ok").length;
     document.getElementById("summary").textContent =
       `${D.db} · ${D.trials.length} trials in ${D.rows.length} rows (${failed} failed)` +
-      (D.description ? ` · ${D.description}` : "") + (D.note ? ` · note: ${D.note}` : "");
+      (D.description ? ` · ${D.description}` : "") + (D.note ? ` · note: ${D.note}` : "") +
+      (D.status_counts && Object.values(D.status_counts).some(n => n) ? " · published values: " +
+        Object.entries(D.status_counts).filter(([, n]) => n).map(([k, n]) => `${n} ${k.replace("-", " ")}`).join(", ") : "");
     reportTable();
     let drawn = 0;
     for (const m of D.metrics) drawn += plotMetric(m) ? 1 : 0;
