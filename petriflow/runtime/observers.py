@@ -47,10 +47,10 @@ class Progress:
         interval: off a terminal, seconds between lines (``None``: nothing off a terminal).
     """
 
-    def __init__(self, scheduler: Scheduler, stream: TextIO = sys.stderr, delay: float = 1.0,
+    def __init__(self, scheduler: Scheduler, stream: TextIO | None = None, delay: float = 1.0,
                  interval: float | None = 30.0) -> None:
         self.scheduler = scheduler
-        self.stream = stream
+        self.stream = stream = sys.stderr if stream is None else stream  # the one at the run's start
         self.delay = delay
         self.start = wallclock.perf_counter()
         self.last = 0.0
