@@ -430,6 +430,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         if value is not None and value < 0:
             raise PetriflowError(f"{option} must be >= 0, got {value}")
     net, _ = _load_bound(args.net, args.import_actions)
+    if args.properties is not None:
+        return _check_properties(args, net)
     result = check_net(
         net, max_states=args.max_states or DEFAULT_MAX_STATES,
         max_coverability=DEFAULT_MAX_COVERABILITY if args.max_coverability is None else args.max_coverability,
@@ -444,6 +446,28 @@ def cmd_check(args: argparse.Namespace) -> int:
         # soundness decided by another method) is an answer, the limit a note in the report
         print(f"petriflow: {args.net}: {result['error']}", file=sys.stderr)
     return code
+
+
+def _check_properties(args: argparse.Namespace, net) -> int:
+    """``check --properties [FILE]``: the file's properties, or the net's own."""
+    from petriflow.analysis.reachability import DEFAULT_MAX_STATES
+    from petriflow.properties.check import check_properties
+    from petriflow.properties.report import format_properties, properties_exit_code
+    from petriflow.properties.yaml_props import load_properties
+
+    if args.properties:
+        properties = load_properties(args.properties)
+    else:
+        properties = net.properties
+        if not properties:
+            raise PetriflowError(f"{args.net}: the net declares no properties (a 'properties:' list);"
+                                 " name a properties file: --properties FILE")
+    results = check_properties(net, properties, max_states=args.max_states or DEFAULT_MAX_STATES)
+    if args.json:
+        _print_json({"net": net.id, "properties": results})
+    else:
+        print(format_properties(results))
+    return properties_exit_code(results)
 
 
 # Parser ------------------------------------------------------------------------------
@@ -558,6 +582,11 @@ def build_parser() -> argparse.ArgumentParser:
         cmd_check)
     check.add_argument("--json", action="store_true", help="print JSON")
     check.add_argument("--import-actions", action="store_true", help=import_help)
+    check.add_argument("--properties", nargs="?", const="", default=None, metavar="FILE",
+                       help="decide properties instead (docs/analysis.md, 'Properties'): those of"
+                       " FILE (a YAML 'properties:' list or a Model Checking Contest XML file), or"
+                       " without FILE the net's own; exit 1 when one is false, 2 when one is"
+                       " undecided")
     check.add_argument("--max-states", type=limits.integer_argument, default=None, metavar="N",
                        help="most markings to explore (default 2,000,000); beyond it the facts"
                        " found so far, and exit 2 (1 when one of them fails)")

@@ -17,8 +17,10 @@ Each result is ``{"id", "formula", "kind", "verdict", "method", "witness"}`` and
 lasso, ``"cycle"`` (the firings repeated forever; empty: the last marking is a deadlock,
 which repeats); ``verdict`` is ``true``/``false``, the bound (an integer), or ``null``
 with a ``"reason"`` (state space over budget, unbounded net, a formula outside CTL and
-LTL). A verdict is never guessed: a partial state space decides only what a state found
-in it proves (a reachable witness, a reached value meeting the invariant bound).
+LTL). A verdict is never guessed: a partial state space (the markings found before the
+limit; for an unbounded net, the first :data:`UNBOUNDED_STATES`) decides only what a
+state found in it proves (a reachable witness, a reached value meeting the invariant
+bound or exceeding ``at_most``).
 
 Examples:
     >>> from petriflow.classic import producer_consumer
@@ -46,27 +48,13 @@ from petriflow.analysis.reachability import StateSpace, reachability_graph
 from petriflow.net import Net
 from petriflow.properties.bounds import invariant_bound, reached_bound
 from petriflow.properties.ctl import ctl_witness, evaluate
-from petriflow.properties.kripke import Kripke, PropertyNameError
+from petriflow.properties.kripke import Kripke
 from petriflow.properties.language import AllPaths, ExistsPath, Finally, Globally, Not, Property, names_used
 from petriflow.properties.ltl import check_ltl
+from petriflow.properties.yaml_props import check_property_names
 from petriflow.workflow import workflow_structure
 
-__all__ = ["check_properties", "check_names"]
-
-
-def check_names(net: Net, properties: Sequence[Property]) -> None:
-    """Raise :class:`~petriflow.properties.kripke.PropertyNameError` naming the first
-    property that names a place or transition ``net`` lacks (with its file and line)."""
-    for prop in properties:
-        places, transitions = (set(prop.bound), set()) if prop.formula is None else names_used(prop.formula)
-        for kind, names, known in (("place", places, net.places), ("transition", transitions, net.transitions)):
-            for name in sorted(names):
-                if name not in known:
-                    from petriflow.errors import did_you_mean
-
-                    where = f"{prop.source}:{prop.line}: " if prop.source and prop.line else ""
-                    raise PropertyNameError(f"{where}property {prop.id!r}: unknown {kind} {name!r}"
-                                            f"{did_you_mean(name, list(known))}")
+__all__ = ["check_properties"]
 
 
 def check_properties(net: Net, properties: Sequence[Property], *,
@@ -74,9 +62,10 @@ def check_properties(net: Net, properties: Sequence[Property], *,
     """Decide every property of ``net`` (see the module documentation for the entries).
 
     Raises:
-        PropertyNameError: a property names a place or transition the net lacks.
+        NetFormatError: a property names a place or transition the net lacks (its file
+            and line).
     """
-    check_names(net, properties)
+    check_property_names(net, properties)
     start = explored_marking(net, workflow_structure(net))
     space: StateSpace | None = None
     reason = None
@@ -89,6 +78,7 @@ def check_properties(net: Net, properties: Sequence[Property], *,
     except UnboundedNetError as exc:
         reason = f"unbounded net: firing {' '.join(exc.pump)} repeats forever, adding tokens to" \
                  f" {', '.join(exc.places)}"
+        partial = _explored_part(net, start, min(max_states, UNBOUNDED_STATES))
     kripke = Kripke(space) if space is not None else None
     cache: dict = {}
     semiflows: list | None = None
@@ -116,6 +106,20 @@ def check_properties(net: Net, properties: Sequence[Property], *,
             entry["reason"] = reason
         results.append(entry)
     return results
+
+
+#: How many markings of an unbounded net are still explored, in search of markings that
+#: decide reachability properties (``EF p`` true, ``AG p`` false) or exceed a bound.
+UNBOUNDED_STATES = 100_000
+
+
+def _explored_part(net: Net, start, max_states: int) -> StateSpace | None:
+    """The first ``max_states`` markings of an unbounded net, breadth first."""
+    try:
+        reachability_graph(net, start, max_states=max_states, detect_unbounded=False)
+    except StateSpaceLimit as exc:
+        return exc.partial if isinstance(exc.partial, StateSpace) else None
+    return None             # finite after all: cannot happen for a net found unbounded
 
 
 def _describe(prop: Property) -> str:

@@ -29,7 +29,7 @@ Examples:
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 __all__ = [
     "AllPaths", "And", "Compare", "Constant", "Deadlock", "ExistsPath", "Finally", "Fireable",
@@ -222,9 +222,7 @@ class AllPaths(Formula):
     operand: Formula
 
     def __str__(self) -> str:
-        inner = str(self.operand)
-        return "A" + (inner if isinstance(self.operand, (Next, Finally, Globally)) else f"[{inner.strip('()')}]"
-                      if isinstance(self.operand, Until) else f"({inner})")
+        return "A" + _quantified(self.operand)
 
 
 @dataclass(frozen=True)
@@ -234,9 +232,15 @@ class ExistsPath(Formula):
     operand: Formula
 
     def __str__(self) -> str:
-        inner = str(self.operand)
-        return "E" + (inner if isinstance(self.operand, (Next, Finally, Globally)) else f"[{inner.strip('()')}]"
-                      if isinstance(self.operand, Until) else f"({inner})")
+        return "E" + _quantified(self.operand)
+
+
+def _quantified(path: Formula) -> str:
+    """How a path formula reads after ``A``/``E``: ``G(p)``, ``[p U q]``, ``(...)``."""
+    inner = str(path)
+    if isinstance(path, (Next, Finally, Globally)):
+        return inner
+    return f"[{inner[1:-1]}]" if isinstance(path, Until) else f"({inner})"
 
 
 _TEMPORAL = (Next, Finally, Globally, Until)
@@ -256,8 +260,9 @@ class Property:
     formula: Formula | None = None
     bound: tuple[str, ...] = ()
     at_most: int | None = None
-    line: int | None = None
-    source: str | None = None
+    line: int | None = field(default=None, compare=False)
+    source: str | None = field(default=None, compare=False)
+    description: str | None = None
 
     @property
     def kind(self) -> str:

@@ -62,9 +62,11 @@ from petriflow.properties.language import (
     Until,
     classify,
     is_state_formula,
+    names_used,
 )
 
-__all__ = ["load_properties", "parse_formula", "parse_properties", "parse_property"]
+__all__ = ["check_property_names", "load_properties", "parse_formula", "parse_properties",
+           "parse_property", "property_entry"]
 
 _TOKEN = re.compile(r"\s*(?:(?P<num>\d+)|(?P<name>[A-Za-z_][A-Za-z0-9_.@]*)|"
                     r"(?P<op><=|>=|==|!=|->|&&|\|\||[-+*<>!()\[\],]))")
@@ -277,6 +279,9 @@ def _property(entry: Any, path: str | None, line: int | None) -> Property:
         raise NetFormatError(f"property {ident!r}: give exactly one of {', '.join(_SHORTHANDS)}"
                              f" (found {', '.join(kinds) or 'none'})", path=path, line=line)
     kind, value = kinds[0], entry[kinds[0]]
+    description = entry.get("description")
+    if description is not None and not isinstance(description, str):
+        raise NetFormatError(f"property {ident!r}: 'description' is text", path=path, line=line)
     at_most = entry.get("at_most")
     if at_most is not None and (kind != "bound" or not isinstance(at_most, int) or isinstance(at_most, bool)):
         raise NetFormatError(f"property {ident!r}: 'at_most' (an integer) goes with 'bound' only",
@@ -287,7 +292,8 @@ def _property(entry: Any, path: str | None, line: int | None) -> Property:
             places = [value] if isinstance(value, str) else value
             if not isinstance(places, list) or not places or not all(isinstance(p, str) for p in places):
                 raise NetFormatError(f"{where} takes a place id or a list of them")
-            return Property(ident, bound=tuple(places), at_most=at_most, line=line, source=path)
+            return Property(ident, bound=tuple(places), at_most=at_most, line=line, source=path,
+                            description=description)
         if kind == "responds":
             if not isinstance(value, dict) or set(value) != {"to", "with"}:
                 raise NetFormatError(f"{where} takes {{to: P, with: Q}}")
@@ -317,7 +323,7 @@ def _property(entry: Any, path: str | None, line: int | None) -> Property:
         if not message.startswith("property "):
             message = f"{where}: {message}"
         raise NetFormatError(message, path=path, line=line) from None
-    return Property(ident, formula, line=line, source=path)
+    return Property(ident, formula, line=line, source=path, description=description)
 
 
 def parse_properties(entries: Any, path: str | None = None, line: int | None = None) -> list[Property]:
@@ -365,3 +371,39 @@ def load_properties(path: str | Path) -> list[Property]:
     return parse_properties(data, str(path))
 
 
+
+
+def check_property_names(net: Any, properties: list[Property]) -> None:
+    """Raise :class:`~petriflow.errors.NetFormatError` for the first property naming a
+    place or transition ``net`` lacks (with the property's file and line, and a hint)."""
+    from petriflow.errors import did_you_mean
+
+    for prop in properties:
+        places, transitions = (set(prop.bound), set()) if prop.formula is None else names_used(prop.formula)
+        for kind, names, known in (("place", places, net.places), ("transition", transitions, net.transitions)):
+            for name in sorted(names):
+                if name not in known:
+                    raise NetFormatError(f"property {prop.id!r}: unknown {kind} {name!r}"
+                                         f"{did_you_mean(name, list(known))}", path=prop.source,
+                                         line=prop.line)
+
+
+def property_entry(prop: Property) -> dict[str, Any]:
+    """A property as a ``properties:`` entry that :func:`parse_property` reads back.
+
+    Examples:
+        >>> property_entry(parse_property({"id": "x", "never": "a + b >= 2"}))
+        {'id': 'x', 'ctl': 'AG(!(a + b >= 2))'}
+    """
+    entry: dict[str, Any] = {"id": prop.id}
+    if prop.description:
+        entry["description"] = prop.description
+    if prop.formula is None:
+        entry["bound"] = list(prop.bound) if len(prop.bound) != 1 else prop.bound[0]
+        if prop.at_most is not None:
+            entry["at_most"] = prop.at_most
+    elif classify(prop.formula) == "ltl" and isinstance(prop.formula, AllPaths):
+        entry["ltl"] = str(prop.formula.operand)
+    else:
+        entry["ctl"] = str(prop.formula)
+    return entry
