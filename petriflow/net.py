@@ -495,6 +495,7 @@ class Net:
         other.final_marking = self.final_marking
         other.meta = dict(self.meta)
         other.run = self.run
+        other.properties = list(self.properties)
         other.path = self.path
         other.lines = dict(self.lines)
         return other

@@ -393,7 +393,9 @@ def property_entry(prop: Property) -> dict[str, Any]:
 
     Examples:
         >>> property_entry(parse_property({"id": "x", "never": "a + b >= 2"}))
-        {'id': 'x', 'ctl': 'AG(!(a + b >= 2))'}
+        {'id': 'x', 'never': 'a + b >= 2'}
+        >>> property_entry(parse_property({"id": "y", "ctl": "AG EF o == 1"}))
+        {'id': 'y', 'ctl': 'AG(EF(o == 1))'}
     """
     entry: dict[str, Any] = {"id": prop.id}
     if prop.description:
@@ -402,8 +404,28 @@ def property_entry(prop: Property) -> dict[str, Any]:
         entry["bound"] = list(prop.bound) if len(prop.bound) != 1 else prop.bound[0]
         if prop.at_most is not None:
             entry["at_most"] = prop.at_most
-    elif classify(prop.formula) == "ltl" and isinstance(prop.formula, AllPaths):
-        entry["ltl"] = str(prop.formula.operand)
     else:
-        entry["ctl"] = str(prop.formula)
+        entry.update(_shorthand(prop.formula))
     return entry
+
+
+def _shorthand(formula: Formula) -> dict[str, Any]:
+    """The shortest entry that reads back as ``formula``."""
+    path = formula.operand if isinstance(formula, (AllPaths, ExistsPath)) else None
+    inner = getattr(path, "operand", None)
+    if isinstance(formula, AllPaths) and isinstance(path, Globally) and is_state_formula(inner):
+        if isinstance(inner, Not):
+            return {"never": str(inner.operand)}
+        return {"always": str(inner)}
+    if isinstance(formula, ExistsPath) and isinstance(path, Finally) and is_state_formula(inner):
+        return {"reachable": str(inner)}
+    if isinstance(formula, AllPaths) and isinstance(path, Finally) and is_state_formula(inner):
+        return {"eventually": str(inner)}
+    if (isinstance(formula, AllPaths) and isinstance(path, Globally) and isinstance(inner, Or)
+            and len(inner.operands) == 2 and isinstance(inner.operands[0], Not)
+            and isinstance(inner.operands[1], Finally) and is_state_formula(inner.operands[0].operand)
+            and is_state_formula(inner.operands[1].operand)):
+        return {"responds": {"to": str(inner.operands[0].operand), "with": str(inner.operands[1].operand)}}
+    if classify(formula) == "ltl" and isinstance(formula, AllPaths):
+        return {"ltl": str(formula.operand)}
+    return {"ctl": str(formula)}
