@@ -315,7 +315,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                                 until=args.until, trace=args.trace, xes=args.xes, db=args.db, poses=args.poses,
                                 realtime=args.realtime, gui=args.gui, progress=_progress(args),
                                 max_firings=args.max_firings, metrics=_metric_names(args.metrics),
-                                picture=args.picture)
+                                picture=args.picture, monitor=args.monitor)
     except BaseException:
         if made_up_trace is not None:  # the page's made-up trace, in a folder of its own
             shutil.rmtree(made_up_trace.parent, ignore_errors=True)
@@ -326,6 +326,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     final = final_marking_of(outcome.net)  # declared, else a WF-net's sink: the rule check uses
     problem = result.reason in ("failed", "stalled") or (final is not None and result.reason != "final")
+    problem = problem or any(p["verdict"] is False for p in outcome.properties)
     summary = {
         "net": outcome.net.id,
         "reason": result.reason,
@@ -341,6 +342,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         "metrics": outcome.metrics,
         "written": outcome.written,
     }
+    if args.monitor:
+        summary["properties"] = outcome.properties
     if args.json:
         _print_json(summary)
     else:
@@ -355,9 +358,26 @@ def cmd_run(args: argparse.Namespace) -> int:
         if result.error:
             print(f"  error: {result.error}")
         _print_metrics(outcome.metrics)
+        _print_monitored(outcome.properties)
         for path in outcome.written:
             print(f"  wrote {path}")
     return EXIT_PROBLEM if problem else EXIT_OK
+
+
+def _print_monitored(results: list[dict[str, Any]]) -> None:
+    """``run --monitor``: one line per property, a violation with its event."""
+    for entry in results:
+        verdict = entry["verdict"]
+        text = "undecided" if verdict is None else ("holds" if verdict is True else "violated"
+                                                     if verdict is False else str(verdict))
+        line = f"  property {entry['id']}: {text}"
+        where = entry.get("violation")
+        if where:
+            line += (f" at event {where['seq']} (t = {where['time']:g} s, {where['kind']}"
+                     f"{' ' + where['transition'] if where['transition'] else ''})")
+        elif entry.get("reason"):
+            line += f" ({entry['reason']})"
+        print(line)
 
 
 def _metric_names(given: str | None) -> list[str] | None:
@@ -555,6 +575,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--metrics", metavar="NAMES",
                      help="report these registered metrics at the end (comma-separated; 'none': no metric)"
                           " instead of the ones the run configuration names")
+    run.add_argument("--monitor", action="store_true",
+                     help="watch the net's properties during the run (docs/analysis.md, 'Properties'):"
+                     " safety on every marking, LTL on the finite trace; a violation is reported with its"
+                     " event, marked in the trace, and makes the exit code 1")
     run.add_argument("--picture", metavar="OUT.png",
                      help="draw the world's top view with the robots' trajectories (.png, .svg or .pdf)")
     run.add_argument("--quiet", action="store_true", help="no progress on standard error")

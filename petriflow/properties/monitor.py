@@ -1,0 +1,250 @@
+"""Properties watched while a net runs: safety on every marking, LTL on the finite trace.
+
+:class:`PropertyMonitor` is a run observer (:meth:`Scheduler.on_event
+<petriflow.runtime.scheduler.Scheduler.on_event>`). The run's markings are the marking
+at the start and the one after each event that moves tokens (a firing's start consumes
+its inputs, its end produces the outputs, a cancellation withdraws; tokens of a running
+action are in neither place). On that sequence of markings:
+
+* **safety** (``never``, ``always``, ``AG p``): ``p`` is checked on every marking; the
+  first marking violating it is reported with the event that made it (sequence number,
+  time, kind, transition), and the monitor emits a ``custom`` event
+  ``property_violated`` into the run's events, so the trace marks the spot;
+* **bounds**: the most tokens the places held together (and, with ``at_most``, a
+  violation when it is exceeded, as for safety);
+* **reachability** (``reachable``, ``EF p``): ``true`` once a marking satisfies ``p``,
+  else ``null`` (a finite run that has not seen it says nothing about the net);
+* **LTL** (``eventually``, ``responds``, ``ltl``): evaluated at the end on the finite
+  trace with the usual finite-trace semantics (LTLf): ``X p`` needs a next marking (false
+  at the last one), ``G p`` means at every remaining marking of the run, ``F p`` at some,
+  ``p U q`` as usual within the run. So ``responds`` fails when a request is still
+  unanswered when the run ends. A run's verdict is about that run, not the net;
+* CTL formulas with nested path quantifiers (``AG EF p``) speak of branches a run does
+  not take: not monitored (``null``, with the reason).
+
+``enabled(t)`` is read structurally (``t``'s input places hold enough tokens), without
+guards. Results: :meth:`PropertyMonitor.results`, one entry per property like ``check``'s
+(``verdict``, ``method``, and ``violation``: ``{"seq", "time", "kind", "transition"}``).
+
+Examples:
+    >>> from petriflow.io.yaml import loads_net
+    >>> from petriflow.runtime.scheduler import Scheduler
+    >>> from petriflow.runtime.observers import run_observed
+    >>> net = loads_net('''
+    ... petriflow: 1
+    ... places: [{id: a, tokens: 1}, b, c]
+    ... transitions: [{id: go, in: [a], out: [b]}, {id: stop, in: [b], out: [c]}]
+    ... properties:
+    ...   - {id: never_c, never: "c >= 1"}
+    ...   - {id: ends, eventually: "c == 1"}
+    ... ''')
+    >>> scheduler = Scheduler(net)
+    >>> monitor = PropertyMonitor(net, net.properties)
+    >>> monitor.attach(scheduler)
+    >>> _ = run_observed(scheduler)
+    >>> [(r["id"], r["verdict"]) for r in monitor.results()]
+    [('never_c', False), ('ends', True)]
+    >>> monitor.results()[0]["violation"]["transition"]
+    'stop'
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from petriflow.net import Net
+from petriflow.properties.language import (
+    AllPaths,
+    And,
+    Compare,
+    Constant,
+    Deadlock,
+    ExistsPath,
+    Finally,
+    Fireable,
+    Formula,
+    Globally,
+    Next,
+    Not,
+    Or,
+    Property,
+    Until,
+    atoms,
+)
+
+__all__ = ["PropertyMonitor", "holds_in", "holds_on_trace"]
+
+#: The event kinds after which the marking may have changed.
+MOVING_KINDS = ("run", "start", "end", "cancel", "message", "fault")
+
+_OPS = {"<=": lambda a, b: a <= b, "<": lambda a, b: a < b, ">=": lambda a, b: a >= b,
+        ">": lambda a, b: a > b, "==": lambda a, b: a == b, "!=": lambda a, b: a != b}
+
+
+def holds_in(net: Net, marking: Mapping[str, int], formula: Formula) -> bool:
+    """Whether a state predicate holds in one marking (``enabled``: structurally)."""
+    if isinstance(formula, Constant):
+        return formula.value
+    if isinstance(formula, Compare):
+        left = formula.left.offset + sum(k * marking.get(p, 0) for p, k in formula.left.terms)
+        right = formula.right.offset + sum(k * marking.get(p, 0) for p, k in formula.right.terms)
+        return _OPS[formula.op](left, right)
+    if isinstance(formula, Fireable):
+        return any(all(marking.get(p, 0) >= w for p, w in net.preset(t).items()) for t in formula.transitions)
+    if isinstance(formula, Deadlock):
+        return not holds_in(net, marking, Fireable(tuple(net.transitions)))
+    if isinstance(formula, Not):
+        return not holds_in(net, marking, formula.operand)
+    if isinstance(formula, And):
+        return all(holds_in(net, marking, f) for f in formula.operands)
+    if isinstance(formula, Or):
+        return any(holds_in(net, marking, f) for f in formula.operands)
+    raise ValueError(f"not a state predicate: {formula}")
+
+
+def holds_on_trace(formula: Formula, trace: Sequence[Mapping[Formula, bool]], at: int = 0) -> bool:
+    """LTLf: whether the path formula holds at position ``at`` of a finite trace, each
+    position giving the value of the formula's atoms (:func:`~petriflow.properties.language.atoms`)."""
+    return _ltlf(formula, trace)[at]
+
+
+def _ltlf(formula: Formula, trace: Sequence[Mapping[Formula, bool]]) -> list[bool]:
+    n = len(trace)
+    if formula in trace[0]:
+        return [step[formula] for step in trace]
+    if isinstance(formula, Not):
+        return [not v for v in _ltlf(formula.operand, trace)]
+    if isinstance(formula, (And, Or)):
+        parts = [_ltlf(f, trace) for f in formula.operands]
+        combine = all if isinstance(formula, And) else any
+        return [combine(p[i] for p in parts) for i in range(n)]
+    if isinstance(formula, Next):
+        inner = _ltlf(formula.operand, trace)
+        return inner[1:] + [False]
+    if isinstance(formula, (Finally, Globally, Until)):
+        if isinstance(formula, Until):
+            left, right = _ltlf(formula.left, trace), _ltlf(formula.right, trace)
+        elif isinstance(formula, Finally):
+            left, right = [True] * n, _ltlf(formula.operand, trace)
+        else:      # G p = ¬F¬p
+            left, right = [True] * n, [not v for v in _ltlf(formula.operand, trace)]
+        out, later = [False] * n, False
+        for i in range(n - 1, -1, -1):
+            later = right[i] or (left[i] and later)
+            out[i] = later
+        return [not v for v in out] if isinstance(formula, Globally) else out
+    if isinstance(formula, Constant):
+        return [formula.value] * n
+    raise ValueError(f"not an LTL path formula: {formula}")
+
+
+class PropertyMonitor:
+    """Watches a run for the net's properties (see the module documentation).
+
+    Args:
+        net: the net that runs.
+        properties: what to watch (usually ``net.properties``).
+    """
+
+    def __init__(self, net: Net, properties: Sequence[Property]) -> None:
+        self.net = net
+        self.properties = list(properties)
+        self.scheduler: Any = None
+        self._kind: dict[str, str] = {}
+        self._predicate: dict[str, Formula] = {}
+        self._violation: dict[str, dict[str, Any]] = {}
+        self._seen: dict[str, dict[str, Any]] = {}
+        self._most: dict[str, tuple[int, dict[str, Any] | None]] = {}
+        self._atoms: list[Formula] = []
+        self._trace: list[dict[Formula, bool]] = []
+        self.markings = 0
+        self._every_step = _has_next(self.properties)
+        for prop in self.properties:
+            formula = prop.formula
+            if formula is None:
+                self._kind[prop.id] = "bound"
+            elif isinstance(formula, AllPaths) and isinstance(formula.operand, Globally) \
+                    and not _temporal(formula.operand.operand):
+                self._kind[prop.id], self._predicate[prop.id] = "safety", formula.operand.operand
+            elif isinstance(formula, ExistsPath) and isinstance(formula.operand, Finally) \
+                    and not _temporal(formula.operand.operand):
+                self._kind[prop.id], self._predicate[prop.id] = "reachability", formula.operand.operand
+            elif isinstance(formula, AllPaths) and not _quantified(formula.operand):
+                self._kind[prop.id] = "ltl"
+                self._atoms.extend(a for a in atoms(formula.operand) if a not in self._atoms)
+            else:
+                self._kind[prop.id] = "branching"
+
+    def attach(self, scheduler: Any) -> None:
+        """Subscribe to ``scheduler``'s events (before the run starts)."""
+        self.scheduler = scheduler
+        scheduler.on_event(self, MOVING_KINDS)
+
+    def __call__(self, event: Any) -> None:
+        """One event: check the marking it leaves."""
+        marking = self.scheduler.marking()
+        self.markings += 1
+        where = {"seq": event.seq, "time": event.time, "kind": event.kind, "transition": event.transition}
+        for prop in self.properties:
+            kind = self._kind[prop.id]
+            if kind == "safety" and prop.id not in self._violation:
+                if not holds_in(self.net, marking, self._predicate[prop.id]):
+                    self._violate(prop, where, marking)
+            elif kind == "reachability" and prop.id not in self._seen:
+                if holds_in(self.net, marking, self._predicate[prop.id]):
+                    self._seen[prop.id] = where
+            elif kind == "bound":
+                total = sum(marking.get(p, 0) for p in dict.fromkeys(prop.bound))
+                if prop.id not in self._most or total > self._most[prop.id][0]:
+                    self._most[prop.id] = (total, where)
+                if prop.at_most is not None and total > prop.at_most and prop.id not in self._violation:
+                    self._violate(prop, where, marking)
+        if self._atoms:
+            step = {a: holds_in(self.net, marking, a) for a in self._atoms}
+            if not self._trace or step != self._trace[-1] or self._every_step:
+                self._trace.append(step)
+
+    def _violate(self, prop: Property, where: dict[str, Any], marking: Mapping[str, int]) -> None:
+        self._violation[prop.id] = where
+        self.scheduler.emit("custom", where["transition"], None, name="property_violated", property=prop.id,
+                            marking=dict(marking))
+
+    def results(self) -> list[dict[str, Any]]:
+        """One entry per property: ``{"id", "kind", "verdict", "method", "violation"?}``."""
+        out = []
+        for prop in self.properties:
+            kind = self._kind[prop.id]
+            entry: dict[str, Any] = {"id": prop.id, "kind": kind, "verdict": None}
+            if kind == "safety":
+                entry.update(verdict=prop.id not in self._violation, method="every marking of the run")
+            elif kind == "reachability":
+                entry.update(verdict=True if prop.id in self._seen else None, method="markings of the run")
+                if prop.id in self._seen:
+                    entry["seen"] = self._seen[prop.id]
+            elif kind == "bound":
+                most, where = self._most.get(prop.id, (0, None))
+                entry.update(bound_reached=most, method="markings of the run", at=where)
+                entry["verdict"] = most if prop.at_most is None else prop.id not in self._violation
+            elif kind == "ltl":
+                entry["method"] = "LTL on the finite trace (LTLf)"
+                entry["verdict"] = bool(self._trace) and holds_on_trace(prop.formula.operand, self._trace)
+            else:
+                entry["reason"] = "a branching-time (CTL) property: a single run cannot decide it"
+            if prop.id in self._violation:
+                entry["violation"] = self._violation[prop.id]
+            out.append(entry)
+        return out
+
+
+def _temporal(formula: Formula) -> bool:
+    return any(isinstance(n, (Next, Finally, Globally, Until, AllPaths, ExistsPath)) for n in formula.walk())
+
+
+def _quantified(formula: Formula) -> bool:
+    return any(isinstance(n, (AllPaths, ExistsPath)) for n in formula.walk())
+
+
+def _has_next(properties: Sequence[Property]) -> bool:
+    """Whether some LTL formula uses X: then every marking is a step (no stutter folding)."""
+    return any(p.formula is not None and any(isinstance(n, Next) for n in p.formula.walk()) for p in properties)
