@@ -8,8 +8,9 @@ action are in neither place). On that sequence of markings:
 
 * **safety** (``never``, ``always``, ``AG p``): ``p`` is checked on every marking; the
   first marking violating it is reported with the event that made it (sequence number,
-  time, kind, transition), and the monitor emits a ``custom`` event
-  ``property_violated`` into the run's events, so the trace marks the spot;
+  time, kind, transition), and the monitor records a ``custom`` event
+  ``property_violated`` (naming the property and that event) after the instant, so the
+  trace marks the spot;
 * **bounds**: the most tokens the places held together (and, with ``at_most``, a
   violation when it is exceeded, as for safety);
 * **reachability** (``reachable``, ``EF p``): ``true`` once a marking satisfies ``p``,
@@ -23,7 +24,9 @@ action are in neither place). On that sequence of markings:
   not take: not monitored (``null``, with the reason).
 
 ``enabled(t)`` is read structurally (``t``'s input places hold enough tokens), without
-guards. Results: :meth:`PropertyMonitor.results`, one entry per property like ``check``'s
+guards. Only the places the properties read are looked at: an event that moves none
+of them is skipped (so the LTL trace's positions are the markings after events that
+change those places). Results: :meth:`PropertyMonitor.results`, one entry per property like ``check``'s
 (``verdict``, ``method``, and ``violation``: ``{"seq", "time", "kind", "transition"}``).
 
 Examples:
@@ -73,7 +76,7 @@ from petriflow.properties.language import (
     atoms,
 )
 
-__all__ = ["PropertyMonitor", "holds_in", "holds_on_trace"]
+__all__ = ["PropertyMonitor", "compile_predicate", "holds_in", "holds_on_trace"]
 
 #: The event kinds after which the marking may have changed.
 MOVING_KINDS = ("run", "start", "end", "cancel", "message", "fault")
@@ -139,6 +142,47 @@ def _ltlf(formula: Formula, trace: Sequence[Mapping[Formula, bool]]) -> list[boo
     raise ValueError(f"not an LTL path formula: {formula}")
 
 
+def compile_predicate(net: Net, formula: Formula, index: Mapping[str, int]):
+    """A state predicate as a function of the run's token counts (a list indexed by
+    ``index[place]``): Python source built from the formula's integers and indices
+    only (no name or text of the file reaches it), compiled once, so that checking a
+    marking costs a few comparisons.
+
+    Examples:
+        >>> from petriflow.properties.yaml_props import parse_formula
+        >>> from petriflow.net import Net
+        >>> check = compile_predicate(Net(), parse_formula("a + 2*b <= 3"), {"a": 0, "b": 1})
+        >>> check([1, 1]), check([2, 1])
+        (True, False)
+    """
+    def linear(expression) -> str:
+        terms = [f"{int(k)}*m[{int(index[p])}]" for p, k in expression.terms]
+        return " + ".join(terms + [str(int(expression.offset))])
+
+    def enabled(transition: str) -> str:
+        need = [f"m[{int(index[p])}] >= {int(w)}" for p, w in net.preset(transition).items()]
+        return "(" + (" and ".join(need) or "True") + ")"
+
+    def source(node: Formula) -> str:
+        if isinstance(node, Constant):
+            return "True" if node.value else "False"
+        if isinstance(node, Compare):
+            return f"(({linear(node.left)}) {node.op} ({linear(node.right)}))"
+        if isinstance(node, Fireable):
+            return "(" + (" or ".join(enabled(t) for t in node.transitions) or "False") + ")"
+        if isinstance(node, Deadlock):
+            return "(not (" + (" or ".join(enabled(t) for t in net.transitions) or "False") + "))"
+        if isinstance(node, Not):
+            return f"(not {source(node.operand)})"
+        if isinstance(node, And):
+            return "(" + (" and ".join(source(f) for f in node.operands) or "True") + ")"
+        if isinstance(node, Or):
+            return "(" + (" or ".join(source(f) for f in node.operands) or "False") + ")"
+        raise ValueError(f"not a state predicate: {node}")
+
+    return eval(compile(f"lambda m: {source(formula)}", "<property>", "eval"), {"__builtins__": {}})  # noqa: S307
+
+
 class PropertyMonitor:
     """Watches a run for the net's properties (see the module documentation).
 
@@ -160,6 +204,7 @@ class PropertyMonitor:
         self._trace: list[dict[Formula, bool]] = []
         self.markings = 0
         self._every_step = _has_next(self.properties)
+        self._pending: list[tuple[str | None, dict[str, Any]]] = []
         for prop in self.properties:
             formula = prop.formula
             if formula is None:
@@ -175,43 +220,89 @@ class PropertyMonitor:
                 self._atoms.extend(a for a in atoms(formula.operand) if a not in self._atoms)
             else:
                 self._kind[prop.id] = "branching"
+        self._read = self._places_read()
+        self._tokens: Any = None
+
+    def _places_read(self) -> tuple[str, ...]:
+        """The places the monitored properties read (``enabled``/``deadlock``: presets)."""
+        read: dict[str, None] = {}
+        for prop in self.properties:
+            kind = self._kind[prop.id]
+            if kind == "bound":
+                read.update(dict.fromkeys(prop.bound))
+            elif kind != "branching":
+                for node in prop.formula.walk():
+                    if isinstance(node, Compare):
+                        read.update(dict.fromkeys(p for p, _ in node.left.terms + node.right.terms))
+                    elif isinstance(node, (Fireable, Deadlock)):
+                        names = node.transitions if isinstance(node, Fireable) else tuple(self.net.transitions)
+                        for t in names:
+                            read.update(dict.fromkeys(self.net.preset(t)))
+        return tuple(read)
 
     def attach(self, scheduler: Any) -> None:
         """Subscribe to ``scheduler``'s events (before the run starts)."""
         self.scheduler = scheduler
+        self._tokens = scheduler.tokens
+        index = self._tokens.index
+        self._check = {pid: compile_predicate(self.net, f, index) for pid, f in self._predicate.items()}
+        self._atom_checks = [(a, compile_predicate(self.net, a, index)) for a in self._atoms]
+        self._bound_columns = {p.id: [index[q] for q in dict.fromkeys(p.bound)] for p in self.properties
+                               if p.formula is None}
+        self._relevant = frozenset(self._read)
         scheduler.on_event(self, MOVING_KINDS)
+        scheduler.on_instant(self._flush)
+
+    def _marking(self) -> dict[str, int]:
+        """The counts of the places read, now (for a report)."""
+        counts, index = self._tokens.counts, self._tokens.index
+        return {p: counts[index[p]] for p in self._read}
 
     def __call__(self, event: Any) -> None:
-        """One event: check the marking it leaves."""
-        marking = self.scheduler.marking()
+        """One event: check the marking it leaves, when it moved tokens the properties read."""
+        if event.kind == "start" or event.kind == "end":
+            moved = event.data.get("consumed" if event.kind == "start" else "produced") or ()
+            if self.markings and self._relevant.isdisjoint(moved):
+                return
+        counts = self._tokens.counts
         self.markings += 1
-        where = {"seq": event.seq, "time": event.time, "kind": event.kind, "transition": event.transition}
         for prop in self.properties:
             kind = self._kind[prop.id]
             if kind == "safety" and prop.id not in self._violation:
-                if not holds_in(self.net, marking, self._predicate[prop.id]):
-                    self._violate(prop, where, marking)
+                if not self._check[prop.id](counts):
+                    self._violate(prop, event)
             elif kind == "reachability" and prop.id not in self._seen:
-                if holds_in(self.net, marking, self._predicate[prop.id]):
-                    self._seen[prop.id] = where
+                if self._check[prop.id](counts):
+                    self._seen[prop.id] = _where(event)
             elif kind == "bound":
-                total = sum(marking.get(p, 0) for p in dict.fromkeys(prop.bound))
+                total = sum(counts[i] for i in self._bound_columns[prop.id])
                 if prop.id not in self._most or total > self._most[prop.id][0]:
-                    self._most[prop.id] = (total, where)
+                    self._most[prop.id] = (total, _where(event))
                 if prop.at_most is not None and total > prop.at_most and prop.id not in self._violation:
-                    self._violate(prop, where, marking)
+                    self._violate(prop, event)
         if self._atoms:
-            step = {a: holds_in(self.net, marking, a) for a in self._atoms}
+            step = {a: check(counts) for a, check in self._atom_checks}
             if not self._trace or step != self._trace[-1] or self._every_step:
                 self._trace.append(step)
 
-    def _violate(self, prop: Property, where: dict[str, Any], marking: Mapping[str, int]) -> None:
+    def _violate(self, prop: Property, event: Any) -> None:
+        where = _where(event)
+        marking = self._marking()
         self._violation[prop.id] = where
-        self.scheduler.emit("custom", where["transition"], None, name="property_violated", property=prop.id,
-                            marking=dict(marking))
+        # recorded once the event being handled is done (an event handler must not emit)
+        self._pending.append((where["transition"], {"name": "property_violated", "property": prop.id,
+                                                    "event": where["seq"],
+                                                    "marking": {p: c for p, c in marking.items() if c}}))
+
+    def _flush(self, scheduler: Any = None) -> None:
+        """After an instant: record the violations found as ``custom`` events."""
+        pending, self._pending = self._pending, []
+        for transition, data in pending:
+            self.scheduler.emit("custom", transition, None, **data)
 
     def results(self) -> list[dict[str, Any]]:
         """One entry per property: ``{"id", "kind", "verdict", "method", "violation"?}``."""
+        self._pending = []  # a violation in the last instant: the run is over, its events closed
         out = []
         for prop in self.properties:
             kind = self._kind[prop.id]
@@ -235,6 +326,10 @@ class PropertyMonitor:
                 entry["violation"] = self._violation[prop.id]
             out.append(entry)
         return out
+
+
+def _where(event: Any) -> dict[str, Any]:
+    return {"seq": event.seq, "time": event.time, "kind": event.kind, "transition": event.transition}
 
 
 def _temporal(formula: Formula) -> bool:
