@@ -38,17 +38,7 @@ import numpy as np
 from petriflow.analysis import components, reachable
 from petriflow.properties.kripke import STUTTER, Kripke
 from petriflow.properties.language import (
-    AllPaths,
-    And,
-    ExistsPath,
-    Finally,
-    Formula,
-    Globally,
-    Next,
-    Not,
-    Or,
-    Until,
-    is_state_formula,
+    AllPaths, And, ExistsPath, Finally, Formula, Globally, Next, Not, Or, Until, is_state_formula
 )
 
 __all__ = ["ctl_witness", "evaluate"]

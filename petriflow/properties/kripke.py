@@ -34,15 +34,7 @@ from petriflow.analysis import csr, transpose
 from petriflow.analysis.reachability import StateSpace
 from petriflow.errors import PetriflowError
 from petriflow.properties.language import (
-    And,
-    Compare,
-    Constant,
-    Deadlock,
-    Fireable,
-    Formula,
-    Linear,
-    Not,
-    Or,
+    And, Compare, Constant, Deadlock, Fireable, Formula, Linear, Not, Or
 )
 
 __all__ = ["STUTTER", "Kripke", "PropertyNameError"]

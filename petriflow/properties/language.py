@@ -30,6 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 __all__ = [
     "AllPaths", "And", "Compare", "Constant", "Deadlock", "ExistsPath", "Finally", "Fireable",
@@ -139,69 +140,65 @@ class Deadlock(Formula):
 
 
 @dataclass(frozen=True)
-class Not(Formula):
+class _Unary(Formula):
+    """An operator of one operand, written ``SYMBOL(operand)``."""
+
+    operand: Formula
+    symbol: ClassVar[str] = ""
+
+    def __str__(self) -> str:
+        return f"{self.symbol}({self.operand})"
+
+
+class Not(_Unary):
     """Negation."""
 
-    operand: Formula
-
-    def __str__(self) -> str:
-        return f"!({self.operand})"
+    symbol = "!"
 
 
 @dataclass(frozen=True)
-class And(Formula):
+class _Nary(Formula):
+    """An associative connective of any number of operands (none: its unit)."""
+
+    operands: tuple[Formula, ...]
+    symbol: ClassVar[str] = ""
+    unit: ClassVar[str] = ""
+
+    def children(self) -> tuple[Formula, ...]:
+        return self.operands
+
+    def __str__(self) -> str:
+        return "(" + f" {self.symbol} ".join(map(str, self.operands)) + ")" if self.operands else self.unit
+
+
+class And(_Nary):
     """Conjunction (of two or more operands; none: true)."""
 
-    operands: tuple[Formula, ...]
-
-    def children(self) -> tuple[Formula, ...]:
-        return self.operands
-
-    def __str__(self) -> str:
-        return "(" + " && ".join(map(str, self.operands)) + ")" if self.operands else "true"
+    symbol, unit = "&&", "true"
 
 
-@dataclass(frozen=True)
-class Or(Formula):
+class Or(_Nary):
     """Disjunction (of two or more operands; none: false)."""
 
-    operands: tuple[Formula, ...]
-
-    def children(self) -> tuple[Formula, ...]:
-        return self.operands
-
-    def __str__(self) -> str:
-        return "(" + " || ".join(map(str, self.operands)) + ")" if self.operands else "false"
+    symbol, unit = "||", "false"
 
 
-@dataclass(frozen=True)
-class Next(Formula):
+class Next(_Unary):
     """``X φ``: φ holds in the next state."""
 
-    operand: Formula
-
-    def __str__(self) -> str:
-        return f"X({self.operand})"
+    symbol = "X"
 
 
-@dataclass(frozen=True)
-class Finally(Formula):
+class Finally(_Unary):
     """``F φ``: φ holds now or later."""
 
-    operand: Formula
-
-    def __str__(self) -> str:
-        return f"F({self.operand})"
+    symbol = "F"
 
 
-@dataclass(frozen=True)
-class Globally(Formula):
+class Globally(_Unary):
     """``G φ``: φ holds now and forever."""
 
-    operand: Formula
-
-    def __str__(self) -> str:
-        return f"G({self.operand})"
+    symbol = "G"
 
 
 @dataclass(frozen=True)
@@ -215,21 +212,15 @@ class Until(Formula):
         return f"({self.left} U {self.right})"
 
 
-@dataclass(frozen=True)
-class AllPaths(Formula):
+class AllPaths(_Unary):
     """``A ψ``: every path from the state satisfies ψ."""
-
-    operand: Formula
 
     def __str__(self) -> str:
         return "A" + _quantified(self.operand)
 
 
-@dataclass(frozen=True)
-class ExistsPath(Formula):
+class ExistsPath(_Unary):
     """``E ψ``: some path from the state satisfies ψ."""
-
-    operand: Formula
 
     def __str__(self) -> str:
         return "E" + _quantified(self.operand)

@@ -37,18 +37,7 @@ from petriflow.analysis import components, csr, reachable
 from petriflow.errors import PetriflowError
 from petriflow.properties.kripke import Kripke
 from petriflow.properties.language import (
-    AllPaths,
-    And,
-    Constant,
-    ExistsPath,
-    Finally,
-    Formula,
-    Globally,
-    Next,
-    Not,
-    Or,
-    Until,
-    atoms,
+    AllPaths, And, Constant, ExistsPath, Finally, Formula, Globally, Next, Not, Or, Until, atoms
 )
 
 __all__ = ["check_ltl", "to_spot"]

@@ -29,22 +29,8 @@ from pathlib import Path
 from petriflow.errors import NetFormatError
 from petriflow.io.safe_xml import child, children, line_of, local_name, parse_xml
 from petriflow.properties.language import (
-    AllPaths,
-    And,
-    Compare,
-    Constant,
-    Deadlock,
-    ExistsPath,
-    Finally,
-    Fireable,
-    Formula,
-    Globally,
-    Linear,
-    Next,
-    Not,
-    Or,
-    Property,
-    Until,
+    AllPaths, And, Compare, Constant, Deadlock, ExistsPath, Finally, Fireable, Formula, Globally,
+    Linear, Next, Not, Or, Property, Until
 )
 
 __all__ = ["load_mcc_properties", "parse_mcc_properties"]

@@ -34,19 +34,16 @@ Examples:
     >>> from petriflow.runtime.scheduler import Scheduler
     >>> from petriflow.runtime.observers import run_observed
     >>> net = loads_net('''
-    ... petriflow: 1
-    ... places: [{id: a, tokens: 1}, b, c]
-    ... transitions: [{id: go, in: [a], out: [b]}, {id: stop, in: [b], out: [c]}]
-    ... properties:
-    ...   - {id: never_c, never: "c >= 1"}
-    ...   - {id: ends, eventually: "c == 1"}
+    ... {petriflow: 1, places: [{id: home, tokens: 1}, way, gate],
+    ...  transitions: [{id: leave, in: [home], out: [way]}, {id: stop, in: [way], out: [gate]}],
+    ...  properties: [{id: never_gate, never: "gate >= 1"}, {id: ends, eventually: "gate == 1"}]}
     ... ''')
     >>> scheduler = Scheduler(net)
     >>> monitor = PropertyMonitor(net, net.properties)
     >>> monitor.attach(scheduler)
     >>> _ = run_observed(scheduler)
     >>> [(r["id"], r["verdict"]) for r in monitor.results()]
-    [('never_c', False), ('ends', True)]
+    [('never_gate', False), ('ends', True)]
     >>> monitor.results()[0]["violation"]["transition"]
     'stop'
 """
@@ -58,53 +55,14 @@ from typing import Any
 
 from petriflow.net import Net
 from petriflow.properties.language import (
-    AllPaths,
-    And,
-    Compare,
-    Constant,
-    Deadlock,
-    ExistsPath,
-    Finally,
-    Fireable,
-    Formula,
-    Globally,
-    Next,
-    Not,
-    Or,
-    Property,
-    Until,
-    atoms,
+    AllPaths, And, Compare, Constant, Deadlock, ExistsPath, Finally, Fireable, Formula, Globally, Next,
+    Not, Or, Property, Until, atoms
 )
 
-__all__ = ["PropertyMonitor", "compile_predicate", "holds_in", "holds_on_trace"]
+__all__ = ["PropertyMonitor", "compile_predicate", "holds_on_trace"]
 
 #: The event kinds after which the marking may have changed.
 MOVING_KINDS = ("run", "start", "end", "cancel", "message", "fault")
-
-_OPS = {"<=": lambda a, b: a <= b, "<": lambda a, b: a < b, ">=": lambda a, b: a >= b,
-        ">": lambda a, b: a > b, "==": lambda a, b: a == b, "!=": lambda a, b: a != b}
-
-
-def holds_in(net: Net, marking: Mapping[str, int], formula: Formula) -> bool:
-    """Whether a state predicate holds in one marking (``enabled``: structurally)."""
-    if isinstance(formula, Constant):
-        return formula.value
-    if isinstance(formula, Compare):
-        left = formula.left.offset + sum(k * marking.get(p, 0) for p, k in formula.left.terms)
-        right = formula.right.offset + sum(k * marking.get(p, 0) for p, k in formula.right.terms)
-        return _OPS[formula.op](left, right)
-    if isinstance(formula, Fireable):
-        return any(all(marking.get(p, 0) >= w for p, w in net.preset(t).items()) for t in formula.transitions)
-    if isinstance(formula, Deadlock):
-        return not holds_in(net, marking, Fireable(tuple(net.transitions)))
-    if isinstance(formula, Not):
-        return not holds_in(net, marking, formula.operand)
-    if isinstance(formula, And):
-        return all(holds_in(net, marking, f) for f in formula.operands)
-    if isinstance(formula, Or):
-        return any(holds_in(net, marking, f) for f in formula.operands)
-    raise ValueError(f"not a state predicate: {formula}")
-
 
 def holds_on_trace(formula: Formula, trace: Sequence[Mapping[Formula, bool]], at: int = 0) -> bool:
     """LTLf: whether the path formula holds at position ``at`` of a finite trace, each
@@ -174,10 +132,9 @@ def compile_predicate(net: Net, formula: Formula, index: Mapping[str, int]):
             return "(not (" + (" or ".join(enabled(t) for t in net.transitions) or "False") + "))"
         if isinstance(node, Not):
             return f"(not {source(node.operand)})"
-        if isinstance(node, And):
-            return "(" + (" and ".join(source(f) for f in node.operands) or "True") + ")"
-        if isinstance(node, Or):
-            return "(" + (" or ".join(source(f) for f in node.operands) or "False") + ")"
+        if isinstance(node, (And, Or)):   # an empty conjunction is true, an empty disjunction false
+            joiner, empty = (" and ", "True") if isinstance(node, And) else (" or ", "False")
+            return "(" + (joiner.join(source(f) for f in node.operands) or empty) + ")"
         raise ValueError(f"not a state predicate: {node}")
 
     return eval(compile(f"lambda m: {source(formula)}", "<property>", "eval"), {"__builtins__": {}})  # noqa: S307

@@ -44,25 +44,8 @@ from typing import Any
 
 from petriflow.errors import NetFormatError
 from petriflow.properties.language import (
-    AllPaths,
-    And,
-    Compare,
-    Constant,
-    Deadlock,
-    ExistsPath,
-    Finally,
-    Fireable,
-    Formula,
-    Globally,
-    Linear,
-    Next,
-    Not,
-    Or,
-    Property,
-    Until,
-    classify,
-    is_state_formula,
-    names_used,
+    AllPaths, And, Compare, Constant, Deadlock, ExistsPath, Finally, Fireable, Formula, Globally,
+    Linear, Next, Not, Or, Property, Until, classify, is_state_formula, names_used
 )
 
 __all__ = ["check_property_names", "load_properties", "parse_formula", "parse_properties",
@@ -114,19 +97,19 @@ class _Parser:
             return Or((Not(left), self.formula()))
         return left
 
-    def disjunction(self) -> Formula:
-        parts = [self.conjunction()]
-        while self.peek() in ("||", "or"):
+    def chain(self, operators: tuple[str, str], operand, connective) -> Formula:
+        """``operand (op operand)*`` as one ``connective`` (or the operand alone)."""
+        parts = [operand()]
+        while self.peek() in operators:
             self.take()
-            parts.append(self.conjunction())
-        return parts[0] if len(parts) == 1 else Or(tuple(parts))
+            parts.append(operand())
+        return parts[0] if len(parts) == 1 else connective(tuple(parts))
+
+    def disjunction(self) -> Formula:
+        return self.chain(("||", "or"), self.conjunction, Or)
 
     def conjunction(self) -> Formula:
-        parts = [self.until()]
-        while self.peek() in ("&&", "and"):
-            self.take()
-            parts.append(self.until())
-        return parts[0] if len(parts) == 1 else And(tuple(parts))
+        return self.chain(("&&", "and"), self.until, And)
 
     def until(self) -> Formula:
         left = self.unary()
