@@ -223,6 +223,23 @@ def _size(text: str | None) -> tuple[float, float] | None:
     return width, height
 
 
+def _property_violations(net) -> list[dict[str, Any]]:
+    """The net's own properties that fail, as violations with their witness sequence (a
+    lasso's cycle is left out: the drawing shows where it starts)."""
+    if not net.properties:
+        return []
+    from petriflow.engine import fire_sequence
+    from petriflow.properties.check import check_properties
+
+    found = []
+    for result in check_properties(net, net.properties):
+        if result["verdict"] is False and result.get("witness") is not None:
+            reached = fire_sequence(net, net.initial_marking, result["witness"])
+            found.append({"transitions": result["witness"], "marking": reached.to_dict(),
+                          "message": f"property {result['id']} fails: {result['formula']}"})
+    return [v for v in found if v["transitions"]]
+
+
 def cmd_export(args: argparse.Namespace) -> int:
     from petriflow.export import export_net, format_of
 
@@ -243,7 +260,8 @@ def cmd_export(args: argparse.Namespace) -> int:
     if args.violation:
         from petriflow.analysis.report import check_net
 
-        violations = [v for v in check_net(net)["violations"] if v.get("transitions")]
+        violations = _property_violations(net)   # what the net states it guarantees comes first
+        violations += [v for v in check_net(net)["violations"] if v.get("transitions")]
         if not violations:
             print(f"petriflow: {args.net}: the analysis found no violation with a witness; nothing drawn",
                   file=sys.stderr)

@@ -74,3 +74,15 @@ def test_an_arc_removed_breaks_a_property_with_a_counterexample(relative, arc, f
     result = {r["id"]: r for r in check_properties(net, net.properties)}[failing]
     assert result["verdict"] is False
     fire_sequence(net, net.initial_marking, result["witness"])     # raises if not fireable
+
+
+def test_export_violation_draws_a_failing_property(tmp_path, capsys):
+    """`export --violation` draws the counterexample of the net's own failing property."""
+    from petriflow.cli import main
+
+    mutated = tmp_path / "passage.yaml"
+    text = (NETS / "passage" / "passage.yaml").read_text()
+    mutated.write_text(text.replace("in: [blue_waiting, mutex]", "in: [blue_waiting]").replace("run: run.yaml\n", ""))
+    assert main(["export", str(mutated), "-o", str(tmp_path / "out.dot"), "--violation"]) == 0
+    assert capsys.readouterr().out.startswith("property passage_exclusive fails")
+    assert "blue_enter" in (tmp_path / "out.dot").read_text()
