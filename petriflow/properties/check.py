@@ -49,7 +49,10 @@ from petriflow.net import Net
 from petriflow.properties.bounds import invariant_bound, reached_bound
 from petriflow.properties.ctl import ctl_witness, evaluate
 from petriflow.properties.kripke import Kripke
-from petriflow.properties.language import AllPaths, ExistsPath, Finally, Globally, Not, Property, names_used
+from petriflow.analysis.stubborn import stubborn_deadlocks
+from petriflow.properties.language import (
+    AllPaths, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Property, names_used
+)
 from petriflow.properties.ltl import check_ltl
 from petriflow.properties.yaml_props import check_property_names
 from petriflow.workflow import workflow_structure
@@ -100,6 +103,8 @@ def check_properties(net: Net, properties: Sequence[Property], *,
         elif kripke is None:
             if prop.kind == "reachability" and partial is not None:
                 _partial_reachability(entry, prop, partial)
+            if entry["verdict"] is None and prop.kind == "reachability":
+                _deadlock_by_stubborn_sets(entry, prop, net, start, max_states)
         else:
             _decide(entry, prop, kripke, cache)
         if entry["verdict"] is None and "reason" not in entry:
@@ -174,9 +179,27 @@ def _partial_reachability(entry: dict, prop: Property, partial: StateSpace) -> N
         return
     holds = Kripke(partial).holds(predicate)
     bad = np.flatnonzero(~holds if universal else holds)
+    if partial.expanded is not None and any(isinstance(n, (Fireable, Deadlock)) for n in predicate.walk()):
+        # what a state enables is known only once it is expanded (the others look dead)
+        bad = bad[bad < partial.expanded]
     if bad.size:
         entry.update(verdict=not universal, witness=partial.path(int(bad[0])),
                      method="reachability graph (stopped at the limit; the witness is reachable)")
+
+
+def _deadlock_by_stubborn_sets(entry: dict, prop: Property, net: Net, start, max_states: int) -> None:
+    """``EF deadlock`` / ``AG !deadlock`` beyond the full state space: a stubborn-set
+    search preserves every reachable deadlock (:mod:`petriflow.analysis.stubborn`)."""
+    universal, predicate = _reachability_shape(prop.formula)
+    wanted = Not(Deadlock()) if universal else Deadlock()
+    if universal is None or predicate != wanted:
+        return
+    try:
+        found = stubborn_deadlocks(net, start, max_states=max_states, first=True)
+    except StateSpaceLimit:
+        return
+    entry.update(verdict=found.deadlock != bool(universal), witness=found.witness,
+                 method="stubborn sets (every reachable deadlock preserved)")
 
 
 def _bound(entry: dict, prop: Property, space: StateSpace | None, proved: int | None,

@@ -142,3 +142,15 @@ def test_cli_check_properties(tmp_path, capsys):
     extra.write_text("properties:\n  - {id: fair, ltl: 'G F red_in == '}\n")
     assert main(["check", str(path), "--properties", str(extra)]) == 2
     assert "more.yaml:2:" in capsys.readouterr().err
+
+
+def test_deadlock_reachability_beyond_the_budget_by_stubborn_sets():
+    """Over --max-states, EF deadlock is still decided: stubborn sets keep every deadlock."""
+    from petriflow.classic import dining_philosophers
+
+    net = dining_philosophers(12)
+    got = decide(net, {"id": "stuck", "reachable": "deadlock"}, {"id": "free", "never": "deadlock"},
+                 {"id": "other", "reachable": "eat_0 == 1"}, max_states=20)
+    assert (got["stuck"]["verdict"], got["free"]["verdict"]) == (False, True)
+    assert got["stuck"]["method"].startswith("stubborn sets")
+    assert got["other"]["verdict"] is True       # found before the limit
