@@ -5,7 +5,8 @@ between (a run with no world jumps straight there). :class:`SimulatedClock` does
 that; :class:`RealtimeClock` also sleeps so that simulated time never runs ahead of
 the wall clock, as SimPy's ``RealtimeEnvironment`` does. A run takes its clock when it
 is made (``Scheduler(..., clock=RealtimeClock())``); nothing else in the run knows
-which one it has.
+which one it has. A clock made with a stopwatch (:mod:`~petriflow.runtime.stopwatch`)
+reports each world step to it as ``physics``.
 
 Examples:
     >>> from petriflow.runtime.kernel import Kernel
@@ -21,6 +22,7 @@ import time as wallclock
 from typing import Any, Protocol
 
 from petriflow.runtime.kernel import Kernel
+from petriflow.runtime.stopwatch import Timing
 
 __all__ = ["Clock", "SimulatedClock", "RealtimeClock"]
 
@@ -36,7 +38,14 @@ class Clock(Protocol):
 
 
 class SimulatedClock:
-    """As fast as the machine goes: simulated time is decoupled from the wall clock."""
+    """As fast as the machine goes: simulated time is decoupled from the wall clock.
+
+    Args:
+        stopwatch: where each world step's wall-clock time goes (``physics``).
+    """
+
+    def __init__(self, stopwatch: Timing | None = None) -> None:
+        self.stopwatch = stopwatch
 
     def start(self) -> None:
         pass
@@ -45,8 +54,13 @@ class SimulatedClock:
         if world is None:
             kernel.tick = max(kernel.tick, tick)
             return
+        stopwatch = self.stopwatch
         while kernel.tick < tick:
-            world.step()
+            if stopwatch is None:
+                world.step()
+            else:
+                with stopwatch.measure("physics"):
+                    world.step()
             kernel.tick += 1
 
 
@@ -54,15 +68,19 @@ class RealtimeClock:
     """Paced: after each tick, wait until the wall clock has caught up with simulated
     time (a run that is slower than real time just runs behind)."""
 
-    def __init__(self) -> None:
+    def __init__(self, stopwatch: Timing | None = None) -> None:
         self._start = wallclock.perf_counter()
+        self.stopwatch = stopwatch
 
     def start(self) -> None:
         self._start = wallclock.perf_counter()
 
     def advance(self, kernel: Kernel, world: Any, tick: int) -> None:
         while kernel.tick < tick:
-            if world is not None:
+            if world is not None and self.stopwatch is not None:
+                with self.stopwatch.measure("physics"):
+                    world.step()
+            elif world is not None:
                 world.step()
             kernel.tick += 1
             ahead = kernel.now - (wallclock.perf_counter() - self._start)

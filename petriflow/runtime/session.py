@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import time as wallclock
 import warnings
+from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -57,6 +58,7 @@ from petriflow.runtime.observers import Progress, run_observed
 from petriflow.runtime.outputs import check_outputs, make_folders
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.result import RunResult
+from petriflow.runtime.stopwatch import Timing
 from petriflow.runtime.summary import RunExtras, extras_for
 from petriflow.runtime.trace import read_trace
 from petriflow.runtime.validation import UNKNOWN, CheckedRun, check_run, validate
@@ -113,7 +115,16 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
         run_config.import_actions()
     pending = [] if import_actions else run_config.unimported_actions()
     try:
-        binding = bind(net, registry, path=str(files.path), unimported=pending)
+        if run_config.bridge is not None:  # remote subnets: checked against their agents when the run connects
+            from petriflow.bridge.remote import bind_remote
+            from petriflow.runtime.registry import default_registry
+
+            run_config.check(net)  # the subnets it names, at the configuration's line
+            binding = bind_remote(net, run_config.bridge, registry or default_registry,
+                                  lambda local: bind(local, registry, path=str(files.path), unimported=pending),
+                                  str(files.path))
+        else:
+            binding = bind(net, registry, path=str(files.path), unimported=pending)
     except NetFormatError as exc:
         raise run_config.blame(exc) from None
     run_config.check(net)
@@ -122,11 +133,25 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
 
 def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | None, trace: Path | None,
              xes: Path | None, realtime: bool, gui: bool, progress: bool | float, max_firings: int | None,
-             keep_events: bool = False, extras: RunExtras | None = None) -> RunResult:
-    """Put the checked run together and run it with its observers (step 3 and 4)."""
+             keep_events: bool = False, extras: RunExtras | None = None,
+             stopwatch: Timing | None = None, wait_agents: float | None = None) -> RunResult:
+    """Put the checked run together and run it with its observers (step 3 and 4); a
+    configuration with a ``bridge:`` connects to its remote agents first
+    (:mod:`petriflow.bridge.orchestrator`; ``wait_agents``: seconds to wait for them)."""
     extras = extras or RunExtras()
     keep = keep_events or extras.needs_events()
-    with open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime) as scheduler:
+    with ExitStack() as stack:
+        remote, clock, watch = None, None, None
+        spec = checked.config.bridge
+        if spec is not None:  # remote agents: connected and checked first, then in wall-clock time
+            from petriflow.bridge.orchestrator import connect_run
+
+            remote, clock, watch = connect_run(stack, checked, run=inputs.get("bridge_run"), wait=wait_agents,
+                                               journal=journal)
+        scheduler = stack.enter_context(open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime,
+                                                 clock=clock, remote=remote, stopwatch=stopwatch))
+        if remote is not None:
+            scheduler.on_instant(watch)
         if inputs.get("poses"):  # the world's body poses as trace events (petriflow.runtime.poses)
             from petriflow.runtime.poses import PoseSampler
 
@@ -138,6 +163,10 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
                               until=inputs["until"], max_firings=max_firings)
         result.cpu = wallclock.process_time() - cpu
         extras.finish(scheduler, result, checked.config)
+        if remote is not None:  # what the bridge dropped, by reason (docs/bridge.md)
+            dropped = getattr(remote, "dispatcher", remote).dropped
+            result.metrics["bridge.dropped"] = sum(dropped.values())
+            result.metrics.update({f"bridge.dropped.{why}": count for why, count in sorted(dropped.items())})
     if not keep_events:
         result.events = []
     if journal is not None:
@@ -176,6 +205,7 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
               gui: bool = False, registry: Registry | None = None, progress: bool | float = False,
               max_firings: int | None = None, keep_events: bool = False, metrics: list[str] | None = None,
               picture: str | Path | None = None, poses: float | None = None,
+              stopwatch: Timing | None = None, wait_agents: float | None = None,
               monitor: bool = False) -> RunResult:
     """Run the net in ``net_path`` (what ``petriflow run`` does).
 
@@ -188,6 +218,10 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     robots' trajectories at the end (see :mod:`petriflow.runtime.summary`). ``poses``:
     record the world's body poses as ``pose`` events every so many simulated seconds
     (:mod:`petriflow.runtime.poses`; what ``petriflow view`` draws the world from).
+    ``stopwatch``: where the run's wall-clock time goes, by category (the world's
+    steps as ``physics``, what the actions measure: :mod:`petriflow.runtime.stopwatch`).
+    ``wait_agents``: seconds to wait for a bridged run's remote agents (default: the
+    configuration's ``bridge: wait``).
     ``monitor``: watch the net's properties during the run
     (:mod:`petriflow.properties.monitor`) into ``result.properties``; a violation is
     also a ``custom`` event ``property_violated`` in the trace.
@@ -202,6 +236,10 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     _warn_unbound(checked.net, net_path)
     inputs = journal_inputs(files, seed=seed, until=until)
     inputs["max_firings"] = max_firings
+    if files.config.bridge is not None:  # the run's name in its goal ids: a resume re-attaches by it
+        from petriflow.bridge.orchestrator import new_run_name
+
+        inputs["bridge_run"] = new_run_name()
     if poses is not None:  # journaled, so a resumed run samples them too
         inputs["poses"] = _pose_interval(poses)
     inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())
@@ -226,7 +264,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     try:
         return _execute(checked, inputs, journal=journal, trace=None if trace is None else Path(trace),
                         xes=None if xes is None else Path(xes), realtime=realtime, gui=gui, progress=progress,
-                        max_firings=max_firings, keep_events=keep_events, extras=extras)
+                        max_firings=max_firings, keep_events=keep_events, extras=extras, stopwatch=stopwatch,
+                        wait_agents=wait_agents)
     except BaseException:
         if journal is not None and journal.journaled == 0:  # it never started: leave no journal behind
             journal.close()
