@@ -223,6 +223,23 @@ def _size(text: str | None) -> tuple[float, float] | None:
     return width, height
 
 
+def _property_violations(net) -> list[dict[str, Any]]:
+    """The net's own properties that fail, as violations with their witness sequence (a
+    lasso's cycle is left out: the drawing shows where it starts)."""
+    if not net.properties:
+        return []
+    from petriflow.engine import fire_sequence
+    from petriflow.properties.check import check_properties
+
+    found = []
+    for result in check_properties(net, net.properties):
+        if result["verdict"] is False and result.get("witness") is not None:
+            reached = fire_sequence(net, net.initial_marking, result["witness"])
+            found.append({"transitions": result["witness"], "marking": reached.to_dict(),
+                          "message": f"property {result['id']} fails: {result['formula']}"})
+    return [v for v in found if v["transitions"]]
+
+
 def cmd_export(args: argparse.Namespace) -> int:
     from petriflow.export import export_net, format_of
 
@@ -243,7 +260,8 @@ def cmd_export(args: argparse.Namespace) -> int:
     if args.violation:
         from petriflow.analysis.report import check_net
 
-        violations = [v for v in check_net(net)["violations"] if v.get("transitions")]
+        violations = _property_violations(net)   # what the net states it guarantees comes first
+        violations += [v for v in check_net(net)["violations"] if v.get("transitions")]
         if not violations:
             print(f"petriflow: {args.net}: the analysis found no violation with a witness; nothing drawn",
                   file=sys.stderr)
@@ -315,7 +333,8 @@ def cmd_run(args: argparse.Namespace) -> int:
                                 until=args.until, trace=args.trace, xes=args.xes, db=args.db, poses=args.poses,
                                 realtime=args.realtime, gui=args.gui, progress=_progress(args),
                                 max_firings=args.max_firings, metrics=_metric_names(args.metrics),
-                                picture=args.picture, wait_agents=args.wait_agents)
+                                picture=args.picture, wait_agents=args.wait_agents,
+                                monitor=args.monitor)
     except BaseException:
         if made_up_trace is not None:  # the page's made-up trace, in a folder of its own
             shutil.rmtree(made_up_trace.parent, ignore_errors=True)
@@ -326,6 +345,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     final = final_marking_of(outcome.net)  # declared, else a WF-net's sink: the rule check uses
     problem = result.reason in ("failed", "stalled") or (final is not None and result.reason != "final")
+    problem = problem or any(p["verdict"] is False for p in outcome.properties)
     summary = {
         "net": outcome.net.id,
         "reason": result.reason,
@@ -341,6 +361,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         "metrics": outcome.metrics,
         "written": outcome.written,
     }
+    if args.monitor:
+        summary["properties"] = outcome.properties
     if args.json:
         _print_json(summary)
     else:
@@ -355,9 +377,26 @@ def cmd_run(args: argparse.Namespace) -> int:
         if result.error:
             print(f"  error: {result.error}")
         _print_metrics(outcome.metrics)
+        _print_monitored(outcome.properties)
         for path in outcome.written:
             print(f"  wrote {path}")
     return EXIT_PROBLEM if problem else EXIT_OK
+
+
+def _print_monitored(results: list[dict[str, Any]]) -> None:
+    """``run --monitor``: one line per property, a violation with its event."""
+    for entry in results:
+        verdict = entry["verdict"]
+        text = "undecided" if verdict is None else ("holds" if verdict is True else "violated"
+                                                     if verdict is False else str(verdict))
+        line = f"  property {entry['id']}: {text}"
+        where = entry.get("violation")
+        if where:
+            line += (f" at event {where['seq']} (t = {where['time']:g} s, {where['kind']}"
+                     f"{' ' + where['transition'] if where['transition'] else ''})")
+        elif entry.get("reason"):
+            line += f" ({entry['reason']})"
+        print(line)
 
 
 def _metric_names(given: str | None) -> list[str] | None:
@@ -430,6 +469,8 @@ def cmd_check(args: argparse.Namespace) -> int:
         if value is not None and value < 0:
             raise PetriflowError(f"{option} must be >= 0, got {value}")
     net, _ = _load_bound(args.net, args.import_actions)
+    if args.properties is not None:
+        return _check_properties(args, net)
     result = check_net(
         net, max_states=args.max_states or DEFAULT_MAX_STATES,
         max_coverability=DEFAULT_MAX_COVERABILITY if args.max_coverability is None else args.max_coverability,
@@ -444,6 +485,28 @@ def cmd_check(args: argparse.Namespace) -> int:
         # soundness decided by another method) is an answer, the limit a note in the report
         print(f"petriflow: {args.net}: {result['error']}", file=sys.stderr)
     return code
+
+
+def _check_properties(args: argparse.Namespace, net) -> int:
+    """``check --properties [FILE]``: the file's properties, or the net's own."""
+    from petriflow.analysis.reachability import DEFAULT_MAX_STATES
+    from petriflow.properties.check import check_properties
+    from petriflow.properties.report import format_properties, properties_exit_code
+    from petriflow.properties.yaml_props import load_properties
+
+    if args.properties:
+        properties = load_properties(args.properties)
+    else:
+        properties = net.properties
+        if not properties:
+            raise PetriflowError(f"{args.net}: the net declares no properties (a 'properties:' list);"
+                                 " name a properties file: --properties FILE")
+    results = check_properties(net, properties, max_states=args.max_states or DEFAULT_MAX_STATES)
+    if args.json:
+        _print_json({"net": net.id, "properties": results})
+    else:
+        print(format_properties(results))
+    return properties_exit_code(results)
 
 
 # Parser ------------------------------------------------------------------------------
@@ -534,6 +597,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--metrics", metavar="NAMES",
                      help="report these registered metrics at the end (comma-separated; 'none': no metric)"
                           " instead of the ones the run configuration names")
+    run.add_argument("--monitor", action="store_true",
+                     help="watch the net's properties during the run (docs/analysis.md, 'Properties'):"
+                     " safety on every marking, LTL on the finite trace; a violation is reported with its"
+                     " event, marked in the trace, and makes the exit code 1")
     run.add_argument("--picture", metavar="OUT.png",
                      help="draw the world's top view with the robots' trajectories (.png, .svg or .pdf)")
     run.add_argument("--quiet", action="store_true", help="no progress on standard error")
@@ -561,6 +628,11 @@ def build_parser() -> argparse.ArgumentParser:
         cmd_check)
     check.add_argument("--json", action="store_true", help="print JSON")
     check.add_argument("--import-actions", action="store_true", help=import_help)
+    check.add_argument("--properties", nargs="?", const="", default=None, metavar="FILE",
+                       help="decide properties instead (docs/analysis.md, 'Properties'): those of"
+                       " FILE (a YAML 'properties:' list or a Model Checking Contest XML file), or"
+                       " without FILE the net's own; exit 1 when one is false, 2 when one is"
+                       " undecided")
     check.add_argument("--max-states", type=limits.integer_argument, default=None, metavar="N",
                        help="most markings to explore (default 2,000,000); beyond it the facts"
                        " found so far, and exit 2 (1 when one of them fails)")

@@ -182,6 +182,10 @@ class Net:
         #: The run configuration the net names (``run:`` in YAML): a file name relative
         #: to the net's file, or the configuration itself as a mapping; ``None``: none.
         self.run: str | dict[str, Any] | None = None
+        #: What the net must guarantee (``properties:`` in YAML): a list of
+        #: :class:`~petriflow.properties.language.Property`, checked by
+        #: ``petriflow check --properties`` and watched by ``petriflow run --monitor``.
+        self.properties: list[Any] = []
         #: The file the net was read from, if any (errors name it).
         self.path: str | None = None
         #: Where the reader found each element: ``{id: line}``, and ``"id/key"`` (e.g.
@@ -491,6 +495,7 @@ class Net:
         other.final_marking = self.final_marking
         other.meta = dict(self.meta)
         other.run = self.run
+        other.properties = list(self.properties)
         other.path = self.path
         other.lines = dict(self.lines)
         return other

@@ -121,6 +121,7 @@ class NetBuilder:
         self._begin_out: dict[str, int] = {}  # what begin hands out: {place: weight}
         self._end_in: dict[str, int] = {}  # what end collects
         self._envelope: tuple[str, str, str, str] | None = None  # (source, begin, end, sink)
+        self._properties: list[dict[str, Any]] = []  # properties: entries, read when built
 
     # Elements -----------------------------------------------------------------------
     @property
@@ -352,9 +353,56 @@ class NetBuilder:
         self._net.add_transition(end, label=end_label)
         self._envelope = ids
 
+    def require(self, entry: dict[str, Any]) -> None:
+        """State a property the net must guarantee: a ``properties:`` entry
+        (:mod:`petriflow.properties.yaml_props`, docs/analysis.md "Properties"), read and
+        its names checked when the net is built.
+
+        Examples:
+            >>> b = NetBuilder("n")
+            >>> a = b.agent("a")
+            >>> a.place("idle", tokens=1)
+            'a_idle'
+            >>> b.require({"id": "idle", "always": "a_idle == 1"})
+            >>> [p.id for p in b.build().properties]
+            ['idle']
+        """
+        if not isinstance(entry, dict) or not isinstance(entry.get("id"), str):
+            raise NetStructureError(f"a property is a mapping with an 'id', got {entry!r}")
+        if any(p["id"] == entry["id"] for p in self._properties):
+            raise NetStructureError(f"duplicate property id {entry['id']!r}")
+        self._properties.append(dict(entry))
+
+    def require_delivery(self) -> None:
+        """State what every mailbox net must guarantee (call it once every mailbox and the
+        envelope exist):
+
+        * ``messages_delivered``: from every reachable marking where a message waits in
+          a mailbox, a marking where that mailbox is empty can still be reached
+          (``AG(box >= 1 -> EF box == 0)``, for each mailbox): no message is stranded;
+        * ``mailboxes_within_capacity``: no mailbox ever holds more messages than its
+          capacity (mailboxes of a whole-number capacity);
+        * ``mission_can_end`` (with an envelope): from every reachable marking the sink
+          can still be marked (``AG EF sink == 1``).
+        """
+        boxes = list(self._mailboxes.values())
+        if boxes:
+            conditions = " && ".join(f"({box.id} >= 1 -> EF {box.id} == 0)" for box in boxes)
+            self.require({"id": "messages_delivered", "ctl": f"AG({conditions})",
+                          "description": "every message waiting in a mailbox can still be taken"})
+            bounded = [box for box in boxes if isinstance(box.capacity, int)]
+            if bounded:
+                self.require({"id": "mailboxes_within_capacity",
+                              "always": " && ".join(f"{box.id} <= {box.capacity}" for box in bounded),
+                              "description": "no mailbox holds more messages than its capacity"})
+        if self._envelope is not None:
+            self.require({"id": "mission_can_end", "ctl": f"AG EF {self._envelope[3]} == 1",
+                          "description": "from every reachable marking the mission can still end"})
+
     def build(self) -> Net:
         """The net as it stands: a new :class:`~petriflow.net.Net`, checked
-        (:meth:`~petriflow.net.Net.check_references`).
+        (:meth:`~petriflow.net.Net.check_references`), with the properties it was told
+        to guarantee (:meth:`require`).
 
         With an envelope, its arcs and final marking are added. Without one, the start
         places and resources are marked in the initial marking instead (as if ``begin``
@@ -379,6 +427,11 @@ class NetBuilder:
             net.add_arc(end, sink)
             net.set_final_marking({sink: 1})
         net.check_references()
+        if self._properties:
+            from petriflow.properties.yaml_props import check_property_names, parse_properties
+
+            net.properties = parse_properties(self._properties)
+            check_property_names(net, net.properties)
         return net
 
     # Internals ----------------------------------------------------------------------

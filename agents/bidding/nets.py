@@ -226,6 +226,7 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
         ], [boxes[name] for name in ["hmia"] + team if name != ra.name], wait,
             [boxes[name] for name in team if name != ra.name] if casts and robots > 2 else None)
     b.envelope(begin_label="REQUEST from the operator", end_label="mission over")
+    b.require_delivery()  # every CFP, PROPOSE, MAP and END can still be received; the mission can end
     return b.build()
 
 

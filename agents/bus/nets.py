@@ -207,6 +207,13 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
     if algorithm == 2:
         b.transition(f"drain_{last}", label="a frame for nobody leaves the bus", action="bus.drain",
                      params={"box": void[0]}, inputs=[void[0]], outputs=[void[1]])
+    boxes = [box for module in chained for _, box, _ in module.inboxes]
+    b.require({"id": "one_frame_per_mailbox", "description": "a module's mailbox holds one frame at a time",
+               "always": " && ".join(f"{box} <= 1" for box in boxes)})
+    b.require({"id": "every_frame_read", "description": "every frame waiting in a mailbox can still be read",
+               "ctl": "AG(" + " && ".join(f"({box} >= 1 -> EF {box} == 0)" for box in boxes) + ")"})
+    b.require({"id": "bus_can_finish", "description": "from every reachable marking every module can still"
+               " finish", "ctl": "AG EF o == 1"})
     net = b.build()
     net.set_final_marking({"o": 1})
     return net

@@ -164,6 +164,7 @@ def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *
         a.start("start")
         a.done("done", "listen")
     b.envelope(begin_label="start-up", end_label="every agent holds the map")
+    b.require_delivery()  # every map message can still be received; the mission can end
     return b.build()
 
 

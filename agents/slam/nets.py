@@ -199,6 +199,7 @@ def build(mode: str = "decentralised", robots: int = 1, reserves: int = 1, was: 
                         inputs=[here, f"{name}_hopper_{k}"], outputs=[following])
     b.transition("discard", label="a frame nobody takes", priority=-10, inputs=[air.id], outputs=[air.slot])
     b.envelope(begin_label="the mission starts", end_label="the map is done, every agent stopped")
+    b.require_delivery()  # one frame on the air at a time, every alert received, the map can be completed
     return b.build()
 
 

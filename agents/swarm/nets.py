@@ -133,6 +133,9 @@ def build(robots: int = 3, *, cells_per_robot: float = 8.0, cell: float = 1.0, r
         a.start("start")
         a.done("done")
     b.envelope(begin_label="deploy", end_label="every robot home")
+    b.require({"id": "one_frame_per_radio", "description": "a robot's radio carries one frame at a time",
+               "always": " && ".join(f"robot{k}_air <= 1" for k in range(1, robots + 1))})
+    b.require_delivery()  # the mission can end from every reachable marking
     return b.build()
 
 

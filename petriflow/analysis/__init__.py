@@ -19,6 +19,9 @@ One concept per module:
   by the explicit state space (:mod:`~petriflow.analysis.explicit`) or a reduction
   (:mod:`~petriflow.analysis.methods`: which of them answers what), each filling the
   result of :mod:`~petriflow.analysis.check_result`;
+* graph algorithms on compressed-row arrays (:func:`csr`, :func:`transpose`,
+  :func:`components`, :func:`reachable`, :func:`reaching`), which
+  :mod:`petriflow.properties` runs on state spaces and their products with automata;
 * :mod:`~petriflow.analysis.verdict` — the exit code of a check; and
   :mod:`~petriflow.analysis.report` — its text.
 
@@ -63,6 +66,7 @@ from petriflow.analysis.reachability import (
     reachability_graph,
     to_networkx,
 )
+from petriflow.analysis._graph import components, csr, reachable, reaching, transpose
 from petriflow.analysis.check import check_net
 from petriflow.analysis.report import format_report
 from petriflow.analysis.soundness import (
@@ -79,9 +83,9 @@ __all__ = [
     "DEFAULT_MAX_COVERABILITY", "DEFAULT_MAX_STATES", "OMEGA", "CoverabilityGraph",
     "CoverabilitySearch", "InvariantLimit", "SoundnessReport",
     "StateSpace", "StateSpaceLimit", "UnboundedNetError", "Violation", "WorkflowStructure",
-    "check_net", "check_soundness", "coverability_graph", "coverability_search", "dead_transitions",
+    "check_net", "check_soundness", "components", "csr", "coverability_graph", "coverability_search", "dead_transitions",
     "deadlock_witness", "deadlocks", "exit_code", "format_report", "is_covered_by_p_semiflows",
     "is_free_choice", "is_live", "is_reversible", "is_safe", "non_live_transitions",
-    "p_semiflows", "place_bounds", "reachability_graph", "structural_bounds", "t_semiflows",
-    "to_networkx", "unbounded_places", "workflow_structure",
+    "p_semiflows", "place_bounds", "reachability_graph", "reachable", "reaching", "structural_bounds", "t_semiflows",
+    "to_networkx", "transpose", "unbounded_places", "workflow_structure",
 ]

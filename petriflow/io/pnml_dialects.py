@@ -468,6 +468,12 @@ def read_petriflow(reading: Reading, tool: Element, kind: str, node: str | None,
                              item, node)
             found["run"] = run
             found["run_line"] = line_of(item)
+        elif name == "properties" and kind == "net":
+            try:
+                found["properties"] = parse_json(text)
+            except ValueError as exc:
+                reading.fail(f"petriflow properties: {exc}", item, node)
+            found["properties_line"] = line_of(item)
         elif name == "priority" and kind == "transition":
             found["priority"] = reading.integer(text, "priority", item, node)
         elif name == "operator" and kind == "transition":

@@ -292,6 +292,10 @@ class _Reader:
         if "run" in data:
             self.net.run = data["run"]
             self.net.lines["run"] = data["run_line"]
+        if "properties" in data:   # what the net must guarantee (petriflow.properties)
+            from petriflow.properties.yaml_props import parse_properties
+
+            self.net.properties = parse_properties(data["properties"], None, data["properties_line"])
         read_data_variables(self, net_element)
 
     # Nodes --------------------------------------------------------------------------

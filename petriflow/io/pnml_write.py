@@ -119,6 +119,10 @@ class _Writer:
             if run is None:
                 raise NetFormatError("the run configuration cannot be written as JSON", element=net.id)
             _sub(tool, "run", run)
+        if net.properties:
+            from petriflow.properties.yaml_props import property_entry
+
+            _sub(tool, "properties", _json_exact([property_entry(p) for p in net.properties]))
         if len(tool):
             net_element.append(tool)
         page = _sub(net_element, "page", id=self.fresh_id("page"))

@@ -48,7 +48,8 @@ _yaml_problem = yaml_problem
 #: The version of the YAML format this module reads and writes.
 FORMAT_VERSION = 1
 
-_TOP_KEYS = {"petriflow", "net", "label", "subnets", "places", "transitions", "arcs", "final", "meta", "run"}
+_TOP_KEYS = {"petriflow", "net", "label", "subnets", "places", "transitions", "arcs", "final", "meta", "run",
+             "properties"}
 _SUBNET_KEYS = {"id", "label", "agent", "state", "places", "transitions"}
 _PLACE_KEYS = {"id", "label", "tokens", "channel", "meta"}
 _TRANSITION_KEYS = {
@@ -124,6 +125,14 @@ class _Reader:
         if data.get("final") is not None:
             final = data["final"]
             self.net.set_final_marking(self.read_marking(final, "final marking"))
+        if data.get("properties") is not None:
+            # what the mission must guarantee (petriflow.properties): read and checked
+            # against the net's names now, so that a typo fails at load time
+            from petriflow.properties.yaml_props import check_property_names, parse_properties
+
+            self.net.properties = parse_properties(data["properties"], None,
+                                                   data.key_lines.get("properties", data.line))
+            check_property_names(self.net, self.net.properties)
         return self.net
 
     def as_list(self, value: Any, what: str, parent: Any) -> list:
@@ -613,6 +622,10 @@ def net_to_dict(net: Net) -> dict[str, Any]:
         data["meta"] = net.meta
     if net.run is not None:
         data["run"] = net.run
+    if net.properties:
+        from petriflow.properties.yaml_props import property_entry
+
+        data["properties"] = [property_entry(p) for p in net.properties]
     return data
 
 

@@ -62,6 +62,8 @@ class RunResult:
         metrics: the metrics the run configuration (or ``metrics=``) asked for, by name.
         cpu: CPU seconds of the run itself (``time.process_time``), ``None`` when not
             measured.
+        properties: with ``monitor=True``, the net's properties as the run kept them
+            (:meth:`~petriflow.properties.monitor.PropertyMonitor.results`).
     """
 
     reason: StopReason
@@ -78,6 +80,7 @@ class RunResult:
     seed: int | None = None
     metrics: dict[str, Any] = field(default_factory=dict)
     cpu: float | None = None
+    properties: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def realtime_factor(self) -> float:

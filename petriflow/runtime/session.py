@@ -205,7 +205,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
               gui: bool = False, registry: Registry | None = None, progress: bool | float = False,
               max_firings: int | None = None, keep_events: bool = False, metrics: list[str] | None = None,
               picture: str | Path | None = None, poses: float | None = None,
-              stopwatch: Timing | None = None, wait_agents: float | None = None) -> RunResult:
+              stopwatch: Timing | None = None, wait_agents: float | None = None,
+              monitor: bool = False) -> RunResult:
     """Run the net in ``net_path`` (what ``petriflow run`` does).
 
     The run configuration is ``config``, else the one the net names, else
@@ -221,6 +222,9 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     steps as ``physics``, what the actions measure: :mod:`petriflow.runtime.stopwatch`).
     ``wait_agents``: seconds to wait for a bridged run's remote agents (default: the
     configuration's ``bridge: wait``).
+    ``monitor``: watch the net's properties during the run
+    (:mod:`petriflow.properties.monitor`) into ``result.properties``; a violation is
+    also a ``custom`` event ``property_violated`` in the trace.
 
     Raises:
         NetFormatError: a file is missing or malformed, an action is unknown...
@@ -241,6 +245,13 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())
                          for name, path in (("trace", trace), ("xes", xes))}
     extras = extras_for(files.config, metrics=metrics, picture=picture, registry=checked.binding.registry)
+    if monitor:
+        from petriflow.properties.monitor import PropertyMonitor
+
+        if not checked.net.properties:
+            raise NetFormatError("--monitor watches the net's properties, and it declares none (a"
+                                 " 'properties:' list)", path=str(net_path))
+        extras.monitor = PropertyMonitor(checked.net, checked.net.properties)
     if picture is not None and files.world is None:
         raise NetFormatError("--picture draws the run's world, and this run has none (give --world, or a run"
                              " configuration with world:)", path=str(net_path))

@@ -35,6 +35,8 @@ class RunExtras:
     metrics: list[tuple[MetricRef, Any]] = field(default_factory=list)
     picture: Path | None = None
     track: Trajectories | None = None
+    #: A :class:`~petriflow.properties.monitor.PropertyMonitor` watching the run, or None.
+    monitor: Any = None
 
     def needs_events(self) -> bool:
         """Whether a metric reads the run's events (then the run keeps them)."""
@@ -51,10 +53,14 @@ class RunExtras:
         if self.picture is not None and scheduler.world is not None:
             self.track = Trajectories()
             scheduler.on_instant(self.track)
+        if self.monitor is not None:
+            self.monitor.attach(scheduler)
 
     def finish(self, scheduler: Any, outcome: Any, config: Any) -> None:
         """Compute the metrics into ``outcome.metrics`` and draw the picture (its file
-        goes into ``outcome.written``)."""
+        goes into ``outcome.written``); the monitored properties into ``outcome.properties``."""
+        if self.monitor is not None:
+            outcome.properties = self.monitor.results()
         if self.metrics:
             record = RunRecord(outcome.result, outcome.events, scheduler.world, config, {}, outcome.seed,
                                outcome.wall, scheduler, outcome.cpu)

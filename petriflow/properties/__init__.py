@@ -1,0 +1,1 @@
+"""Properties of nets: CTL, LTL, reachability and bounds, checked and watched at run time."""

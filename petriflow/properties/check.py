@@ -1,0 +1,226 @@
+"""``petriflow check --properties``: decide each property of a net, with its evidence.
+
+:func:`check_properties` explores the reachability graph once (within ``max_states``)
+and decides every property on it:
+
+* **reachability** (``EF p``, ``AG p``, a state predicate alone): the states are
+  numbered breadth first, so the first state satisfying ``p`` (or violating it) gives
+  a shortest firing sequence as witness (counterexample);
+* **bound** (the places' token total): P-semiflows first
+  (:func:`~petriflow.properties.bounds.invariant_bound`), the explored markings second;
+  the witness reaches a marking with the bound; with ``at_most`` the verdict is whether
+  the bound stays within it;
+* **ctl**: fixpoints (:mod:`~petriflow.properties.ctl`);
+* **ltl**: Spot's Büchi automaton times the graph (:mod:`~petriflow.properties.ltl`).
+
+Each result is ``{"id", "formula", "kind", "verdict", "method", "witness"}`` and, for a
+lasso, ``"cycle"`` (the firings repeated forever; empty: the last marking is a deadlock,
+which repeats); ``verdict`` is ``true``/``false``, the bound (an integer), or ``null``
+with a ``"reason"`` (state space over budget, unbounded net, a formula outside CTL and
+LTL). A verdict is never guessed: a partial state space (the markings found before the
+limit; for an unbounded net, the first :data:`UNBOUNDED_STATES`) decides only what a
+state found in it proves (a reachable witness, a reached value meeting the invariant
+bound or exceeding ``at_most``).
+
+Examples:
+    >>> from petriflow.classic import producer_consumer
+    >>> from petriflow.properties.yaml_props import parse_property
+    >>> net = producer_consumer(2)
+    >>> [r["verdict"] for r in check_properties(net, [
+    ...     parse_property({"id": "full", "reachable": "buffer == 2"}),
+    ...     parse_property({"id": "cap", "bound": "buffer"})])]
+    [True, 2]
+    >>> check_properties(net, [parse_property({"id": "fills", "eventually": "buffer == 2"})])[0]["cycle"]
+    ['produce', 'put', 'take', 'consume']
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from petriflow.analysis.check_result import explored_marking
+from petriflow.analysis.exploration import DEFAULT_MAX_STATES, StateSpaceLimit, UnboundedNetError
+from petriflow.analysis.invariants import InvariantLimit, p_semiflows
+from petriflow.analysis.reachability import StateSpace, reachability_graph
+from petriflow.net import Net
+from petriflow.properties.bounds import invariant_bound, reached_bound
+from petriflow.properties.ctl import ctl_witness, evaluate
+from petriflow.properties.kripke import Kripke
+from petriflow.analysis.stubborn import stubborn_deadlocks
+from petriflow.properties.language import (
+    AllPaths, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Property, names_used
+)
+from petriflow.properties.ltl import check_ltl
+from petriflow.properties.yaml_props import check_property_names
+from petriflow.workflow import workflow_structure
+
+__all__ = ["check_properties"]
+
+
+def check_properties(net: Net, properties: Sequence[Property], *,
+                     max_states: int = DEFAULT_MAX_STATES) -> list[dict[str, Any]]:
+    """Decide every property of ``net`` (see the module documentation for the entries).
+
+    Raises:
+        NetFormatError: a property names a place or transition the net lacks (its file
+            and line).
+    """
+    check_property_names(net, properties)
+    start = explored_marking(net, workflow_structure(net))
+    space: StateSpace | None = None
+    reason = None
+    partial: StateSpace | None = None
+    try:
+        space = reachability_graph(net, start, max_states=max_states)
+    except StateSpaceLimit as exc:
+        reason = f"state space over budget: more than {max_states} states (--max-states)"
+        partial = exc.partial if isinstance(exc.partial, StateSpace) else None
+    except UnboundedNetError as exc:
+        reason = f"unbounded net: firing {' '.join(exc.pump)} repeats forever, adding tokens to" \
+                 f" {', '.join(exc.places)}"
+        partial = _explored_part(net, start, min(max_states, UNBOUNDED_STATES))
+    kripke = Kripke(space) if space is not None else None
+    cache: dict = {}
+    semiflows: list | None = None
+    results = []
+    for prop in properties:
+        entry: dict[str, Any] = {"id": prop.id, "kind": prop.kind,
+                                 "formula": _describe(prop), "verdict": None, "method": None,
+                                 "witness": None}
+        if prop.formula is None:
+            if semiflows is None:
+                try:
+                    semiflows = p_semiflows(net)
+                except InvariantLimit:
+                    semiflows = []
+            _bound(entry, prop, space or partial, invariant_bound(net, prop.bound, start, semiflows),
+                   space is not None)
+        elif prop.kind == "ctl*":
+            entry["reason"] = "a CTL* formula (neither CTL nor LTL): not decided"
+        elif kripke is None:
+            if prop.kind == "reachability" and partial is not None:
+                _partial_reachability(entry, prop, partial)
+            if entry["verdict"] is None and prop.kind == "reachability":
+                _deadlock_by_stubborn_sets(entry, prop, net, start, max_states)
+        else:
+            _decide(entry, prop, kripke, cache)
+        if entry["verdict"] is None and "reason" not in entry:
+            entry["reason"] = reason
+        results.append(entry)
+    return results
+
+
+#: How many markings of an unbounded net are still explored, in search of markings that
+#: decide reachability properties (``EF p`` true, ``AG p`` false) or exceed a bound.
+UNBOUNDED_STATES = 100_000
+
+
+def _explored_part(net: Net, start, max_states: int) -> StateSpace | None:
+    """The first ``max_states`` markings of an unbounded net, breadth first."""
+    try:
+        reachability_graph(net, start, max_states=max_states, detect_unbounded=False)
+    except StateSpaceLimit as exc:
+        return exc.partial if isinstance(exc.partial, StateSpace) else None
+    return None             # finite after all: cannot happen for a net found unbounded
+
+
+def _describe(prop: Property) -> str:
+    if prop.formula is not None:
+        return str(prop.formula)
+    text = "bound(" + " + ".join(prop.bound) + ")"
+    return text if prop.at_most is None else f"{text} <= {prop.at_most}"
+
+
+def _reachability_shape(formula) -> tuple[bool, object]:
+    """``(universal, p)`` for ``AG p`` (true) / ``EF p`` (false) / ``p`` (``EF``-free: as
+    the predicate at the initial marking, returned as universal None)."""
+    if isinstance(formula, AllPaths) and isinstance(formula.operand, Globally):
+        return True, formula.operand.operand
+    if isinstance(formula, ExistsPath) and isinstance(formula.operand, Finally):
+        return False, formula.operand.operand
+    return None, formula  # type: ignore[return-value]
+
+
+def _decide(entry: dict, prop: Property, kripke: Kripke, cache: dict) -> None:
+    formula = prop.formula
+    if prop.kind == "reachability":
+        universal, predicate = _reachability_shape(formula)
+        if universal is None:
+            entry.update(verdict=bool(kripke.holds(predicate)[0]), method="initial marking",
+                         witness=[])
+            return
+        holds = kripke.holds(predicate)
+        bad = np.flatnonzero(~holds if universal else holds)
+        entry["method"] = "reachability graph (breadth first: shortest witness)"
+        entry["verdict"] = (not bad.size) if universal else bool(bad.size)
+        if bad.size:
+            entry["witness"] = kripke.space.path(int(bad[0]))
+        return
+    if prop.kind == "ltl":
+        verdict, lasso = check_ltl(kripke, formula)
+        entry.update(verdict=verdict, method="LTL: Spot Büchi automaton x reachability graph")
+        if lasso is not None:
+            entry.update(lasso)
+        return
+    verdict = bool(evaluate(kripke, formula, cache)[0])
+    entry.update(verdict=verdict, method="CTL: fixpoints on the reachability graph")
+    evidence = ctl_witness(kripke, formula, verdict, cache)
+    if evidence is not None:
+        entry.update(evidence)
+
+
+def _partial_reachability(entry: dict, prop: Property, partial: StateSpace) -> None:
+    """A state found before the limit can settle ``EF p`` (true) or ``AG p`` (false)."""
+    universal, predicate = _reachability_shape(prop.formula)
+    if universal is None:
+        return
+    holds = Kripke(partial).holds(predicate)
+    bad = np.flatnonzero(~holds if universal else holds)
+    if partial.expanded is not None and any(isinstance(n, (Fireable, Deadlock)) for n in predicate.walk()):
+        # what a state enables is known only once it is expanded (the others look dead)
+        bad = bad[bad < partial.expanded]
+    if bad.size:
+        entry.update(verdict=not universal, witness=partial.path(int(bad[0])),
+                     method="reachability graph (stopped at the limit; the witness is reachable)")
+
+
+def _deadlock_by_stubborn_sets(entry: dict, prop: Property, net: Net, start, max_states: int) -> None:
+    """``EF deadlock`` / ``AG !deadlock`` beyond the full state space: a stubborn-set
+    search preserves every reachable deadlock (:mod:`petriflow.analysis.stubborn`)."""
+    universal, predicate = _reachability_shape(prop.formula)
+    wanted = Not(Deadlock()) if universal else Deadlock()
+    if universal is None or predicate != wanted:
+        return
+    try:
+        found = stubborn_deadlocks(net, start, max_states=max_states, first=True)
+    except StateSpaceLimit:
+        return
+    entry.update(verdict=found.deadlock != bool(universal), witness=found.witness,
+                 method="stubborn sets (every reachable deadlock preserved)")
+
+
+def _bound(entry: dict, prop: Property, space: StateSpace | None, proved: int | None,
+           complete: bool) -> None:
+    reached, state = reached_bound(space, prop.bound) if space is not None else (None, None)
+    exact = None
+    if complete:
+        exact, entry["method"] = reached, "reachability graph"
+    elif reached is not None and proved is not None and reached >= proved:
+        exact, entry["method"] = reached, "P-semiflows (upper bound) met by a reachable marking"
+    if exact is not None:
+        entry["witness"] = space.path(state)
+        entry["verdict"] = exact if prop.at_most is None else exact <= prop.at_most
+        entry["bound"] = exact
+    elif prop.at_most is not None and proved is not None and proved <= prop.at_most:
+        entry.update(verdict=True, method="P-semiflows (upper bound)", bound_at_most=proved)
+    elif prop.at_most is not None and reached is not None and reached > prop.at_most:
+        entry.update(verdict=False, witness=space.path(state), bound_at_least=reached,
+                     method="reachability graph (stopped at the limit; the marking is reachable)")
+    else:
+        if reached is not None:
+            entry["bound_at_least"] = reached
+        if proved is not None:
+            entry["bound_at_most"] = proved
