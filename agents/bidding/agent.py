@@ -10,10 +10,10 @@
   (lowest cost, ties to the smallest rank) on every CFP, then maps its zones nearest
   first, sending what its laser sees.
 
-Each is a :class:`~petriflow.agents.bidding.protocol.Mailbox`, an agent state the run
+Each is a :class:`~petriflow.agents.bidding.outbox.Outbox`, an agent state the run
 keeps (``ctx.state``; registered as ``bidding.operator``, ``bidding.interface`` and
-``bidding.robot``): the actions of :mod:`~petriflow.agents.bidding.actions` change
-them and the guards read them. What a guard asks costs the same whatever the team's
+``bidding.robot``): the actions (:mod:`~petriflow.agents.bidding.interface`,
+:mod:`~petriflow.agents.bidding.robot`, ...) change them and the guards read them. What a guard asks costs the same whatever the team's
 size: :meth:`Interface.next_step` and :meth:`RobotAgent.next_step` read counters kept
 as messages arrive, not the team.
 """
@@ -24,12 +24,13 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
-from petriflow.agents.bidding.protocol import Mailbox, Message
+from petriflow.agents.bidding.outbox import Outbox
+from petriflow.agents.bidding.protocol import Payload
 
 __all__ = ["Interface", "Operator", "RobotAgent", "Auction"]
 
 
-class Operator(Mailbox):
+class Operator(Outbox):
     """The human operator: the mission it asks for."""
 
     def __init__(self, name: str, hmia: str, mission: dict[str, Any]) -> None:
@@ -39,7 +40,7 @@ class Operator(Mailbox):
         self.mission = mission
 
 
-class Interface(Mailbox):
+class Interface(Outbox):
     """The HMIA's state (see the module)."""
 
     def __init__(self, name: str) -> None:
@@ -57,7 +58,7 @@ class Interface(Mailbox):
         self.to_offer: deque[int] = deque()
         self.auction: int | None = None
         self.auction_at = 0.0
-        self.request: Message | None = None
+        self.request: Payload | None = None
         self.owner: dict[int, str] = {}
         self.finished: set[int] = set()
         self.alive: set[str] = set()
@@ -66,7 +67,6 @@ class Interface(Mailbox):
         self.global_map: Any = None
         self.truth: Any = None
         self.points = 0
-        self.now = 0.0
         self.until = "mapped"          # END when every zone is mapped (in sight or reached), or only reached
         self.seen: set[int] = set()   # zones a robot's laser has had in sight
 
@@ -144,7 +144,7 @@ class Auction:
         self.proposals[sender] = cost
 
 
-class RobotAgent(Mailbox):
+class RobotAgent(Outbox):
     """An RA's state (see the module)."""
 
     def __init__(self, name: str, rank: int, hmia: str) -> None:
@@ -156,7 +156,7 @@ class RobotAgent(Mailbox):
         self.odometry: Any = None     # its Stage odometry (localization odom), else None: the true pose
         self.sight: dict[int, tuple[float, float]] = {}  # the mission's zones (from MAP), to see
         self.sighted: set[int] = set()  # zones this robot's laser had in sight
-        self.initialise: Message | None = None
+        self.initialise: Payload | None = None
         self.initialised = False
         self.auctions: deque[Auction] = deque()
         self.ranks: dict[str, int] = {}
@@ -178,7 +178,6 @@ class RobotAgent(Mailbox):
         self.seen: set[int] = set()           # cells sent as real returns
         self.seen_teammate: set[int] = set()  # cells sent as returns off teammates
         self.scans = 0
-        self.now = 0.0
         self.waiting = 0.0
         self.ranks[name] = rank
         self._members_of: list[str] | None = None

@@ -11,7 +11,7 @@ from petriflow.agents.bidding.agent import Interface, Operator, RobotAgent
 from petriflow.agents.bidding.auction import autonomous
 from petriflow.agents.bidding.nets import build
 from petriflow.agents.bidding.office import paper_office
-from petriflow.agents.bidding.protocol import Message
+from petriflow.agents.bidding.protocol import Payload
 from petriflow.analysis import check_net
 from petriflow.io import load_net
 from petriflow.io.yaml import dumps_net
@@ -163,7 +163,7 @@ def test_transitions_fire_one_at_a_time():
         receive(hmia.outbox["robot1"][0])
         assert step("ready") == "ok"
         assert robot.initialised and robot.outbox["hmia"][0].kind == "INITIALIZED"
-        cfp = Message("CFP", "hmia", "robot1", zone=5, body={"position": (0.5, -5.5), "bidders": ["robot1", "robot2"]})
+        cfp = Payload("CFP", "hmia", "robot1", zone=5, body={"position": (0.5, -5.5), "bidders": ["robot1", "robot2"]})
         receive(cfp)
         step("bid")
         propose = robot.outbox["robot2"][0]
@@ -171,7 +171,7 @@ def test_transitions_fire_one_at_a_time():
                                                                                   / 0.4 / 3)
         assert not robot.bids_in()  # robot2's proposal is missing
         # robot2 bids lower: robot1 loses and sends no ALLOCATED
-        receive(Message("PROPOSE", "robot2", "robot1", zone=5, body={"cost": 1.0, "rank": 1}))
+        receive(Payload("PROPOSE", "robot2", "robot1", zone=5, body={"cost": 1.0, "rank": 1}))
         assert robot.bids_in() and robot.next_step() == "decide"
         step("decide")
         assert robot.mine == [] and [m.kind for m in robot.outbox["hmia"]] == ["INITIALIZED"]
@@ -272,7 +272,7 @@ def test_hmia_steps_and_a_robots_exploration_fire_alone():
         assert report["accuracy_pct"] == 100.0 and report["sigma"] == 0  # nothing mapped, nothing wrong
 
         robot = RobotAgent("robot1", 0, "hmia")
-        robot.initialise = Message("INITIALIZE", "hmia", "robot1", body={"rank": 0, "team": ["robot1", "robot2"]})
+        robot.initialise = Payload("INITIALIZE", "hmia", "robot1", body={"rank": 0, "team": ["robot1", "robot2"]})
         step("robot1", "ready", robot)
         robot.clear()
         robot.mapping, robot.mine, robot.zones = True, [4], {4: (13.0, -8.1)}

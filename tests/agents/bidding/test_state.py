@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import pytest
 
-from petriflow.agents.bidding.actions import GUARDS
+from petriflow.agents.bidding.guards import GUARDS
 from petriflow.agents.bidding.agent import Auction, Interface, Operator, RobotAgent
 from petriflow.agents.bidding.office import Plan, paper_office, plan_resource
-from petriflow.agents.bidding.protocol import Mailbox, Message
+from petriflow.agents.bidding.outbox import Outbox
+from petriflow.agents.bidding.protocol import Payload
 from petriflow.runtime.agents import AgentState
 from petriflow.runtime.registry import default_registry
 from petriflow.runtime.resources import ResourceContext
@@ -22,10 +23,10 @@ def watched(state):
 
 
 def test_the_outbox_touches_the_peer_and_pending_when_it_empties_or_fills():
-    box = Mailbox()
+    box = Outbox()
     assert isinstance(box, AgentState)
     touched = watched(box)
-    box.queue(Message("CFP", "hmia", "robot1", zone=0))
+    box.queue(Payload("CFP", "hmia", "robot1", zone=0))
     box.broadcast("MAP", "hmia", ["robot1", "robot2"])
     assert touched == ["outbox/robot1", "pending", "outbox/robot1", "outbox/robot2"]
     assert box.pending() and box.queued == 3 and box.has_for("robot2")
@@ -143,11 +144,11 @@ def test_near_reads_the_positions_once_per_step_and_misses_nobody_within_the_rad
 
 
 def test_a_broadcast_leaves_in_one_firing_once_every_copy_is_first_in_its_queue():
-    box = Mailbox()
+    box = Outbox()
     box.track_casts()
     touched = watched(box)
     team = frozenset({"robot1", "robot2", "robot3"})
-    box.queue(Message("ALLOCATED", "robot4", "robot2", zone=1))  # robot2's queue is not free yet
+    box.queue(Payload("ALLOCATED", "robot4", "robot2", zone=1))  # robot2's queue is not free yet
     box.broadcast("PROPOSE", "robot4", ["robot3", "robot1", "robot2"], zone=2, body={"cost": 1.0})
     assert box.ready_cast(team) is None and "cast" not in touched
     assert box.take("robot2").kind == "ALLOCATED"
@@ -167,7 +168,7 @@ def test_a_broadcast_leaves_in_one_firing_once_every_copy_is_first_in_its_queue(
 
 
 def test_without_track_casts_a_mailbox_follows_no_broadcast():
-    box = Mailbox()
+    box = Outbox()
     touched = watched(box)
     box.broadcast("MAP", "hmia", ["robot1", "robot2"])
     assert box.ready_cast(frozenset({"robot1", "robot2"})) is None and "cast" not in touched
