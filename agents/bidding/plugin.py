@@ -41,5 +41,8 @@ def register(registry) -> None:
         registry.register_state(name, cls)
     for name, (function, reads) in GUARDS.items():
         registry.predicate(name, reads=reads)(function)
-    registry.register_resource("bidding.office", "petriflow.agents.bidding.office:plan_resource")
+    from petriflow.agents.bidding.needs import OFFICE_SETTINGS
+
+    registry.register_resource("bidding.office", "petriflow.agents.bidding.office:plan_resource",
+                               settings=OFFICE_SETTINGS)
     metrics.register(registry)

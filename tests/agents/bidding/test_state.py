@@ -8,6 +8,7 @@ import pytest
 
 from petriflow.agents.bidding.guards import GUARDS
 from petriflow.agents.bidding.agent import Auction, Interface, Operator, RobotAgent
+from petriflow.agents.bidding.needs import OFFICE_SETTINGS
 from petriflow.agents.bidding.office import Plan, paper_office, plan_resource
 from petriflow.agents.bidding.outbox import Outbox
 from petriflow.agents.bidding.protocol import Payload
@@ -118,13 +119,18 @@ class _World:
 
 def test_the_office_resource_is_the_worlds_plan_made_once_with_its_navigators():
     office = paper_office()
-    plan = plan_resource(ResourceContext(world=_World({"office": office.meta()}), liveness=None))
+
+    def made(meta):
+        return plan_resource(ResourceContext(world=_World(meta), liveness=None,
+                                             settings={"office": OFFICE_SETTINGS.read(meta.get("office"))}))
+
+    plan = made({"office": office.meta()})
     assert isinstance(plan, Plan) and plan.office == office
     assert plan.navigator(0.35) is plan.navigator(0.35) and plan.navigator(0.3) is not plan.navigator(0.35)
     assert plan_resource(ResourceContext(world=None, liveness=None)) is None
-    assert plan_resource(ResourceContext(world=_World({}), liveness=None)) is None
-    with pytest.raises(Exception, match="meta.office"):
-        plan_resource(ResourceContext(world=_World({"office": {"size": [1, 1]}}), liveness=None))
+    assert made({}) is None
+    with pytest.raises(Exception, match="must be 4 finite numbers"):
+        made({"office": {"size": [1, 1], "walls": [[0.0, 0.0, 1.0]]}})
 
 
 def test_near_reads_the_positions_once_per_step_and_misses_nobody_within_the_radius():
