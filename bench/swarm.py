@@ -165,8 +165,7 @@ def run_numpy(record: dict, dt: float, model) -> float:
         poses[:, 1] += v * is_ + vy * ic
         poses[:, 2] = np.arctan2(np.sin(th1), np.cos(th1))
         for asker in record["queries"].get(tick, ()):
-            d = np.hypot(*(poses[:, :2] - poses[asker, :2]).T)
-            rssi = m.tx_power_dbm - 10.0 * m.exponent * np.log10(np.maximum(d, m.min_distance))
+            rssi = m.rssi_many(np.hypot(*(poses[:, :2] - poses[asker, :2]).T))
             np.flatnonzero(rssi >= model.threshold_dbm)
     return time.process_time() - cpu
 

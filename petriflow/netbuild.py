@@ -79,7 +79,10 @@ Places = Union[str, Sequence[str], Mapping[str, int]]
 
 @dataclass(frozen=True)
 class Mailbox:
-    """A bounded channel into an agent (see :meth:`NetBuilder.mailbox`).
+    """A bounded channel into an agent (see :meth:`NetBuilder.mailbox`): the net's part,
+    two places. The messages themselves are :class:`~petriflow.runtime.channel_models.Message`
+    values carrying a scenario's payload; what an agent keeps waiting to send is its own
+    state (an outbox), not a mailbox.
 
     Attributes:
         id: the channel place (its tokens are the messages in flight).

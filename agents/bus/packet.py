@@ -17,6 +17,11 @@ byte  content
 7–8   amplitude r in milliradians, signed 16 bits
 ====  ==========================================================================
 
+A :class:`Packet` is a payload: :func:`encode` gives the bytes a
+:class:`~petriflow.runtime.channel_models.Message` carries through a bus channel place
+(its data's ``payload``), and the bus turns those into a
+:class:`~petriflow.agents.bus.records.Frame`.
+
 Big-endian throughout. The motor angle θ is not sent: no receiver uses it (the
 reception routine reads only φ, x and r). On CAN the sender's address sets the 11-bit
 identifier (:func:`can_identifier`: ``0x100 + address``, so the lower address wins

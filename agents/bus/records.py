@@ -8,6 +8,12 @@ module. These values are all the media (:mod:`~petriflow.agents.bus.rs485`,
 :mod:`~petriflow.agents.bus.can`, :mod:`~petriflow.agents.bus.zigbee`,
 :mod:`~petriflow.agents.bus.network`) and their users share.
 
+A :class:`Frame` is not a message between agents: it is the medium's unit (bytes and
+addresses on one bus, what a MAC layer queues, arbitrates and garbles). The message
+between agents is the runtime's :class:`~petriflow.runtime.channel_models.Message`
+through a bus channel place; the bus's carrier (:mod:`~petriflow.agents.bus.channel`)
+turns each one into a frame of its payload's bytes.
+
 Examples:
     >>> frame = Frame(sender=0, receivers=(1, 2), data=b"phase")
     >>> Lost(frame, module=2, reason=Loss.OVERWRITTEN, time=0.5).reason.value

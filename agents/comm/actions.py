@@ -173,7 +173,7 @@ def _plan(ctx: ActionContext, state: CommAgent, links: dict[str, Any]) -> None:
 
     ``links`` keeps, per channel place, the model carrying it (the same for the whole
     run); the agents' positions are read once per plan (nothing moves during it)."""
-    state.now = ctx.now
+    state.acted_at = ctx.now
     live: Liveness = ctx.resource("live")
     peers = [peer for peer in state.peers.values() if live.alive(peer.name)]  # the others: no beacon
     world = ctx.world
@@ -201,8 +201,8 @@ def _take_in(ctx: ActionContext, state: CommAgent, message: Any, resent: bool = 
     if resent:
         sender = state.by_address(message.sender)
         ctx.emit("comm.resent", sender=sender.name if sender is not None else str(message.sender),
-                 code=message.code, source=message.source)
-    new = state.receive(message)
+                 code=int(message.code), source=message.source)
+    new = state.receive(message, ctx.now)
     sender = state.by_address(message.sender)
     if sender is not None:
         state.met(sender.name)  # within range here: a place to meet again
@@ -249,7 +249,7 @@ class Explore(Action):
 
     def start(self, ctx: ActionContext) -> None:
         self.state = state = ctx.state
-        state.now = ctx.now
+        state.acted_at = ctx.now
         state.patience = self.params["give_up"]
         if state.robot is None:
             raise ActionFailure("comm.explore: the agent has no robot (use comm.listen for static agents)")
@@ -340,7 +340,7 @@ class Explore(Action):
             return
         stopped = {state.peers[name].address for name in state.stopped if name in state.peers}
         waiting_for = [s for s in waiting_for if s not in stopped]
-        owed = state.untold() + [name for name, box in state.outbox.items() if box and name not in state.stopped]
+        owed = state.untold(ctx.now) + [name for name, box in state.outbox.items() if box and name not in state.stopped]
         waiting_for += [state.peers[name].address for name in owed if state.peers[name].address not in waiting_for]
         if state.parked and tuple(waiting_for) != state.parked_for:
             state.parked = False  # someone else to meet now (or no longer): choose the place again
@@ -498,7 +498,7 @@ class Listen(InstantAction):
 
     def start(self, ctx: ActionContext) -> None:
         self.state = ctx.state
-        self.state.now = ctx.now
+        self.state.acted_at = ctx.now
         self.state.patience = self.params["give_up"]
         self.until = ctx.now + self.params["period"]
 
@@ -531,9 +531,9 @@ class Send(InstantAction):
         if message is None:
             raise ActionFailure(f"comm.send: nothing waiting for {self.params['peer']!r}")
         state.met(self.params["peer"])  # it hears the peer here
-        ctx.put(self.params["box"], {"size": message.size, "payload": message.payload, "code": message.code,
+        ctx.put(self.params["box"], {"size": message.size, "payload": message.payload, "code": int(message.code),
                                      "message": message})
-        ctx.emit("comm.sent", to=self.params["peer"], code=message.code, bytes=message.size,
+        ctx.emit("comm.sent", to=self.params["peer"], code=int(message.code), bytes=message.size,
                  payload=message.payload, source=message.source)
 
 
@@ -560,12 +560,12 @@ class Receive(InstantAction):
         message = packet.get("message") if isinstance(packet, dict) else None
         if message is None:
             raise ActionFailure(f"comm.receive: the token of {self.params['box']!r} carries no message")
-        state.now = ctx.now
+        state.acted_at = ctx.now
         sender = state.by_address(message.sender)
         name = sender.name if sender is not None else str(message.sender)
         if notice:
             state.keep_lost(name, message)
-            ctx.emit("comm.lost", sender=name, code=message.code, bytes=message.size, source=message.source)
+            ctx.emit("comm.lost", sender=name, code=int(message.code), bytes=message.size, source=message.source)
             return
         for earlier in state.resend(name):  # a later frame got through: so does TCP's retransmission
             _take_in(ctx, state, earlier, resent=True)
@@ -584,10 +584,10 @@ def _done(state: CommAgent) -> bool:
     if not state.complete_sources(state.gave_up):  # the cheap test first: most often it decides
         return False
     silent = {name for name, peer in state.peers.items()
-              if peer.address in state.gave_up or state.now - state.heard.get(name, state.since) > state.patience}
+              if peer.address in state.gave_up or state.acted_at - state.heard.get(name, state.since) > state.patience}
     waiting = any(box for name, box in state.outbox.items() if name not in silent) \
         or any(lost for name, lost in state.lost.items() if name not in silent)  # a retransmission to come
-    return not waiting and not state.untold()
+    return not waiting and not state.untold(state.acted_at)
 
 
 def finished(state: CommAgent | None, params: dict[str, Any]) -> bool:

@@ -23,12 +23,12 @@ all of it.
 
 from __future__ import annotations
 
-from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
-from petriflow.agents.comm.framework import History, Message, plan
+from petriflow.agents.comm.framework import Code, History, Packet, plan
 from petriflow.runtime.agents import AgentState
+from petriflow.runtime.outbox import Outbox
 
 __all__ = ["CommAgent", "Peer", "vertex_id"]
 
@@ -68,7 +68,7 @@ class CommAgent(AgentState):
     explored: bool = False
     explored_at: float | None = None
     final: dict[int, int] = field(default_factory=dict)      # source -> items it has in all
-    outbox: dict[str, deque] = field(default_factory=dict)  # peer -> messages waiting
+    outbox: Outbox = field(init=False, repr=False)          # peer -> packets waiting
     asked: set = field(default_factory=set)                  # (peer, source) queries answered by no reply yet
     in_range: set = field(default_factory=set)
     last_seen: dict[int, tuple[float, float]] = field(default_factory=dict)  # source -> last vertex position
@@ -85,7 +85,8 @@ class CommAgent(AgentState):
     heard: dict = field(default_factory=dict)    # peer -> simulated time of its last message
     lost: dict = field(default_factory=dict)     # peer -> its messages the radio lost on the way here,
                                                  # oldest first, until TCP gets them through (see resend)
-    now: float = 0.0                             # simulated time of the agent's last action
+    acted_at: float = 0.0                        # simulated time the agent last planned or took a message in:
+                                                 # guards, which see no clock, judge silence as of then
     patience: float = 240.0                      # seconds of silence after which a peer counts as gone
     since: float = 0.0                           # simulated time the agent started its task
     sent_bytes: int = 0
@@ -93,6 +94,7 @@ class CommAgent(AgentState):
 
     def __post_init__(self) -> None:
         AgentState.__init__(self)
+        self.outbox = Outbox(self)
 
     def to_token(self) -> dict[str, Any]:
         """What a trace records of this state: who it is and how far it got (cheap,
@@ -137,14 +139,14 @@ class CommAgent(AgentState):
         return sorted(s for s in self.team if s != self.address and
                       (s not in self.final or self.history.count(s) < self.final[s]))
 
-    def untold(self) -> list[str]:
+    def untold(self, now: float) -> list[str]:
         """Peers this agent has not yet told that a source it holds in full is final: it
         must meet them once more before it may stop. A peer not heard from for
-        ``patience`` s (gone, as far as anyone can tell) is not waited for; one that still
-        talks (a robot broken down, its radio on) is."""
+        ``patience`` s before ``now`` (gone, as far as anyone can tell) is not waited for;
+        one that still talks (a robot broken down, its radio on) is."""
         out = []
         for name, peer in self.peers.items():
-            if self.now - self.heard.get(name, self.since) > self.patience or name in self.stopped:
+            if now - self.heard.get(name, self.since) > self.patience or name in self.stopped:
                 continue  # gone, or cannot come: it hears what passes by, nobody goes to tell it
             for source, total in self.final.items():
                 if source == peer.address or self.history.count(source) < total:
@@ -170,13 +172,11 @@ class CommAgent(AgentState):
         """Bytes of a vertex id: one (the paper's) up to 256 cells, else two."""
         return 1 if self.cells <= 256 else 2
 
-    def queue(self, message: Message) -> None:
-        message.id_bytes = self.id_bytes
-        message.stopped = self.broken
+    def queue(self, message: Packet) -> None:
+        message = replace(message, id_bytes=self.id_bytes, stopped=self.broken)
         peer = self.by_address(message.receiver)
         if peer is not None:
-            self.outbox.setdefault(peer.name, deque()).append(message)
-            self.touch(f"outbox/{peer.name}")
+            self.outbox.put(peer.name, message)
 
     def hear(self, names: set[str]) -> None:
         """The peers heard now (above the threshold and running); the send guards of
@@ -192,13 +192,13 @@ class CommAgent(AgentState):
         a query with its count and the final flag when the peer may lack it."""
         waiting = {(m.source, m.code) for m in self.outbox.get(peer.name, ())}
         for message in plan(self.history, peer.address):
-            message.final = message.source in self.final
-            if message.code == 0:
+            message = replace(message, final=message.source in self.final)
+            if message.code == Code.QUERY:
                 if (peer.name, message.source) in self.asked or (message.source, 0) in waiting:
                     continue
                 self.asked.add((peer.name, message.source))
             else:
-                if (message.source, 3) in waiting:
+                if (message.source, Code.IMMEDIATE) in waiting:
                     continue
                 self.history.sent(peer.address, message.source, list(message.vertices))
             self.queue(message)
@@ -214,13 +214,11 @@ class CommAgent(AgentState):
                 if unsent:
                     self.history.sent(peer.address, source, unsent)
                 count = self.history.count_for(peer.address, source)
-                note = Message(0, source, count, self.address, peer.address)
-                note.final = True
-                self.queue(note)
+                self.queue(Packet(Code.QUERY, source, count, self.address, peer.address, final=True))
                 if unsent:
-                    self.queue(Message(2, source, count, self.address, peer.address, unsent, final=True))
+                    self.queue(Packet(Code.BEGIN, source, count, self.address, peer.address, unsent, final=True))
 
-    def keep_lost(self, peer: str, message: Message) -> None:
+    def keep_lost(self, peer: str, message: Packet) -> None:
         """A message from ``peer`` the radio lost on the way here (the run's loss notice,
         ``on_loss: notify``). The paper's transport is TCP (§3.2.3, "to ensure packet
         transmission without information loss"): a lost segment is sent again until it
@@ -228,52 +226,50 @@ class CommAgent(AgentState):
         again (:meth:`resend`)."""
         self.lost.setdefault(peer, []).append(message)
 
-    def resend(self, peer: str) -> list[Message]:
+    def resend(self, peer: str) -> list[Packet]:
         """The messages from ``peer`` lost on the way, oldest first, now that the link
         carries frames again (this agent hears ``peer``, or a later message of it got
         through): TCP's retransmission arrives before anything sent after it."""
         return self.lost.pop(peer, [])
 
-    def take(self, peer: str) -> Message | None:
-        box = self.outbox.get(peer)
-        if not box:
+    def take(self, peer: str) -> Packet | None:
+        message = self.outbox.take(peer)
+        if message is None:
             return None
-        message = box.popleft()
-        self.touch(f"outbox/{peer}")
         self.sent_bytes += message.size
         self.payload_bytes += message.payload
         return message
 
     def has_for(self, peer: str) -> bool:
-        return bool(self.outbox.get(peer)) and peer in self.in_range
+        return self.outbox.waiting(peer) > 0 and peer in self.in_range
 
-    def receive(self, message: Message) -> list[int]:
-        """Handle one message; returns the ids of vertices new to this agent."""
+    def receive(self, message: Packet, now: float) -> list[int]:
+        """Handle one message that arrived at simulated time ``now``; returns the ids of
+        vertices new to this agent."""
         sender = self.by_address(message.sender)
         if sender is not None:
-            self.heard[sender.name] = self.now
+            self.heard[sender.name] = now
             if message.stopped:
                 self.stopped.add(sender.name)
         new: list[int] = []
         final = message.final
-        if message.code == 0:
+        if message.code == Code.QUERY:
             if final:
                 self.final[message.source] = max(self.final.get(message.source, 0), message.count)
             have = self.history.count(message.source)
             wanted = max(0, message.count - have)
             if wanted and sender is not None:
-                self.queue(Message(1, message.source, wanted, self.address, message.sender))
-        elif message.code == 1:
+                self.queue(Packet(Code.REQUEST, message.source, wanted, self.address, message.sender))
+        elif message.code == Code.REQUEST:
             if sender is not None:
                 self.asked.discard((sender.name, message.source))
                 # the items never sent to the requester, oldest first
                 chosen = self.history.unsent(message.sender, message.source)[:message.count]
                 self.history.sent(message.sender, message.source, chosen)
                 if chosen:
-                    reply = Message(2, message.source, self.history.count_for(message.sender, message.source),
-                                    self.address, message.sender, list(chosen))
-                    reply.final = message.source in self.final
-                    self.queue(reply)
+                    self.queue(Packet(Code.BEGIN, message.source,
+                                      self.history.count_for(message.sender, message.source),
+                                      self.address, message.sender, chosen, final=message.source in self.final))
         else:
             if final:
                 self.final[message.source] = max(self.final.get(message.source, 0), message.count)

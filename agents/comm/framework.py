@@ -20,11 +20,11 @@ the rows that already sent that source elsewhere.
 
 Process 5, the packet header: code 0 asks how many packets are pending, 1 requests a
 number of packets, 2 begins a transmission, 3 transfers a packet at once
-(:data:`CODES`). :func:`plan` is Algorithm 1: towards one peer in range, a source with
+(:class:`Code`; :data:`CODES` names them). :func:`plan` is Algorithm 1: towards one peer in range, a source with
 a row of pending data goes by request (codes 0, 1, 2), one never sent to that peer
-goes at once (code 3). A message is a header of three bytes (code, source id, count)
-and, for codes 2 and 3, five bytes per map vertex (a 1-byte id and two 16-bit floats,
-§4.1).
+goes at once (code 3). A :class:`Packet` is a header of three bytes (code, source id,
+count) and, for codes 2 and 3, five bytes per map vertex (a 1-byte id and two 16-bit
+floats, §4.1): the payload a :class:`~petriflow.runtime.channel_models.Message` carries.
 
 Examples:
     >>> round(dpp(0.025, 200) * 1000, 4), grid_position((0.25, 4.75), 0.0007853)
@@ -35,18 +35,23 @@ Examples:
 
 from __future__ import annotations
 
+import enum
 import math
 import struct
 from dataclasses import dataclass, field
 from collections.abc import Callable
 from typing import Any
 
+from petriflow.outcome import Name
+
 __all__ = [
     "CODES",
+    "Code",
     "HEADER_BYTES",
     "VERTEX_BYTES",
     "History",
-    "Message",
+    "Packet",
+    "Rule",
     "addresses",
     "decode_vertex",
     "dhcp_pools",
@@ -57,8 +62,23 @@ __all__ = [
     "plan",
 ]
 
-#: The header codes of §3.2.5.
-CODES = {0: "query pending", 1: "request packets", 2: "begin transmission", 3: "immediate transfer"}
+class Code(enum.IntEnum):
+    """A packet header's code (§3.2.5): the kind of a :class:`Packet`. An ``int`` enum: the
+    header byte holds the number, and the trace writes it."""
+
+    QUERY = 0
+    """How many items of the source are pending (a count: the items the sender holds)."""
+    REQUEST = 1
+    """Send this many items of the source."""
+    BEGIN = 2
+    """Items that answer a request."""
+    IMMEDIATE = 3
+    """Items of a source never sent to this peer, sent at once."""
+
+
+#: The header codes of §3.2.5, as the paper names them.
+CODES = {Code.QUERY: "query pending", Code.REQUEST: "request packets", Code.BEGIN: "begin transmission",
+         Code.IMMEDIATE: "immediate transfer"}
 #: Bytes of a header: code, source id, count.
 HEADER_BYTES = 3
 #: Bytes of one map vertex: a 1-byte id and two 16-bit floats (x, y).
@@ -107,9 +127,25 @@ def _round(value: float) -> int:
 
 
 # Process 4 ---------------------------------------------------------------------------
+class Rule(Name):
+    """Why :meth:`History.outgoing` sends a source to a peer."""
+
+    NEW = "new"
+    """Rules 1 and 2: never sent that source to this peer: all of it."""
+    PENDING = "pending"
+    """Rule 3: the items made or received since it was last sent."""
+
+
 @dataclass
 class History:
     """One agent's data array ``Ad`` and history array ``Ah`` (see the module).
+
+    The history model of the comm and swarm scenarios (the swarm's
+    :class:`~petriflow.agents.swarm.agent.SwarmHistory` is this model, kept in arrays for
+    a large team, with the same answers): what this agent knows, from whom, and what
+    went to which peer. The SLAM scenario's
+    :class:`~petriflow.agents.slam.history.History` is a different model (its docstring
+    says how).
 
     ``data`` holds ``(source, item, via)``: ``via`` is the agent it came from (the
     agent itself for its own data), so nothing goes back where it came from.
@@ -199,10 +235,10 @@ class History:
             self._more(source, len(new), sender)
         return new
 
-    def outgoing(self, peer: int) -> list[tuple[int, list[Any], str]]:
+    def outgoing(self, peer: int) -> list[tuple[int, list[Any], Rule]]:
         """What the rules send ``peer``: ``(source, items, rule)`` per source, rule
-        ``"new"`` (rules 1 and 2: never sent that source to this peer: all of it) or
-        ``"pending"`` (rule 3: the items made or received since); in either case only
+        :attr:`Rule.NEW` (rules 1 and 2: never sent that source to this peer: all of it) or
+        :attr:`Rule.PENDING` (rule 3: the items made or received since); in either case only
         the items the peer does not hold (:meth:`lacks`)."""
         out = []
         chosen: set = set()  # what goes to the peer in this plan already, under an earlier source
@@ -221,7 +257,7 @@ class History:
                 if row is not None:
                     row[3] = 0  # the peer holds all of it already: nothing is pending
                 continue
-            out.append((source, items, "new" if row is None else "pending"))
+            out.append((source, items, Rule.NEW if row is None else Rule.PENDING))
         return out
 
     def sent(self, peer: int, source: int, items: list[Any]) -> None:
@@ -273,22 +309,34 @@ def _key(item: Any) -> Any:
 
 
 # Process 5 ---------------------------------------------------------------------------
-@dataclass
-class Message:
-    """One packet: header ``code``, ``source`` id, ``count`` (codes 0, 2, 3: the items of
-    that source the sender holds; code 1: the items requested); vertices for codes 2
+@dataclass(frozen=True)
+class Packet:
+    """One packet, the payload of a :class:`~petriflow.runtime.channel_models.Message`:
+    header ``code`` (:class:`Code`), ``source`` id, ``count`` (codes 0, 2, 3: the items
+    of that source the sender holds; code 1: the items requested); vertices for codes 2
     and 3; ``final``: the source's data is complete (the code byte's top bit);
-    ``stopped``: the sender cannot move any more (a mechanical failure; the next bit)."""
+    ``stopped``: the sender cannot move any more (a mechanical failure; the next bit).
+    ``sender`` and ``receiver`` are network addresses (the IP header's), not the agent
+    names the runtime's message carries."""
 
-    code: int
+    code: Code
     source: int
     count: int
     sender: int
     receiver: int
-    vertices: list[tuple[int, float, float]] = field(default_factory=list)
+    vertices: tuple[tuple[int, float, float], ...] = ()
     final: bool = False
     id_bytes: int = 1
     stopped: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "code", Code(self.code))
+        object.__setattr__(self, "vertices", tuple(self.vertices))
+
+    @property
+    def kind(self) -> Code:
+        """The packet's kind: its code."""
+        return self.code
 
     @property
     def size(self) -> int:
@@ -327,15 +375,15 @@ def decode_vertex(data: bytes, *, id_bytes: int = 1) -> tuple[int, float, float]
     return (int.from_bytes(data[:id_bytes], "little"), x, y)
 
 
-def plan(history: History, peer: int) -> list[Message]:
+def plan(history: History, peer: int) -> list[Packet]:
     """Algorithm 1 towards one peer in range: a message per source to send, code 0
     (query, then the peer requests and code 2 follows) for a source with pending data
     in a row towards the peer, code 3 (immediate) for a source never sent to it."""
     messages = []
     for source, items, rule in history.outgoing(peer):
         total = history.count_for(peer, source)
-        if rule == "pending":
-            messages.append(Message(0, source, total, history.me, peer))
+        if rule is Rule.PENDING:
+            messages.append(Packet(Code.QUERY, source, total, history.me, peer))
         else:
-            messages.append(Message(3, source, total, history.me, peer, list(items)))
+            messages.append(Packet(Code.IMMEDIATE, source, total, history.me, peer, tuple(items)))
     return messages

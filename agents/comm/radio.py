@@ -40,12 +40,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from petriflow.runtime.channels import ChannelModel, Message
-from petriflow.runtime.radio import LogDistance, WallCounter
+from petriflow.runtime.radio import LogDistance, WallCounter, fade_loss, power_for_range
 
 __all__ = ["CALIBRATED_TX_DBM", "RadioChannel", "pick_threshold", "threshold_sweep"]
 
 #: tx power (dBm at 1 m) that puts -63.4375 dBm at 2 m with exponent 2.
-CALIBRATED_TX_DBM = -63.4375 + 20.0 * math.log10(2.0)
+CALIBRATED_TX_DBM = power_for_range(-63.4375, 2.0, exponent=2.0)
 
 
 @dataclass
@@ -148,13 +148,9 @@ class RadioChannel(ChannelModel):
         return level is None or level > self.limit_dbm(a, b)
 
     def loss_probability(self, level: float) -> float:
-        """Chance a frame at RSSI ``level`` is lost."""
-        floor = self.sensitivity_dbm
-        if level <= floor:
-            return 1.0
-        if self.fade_db <= 0 or level >= floor + self.fade_db:
-            return 0.0
-        return 1.0 - (level - floor) / self.fade_db
+        """Chance a frame at RSSI ``level`` is lost (the core's
+        :func:`~petriflow.runtime.radio.fade_loss` above the sensitivity)."""
+        return fade_loss(level, self.sensitivity_dbm, self.fade_db)
 
     def deliver(self, message: Message, rng: Any) -> float | None:
         level = None

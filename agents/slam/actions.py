@@ -42,9 +42,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from petriflow.agents.slam.agent import Air, Base, Central, Robot, Wireless, frame, merge_seen
+from petriflow.agents.slam.agent import Air, Base, Central, FrameKind, Robot, Wireless, frame, merge_seen
 from petriflow.agents.slam.corridors import HALF_WIDTH, to_map
-from petriflow.agents.slam.history import choose, exchange_role, read_node, update
+from petriflow.agents.slam.history import Exchange, ReadingRule, choose, exchange_role, read_node, update
 from petriflow.capabilities import Bodies, Physics, Poses
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 from petriflow.runtime.settings import Section, Setting
@@ -183,11 +183,11 @@ def _evaluate(ctx: ActionContext, state: Robot, air_place: str, boot: bool = Fal
     rssi, nearest, beacon = heard[0]
     role = exchange_role(state.history.counts(), beacon.counts)
     seen = {state.name: ctx.now}
-    if role == "send":
-        state.queue(frame(state.name, nearest, "data", counts=state.history.counts(),
+    if role == Exchange.SEND:
+        state.queue(frame(state.name, nearest, FrameKind.DATA, counts=state.history.counts(),
                           payload=state.history.payload(beacon.counts), seen=seen))
-    elif role == "pull":
-        state.queue(frame(state.name, nearest, "pull", counts=state.history.counts(), seen=seen))
+    elif role == Exchange.PULL:
+        state.queue(frame(state.name, nearest, FrameKind.PULL, counts=state.history.counts(), seen=seen))
         state.awaiting = nearest
         state.touch("plan")
 
@@ -280,7 +280,7 @@ class Explore(Action):
         if state.mode == "centralised":
             state.here = 0 if start else (state.here or 0)
             state.touch("plan")
-            state.queue(frame(state.name, "central", "report", seen={state.name: ctx.now},
+            state.queue(frame(state.name, "central", FrameKind.REPORT, seen={state.name: ctx.now},
                               event={"position": list(event.position), "heading": event.heading,
                                      "openings": list(event.openings), "start": start}))
             ctx.emit("slam.leg", why=event.why, position=list(event.position), true=[round(v, 4) for v in true],
@@ -324,7 +324,7 @@ class Install(Action):
         state = ctx.state
         p = self.params
         self.payload = state.history.payload({})
-        size = frame(state.name, p["wa"], "data", payload=self.payload)["size"]
+        size = frame(state.name, p["wa"], FrameKind.DATA, payload=self.payload)["size"]
         self.wake_at = ctx.now + p["drop_s"] + p["window_s"] + p["connect_s"] + _radio(ctx, p["air"]).latency(size)
 
     def poll(self, ctx: ActionContext) -> Status:
@@ -357,7 +357,7 @@ class Finish(InstantAction):
 
     def run(self, ctx: ActionContext) -> None:
         state = ctx.state
-        ctx.put(self.params["box"], frame(state.name, "base", "finished"))
+        ctx.put(self.params["box"], frame(state.name, "base", FrameKind.FINISHED))
         body = state.body
         report = {"vertices": len(state.history), "legs": state.legs, "distance_m": round(body.travelled, 3)}
         if state.mode == "decentralised":
@@ -428,13 +428,13 @@ class Scan(Action):
                 merge_seen(state.seen, heard[2].seen)
         if state.role == "client":
             aps = [h for h in neighbours if h[2].role == "ap"]
-            role = exchange_role(state.history.counts(), aps[0][2].counts) if aps else "greet"
-            if role != "greet":  # the nearest access point holds other nodes: exchange (Algorithm 2)
+            role = exchange_role(state.history.counts(), aps[0][2].counts) if aps else Exchange.GREET
+            if role != Exchange.GREET:  # the nearest access point holds other nodes: exchange (Algorithm 2)
                 _, peer, beacon = aps[0]
                 mine = state.history.counts()
-                extra = {"payload": state.history.payload(beacon.counts)} if role == "send" else {}
-                state.queue(frame(state.name, peer, "data" if role == "send" else "pull", counts=mine,
-                                  seen=dict(state.seen), **extra))
+                extra = {"payload": state.history.payload(beacon.counts)} if role == Exchange.SEND else {}
+                kind = FrameKind.DATA if role == Exchange.SEND else FrameKind.PULL
+                state.queue(frame(state.name, peer, kind, counts=mine, seen=dict(state.seen), **extra))
                 state.connected_at = ctx.now
                 state.exchanges += 1
                 state.role = "ap"
@@ -452,7 +452,7 @@ class Scan(Action):
             if (ctx.now - heard > p["alert_after"] and neighbours and state.history.has_pending()
                     and (ra, heard) not in state.alerted):
                 state.alerted.add((ra, heard))
-                state.alerts.append(frame(state.name, "base", "alert", ra=ra, last_heard=heard))
+                state.alerts.append(frame(state.name, "base", FrameKind.ALERT, ra=ra, last_heard=heard))
                 state.touch("alert")
         return Status.OK
 
@@ -521,16 +521,16 @@ def _lost(ctx: ActionContext, state: Any, original: dict[str, Any]) -> None:
     (a report to the central unit is sent again)."""
     ctx.emit("slam.lost", to=original.get("to"), frame=original.get("kind"))
     if isinstance(state, Robot):
-        if original.get("kind") == "pull" and state.awaiting == original.get("to"):
+        if original.get("kind") == FrameKind.PULL and state.awaiting == original.get("to"):
             state.awaiting = None
             state.touch("plan")
-        elif original.get("kind") == "report":
+        elif original.get("kind") == FrameKind.REPORT:
             state.queue(original)
 
 
 def _robot_hears(ctx: ActionContext, state: Robot, data: dict[str, Any]) -> None:
     kind = data.get("kind")
-    if kind == "data":
+    if kind == FrameKind.DATA:
         new = state.history.merge(data.get("payload") or {})
         if new:
             ctx.emit("slam.loaded", source=data["from"], ids=new,
@@ -541,15 +541,15 @@ def _robot_hears(ctx: ActionContext, state: Robot, data: dict[str, Any]) -> None
             beacon = air.beacons.get(data["from"])
             ssid = beacon.ssid if beacon else data["from"]
             reading = read_node(state.history, ssid, state.last_read)
-            if reading.kind != "ignore":
+            if reading.kind != ReadingRule.IGNORE:
                 state.last_read = ssid
-            if reading.kind == "follow" and new:
+            if reading.kind == ReadingRule.FOLLOW and new:
                 state.goal = reading.path
                 state.history.take(*reading.path)
                 ctx.emit("slam.reading", node=ssid, rule=reading.kind, path=list(reading.path))
         state.touch("plan")
         _publish(ctx, state)
-    elif kind == "decision":
+    elif kind == FrameKind.DECISION:
         state.decision = data.get("decision") or {}
         state.touch("plan")
 
@@ -559,15 +559,15 @@ def _wa_hears(ctx: ActionContext, state: Wireless, data: dict[str, Any], window:
     sender = data.get("from")
     merge_seen(state.seen, data.get("seen"))
     mine_before = state.history.counts()
-    if kind == "data":
+    if kind == FrameKind.DATA:
         new = state.history.merge(data.get("payload") or {})
         if new:
             ctx.emit("slam.wa_learnt", ssid=state.ssid, source=sender, ids=new)
     theirs = data.get("counts") or {}
     theirs = {int(k): int(v) for k, v in theirs.items()}
-    if kind == "pull" or (kind == "data" and state.history.missing_for(theirs)
+    if kind == FrameKind.PULL or (kind == FrameKind.DATA and state.history.missing_for(theirs)
                           and any(n > theirs.get(b, 0) for b, n in mine_before.items())):
-        state.queue(frame(state.name, sender, "data", counts=state.history.counts(),
+        state.queue(frame(state.name, sender, FrameKind.DATA, counts=state.history.counts(),
                           payload=state.history.payload(theirs), seen=dict(state.seen)))
     if str(sender).startswith("wa_"):
         state.connected_at = ctx.now
@@ -578,7 +578,7 @@ def _wa_hears(ctx: ActionContext, state: Wireless, data: dict[str, Any], window:
 
 
 def _central_hears(ctx: ActionContext, state: Central, data: dict[str, Any]) -> None:
-    if data.get("kind") != "report" or state.broken:
+    if data.get("kind") != FrameKind.REPORT or state.broken:
         return
     ra = data["from"]
     state.heard[ra] = ctx.now
@@ -594,7 +594,7 @@ def _central_hears(ctx: ActionContext, state: Central, data: dict[str, Any]) -> 
         state.done = True
         state.touch("plan")
         ctx.emit("slam.map", **_map_of(state.history))
-    state.queue(frame(state.name, ra, "decision", decision={"direction": direction}))
+    state.queue(frame(state.name, ra, FrameKind.DECISION, decision={"direction": direction}))
     if len(state.history) > before:
         ctx.emit("slam.central_vertex", ra=ra, vertex=vertex)
 
@@ -605,11 +605,11 @@ def _base(ctx: ActionContext, data: dict[str, Any]) -> None:
         state = Base()
         ctx.state = state
     kind = data.get("kind") if isinstance(data, dict) else None
-    if kind == "finished":
+    if kind == FrameKind.FINISHED:
         state.over = True
         state.finished_by.append(data["from"])
         state.touch("over", "missing")
-    elif kind == "alert":
+    elif kind == FrameKind.ALERT:
         ra = data.get("ra")
         ctx.emit("slam.alert", ra=ra, by=data.get("from"), last_heard=data.get("last_heard"))
         if not state.over and ra not in state.replaced and ra not in state.missing:
@@ -657,7 +657,7 @@ class Serve(Action):
         for ra, heard in sorted(state.heard.items()):
             if (ctx.now - heard > self.params["alert_after"] and not state.done and (ra, heard) not in state.alerted):
                 state.alerted.add((ra, heard))
-                state.alerts.append(frame(state.name, "base", "alert", ra=ra, last_heard=heard))
+                state.alerts.append(frame(state.name, "base", FrameKind.ALERT, ra=ra, last_heard=heard))
                 state.touch("alert")
         return Status.OK
 

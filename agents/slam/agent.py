@@ -17,10 +17,12 @@ of each RA (metadata of the same kind, so that the network knows within seconds 
 anyone still hears an RA). The data itself travels as
 frames, tokens of the shared ``air`` place.
 
-Frames are plain mappings: ``from``, ``to``, ``kind`` (``data``, ``pull``, ``greet``,
-``report``, ``decision``, ``alert``, ``finished``), ``size`` (bytes), ``counts`` (the
-sender's nodes per block), ``payload`` (rows, pending paths, links), ``seen`` (the
-latest time the sender knows each RA was heard).
+Frames (:func:`frame`) are the payload of the runtime's
+:class:`~petriflow.runtime.channel_models.Message` through the ``air`` place: plain
+mappings (the token data a trace records) with ``from``, ``to``, ``kind`` (a
+:class:`FrameKind`), ``size`` (bytes), ``counts`` (the sender's nodes per block),
+``payload`` (rows, pending paths, links: the history's rows, not a message), ``seen``
+(the latest time the sender knows each RA was heard).
 """
 
 from __future__ import annotations
@@ -30,9 +32,30 @@ from dataclasses import dataclass
 from typing import Any
 
 from petriflow.agents.slam.history import History
+from petriflow.outcome import Name
 from petriflow.runtime.agents import AgentState
 
-__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "Robot", "Wireless", "frame", "merge_seen", "payload_size"]
+__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "FrameKind", "FrameSender", "Robot", "Wireless", "frame",
+           "merge_seen", "payload_size"]
+
+
+class FrameKind(Name):
+    """What a frame is (its ``kind``; a ``str`` enum, so a trace writes the text)."""
+
+    DATA = "data"
+    """History rows the receiver lacks (Algorithm 2's sender)."""
+    PULL = "pull"
+    """A request for the rows the sender lacks (the node holds more)."""
+    GREET = "greet"
+    """Nothing but the time stamps (equal holders)."""
+    REPORT = "report"
+    """An RA's sensor event, to the central unit."""
+    DECISION = "decision"
+    """The central unit's direction for an RA."""
+    ALERT = "alert"
+    """A WA's alert to the base: an RA not heard for too long."""
+    FINISHED = "finished"
+    """The end of the map, to the base."""
 
 
 @dataclass
@@ -145,9 +168,9 @@ def payload_size(payload: dict[str, Any] | None) -> int:
     return 8 * rows + 2 * pending + 2 * links
 
 
-def frame(sender: str, receiver: str, kind: str, **fields: Any) -> dict[str, Any]:
+def frame(sender: str, receiver: str, kind: FrameKind, **fields: Any) -> dict[str, Any]:
     """A frame (see the module): 12 bytes of header, then its payload."""
-    data = {"from": sender, "to": receiver, "kind": kind, **fields}
+    data = {"from": sender, "to": receiver, "kind": FrameKind(kind), **fields}
     data["size"] = 12 + payload_size(fields.get("payload")) + 4 * len(fields.get("seen", {}) or {})
     return data
 
@@ -162,7 +185,28 @@ def merge_seen(mine: dict[str, float], theirs: dict[str, float] | None) -> bool:
     return changed
 
 
-class Robot(AgentState):
+class FrameSender(AgentState):
+    """The part of a state with a radio: its frames waiting to go into the air, oldest
+    first, in one queue whatever their receivers (the air carries one frame at a
+    time, in the order they were queued). A change touches the key ``outbox``."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.outbox: list[dict[str, Any]] = []
+
+    def queue(self, data: dict[str, Any]) -> None:
+        self.outbox.append(data)
+        self.touch("outbox")
+
+    def take(self) -> dict[str, Any] | None:
+        if not self.outbox:
+            return None
+        data = self.outbox.pop(0)
+        self.touch("outbox")
+        return data
+
+
+class Robot(FrameSender):
     """An RA's state (see the module)."""
 
     def __init__(self, name: str, *, slot: int = 0, mode: str = "decentralised", radius: float = 1.0) -> None:
@@ -181,7 +225,6 @@ class Robot(AgentState):
         self.decision: dict[str, Any] | None = None
         self.awaiting: str | None = None  # a peer whose answer it waits for before moving
         self.last_read: str | None = None
-        self.outbox: list[dict[str, Any]] = []
         self.needs_wa = False
         self.installed = 0
         self.finished = False
@@ -194,17 +237,6 @@ class Robot(AgentState):
             return False
         return self.mode == "decentralised" or self.here is None or self.decision is not None
 
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
-
     def beacon(self) -> Beacon:
         return Beacon("ra", self.name, "client", self.history.counts())
 
@@ -212,7 +244,7 @@ class Robot(AgentState):
         return {"ra": self.name, "vertices": len(self.history), "installed": self.installed}
 
 
-class Wireless(AgentState):
+class Wireless(FrameSender):
     """A WA's state (see the module)."""
 
     def __init__(self, name: str, ssid: str, owner: str, position: tuple[float, float], *, radius: float = 1.0,
@@ -230,19 +262,7 @@ class Wireless(AgentState):
         self.seen: dict[str, float] = {}
         self.alerted: set[tuple[str, float]] = set()
         self.alerts: list[dict[str, Any]] = []
-        self.outbox: list[dict[str, Any]] = []
         self.exchanges = 0
-
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
 
     def beacon(self) -> Beacon:
         return Beacon("wa", self.ssid, self.role, self.history.counts(), dict(self.seen), self.spot)
@@ -251,7 +271,7 @@ class Wireless(AgentState):
         return {"wa": self.ssid, "role": self.role, "vertices": len(self.history)}
 
 
-class Central(AgentState):
+class Central(FrameSender):
     """The central unit's state (see the module)."""
 
     def __init__(self, name: str = "central", *, radius: float = 1.0) -> None:
@@ -262,20 +282,8 @@ class Central(AgentState):
         self.heard: dict[str, float] = {}
         self.alerted: set[tuple[str, float]] = set()
         self.alerts: list[dict[str, Any]] = []
-        self.outbox: list[dict[str, Any]] = []
         self.done = False
         self.broken = False
-
-    def queue(self, data: dict[str, Any]) -> None:
-        self.outbox.append(data)
-        self.touch("outbox")
-
-    def take(self) -> dict[str, Any] | None:
-        if not self.outbox:
-            return None
-        data = self.outbox.pop(0)
-        self.touch("outbox")
-        return data
 
     def to_token(self) -> dict[str, Any]:
         return {"central": self.name, "vertices": len(self.history)}

@@ -49,6 +49,8 @@ import random
 from dataclasses import dataclass, field
 from typing import Any, Iterable
 
+from petriflow.outcome import Name
+
 __all__ = [
     "BLOCK",
     "CARDINALS",
@@ -56,8 +58,10 @@ __all__ = [
     "NAMES",
     "STEP",
     "Choice",
+    "Exchange",
     "History",
     "Reading",
+    "ReadingRule",
     "Vertex",
     "choose",
     "exchange_role",
@@ -134,6 +138,15 @@ class Vertex:
 
 class History:
     """A history array: the rows, by id, in the order they were learnt.
+
+    Not the history model of :class:`petriflow.agents.comm.framework.History` (which
+    the swarm shares): that one records, per source and per peer, what was sent to
+    whom and what is pending (the exchange is driven by *whom* this agent told what).
+    This one keeps no record of peers: it is the map itself (vertices with their
+    pending paths and links), and what a peer lacks is read from the peer's own
+    counts per block of ids, which its beacon and frames carry (Algorithm 2 compares
+    holdings, then sends the difference). The two papers' exchanges differ in just
+    this, so each scenario keeps its own.
 
     Args:
         block: the RA's block of ids (its own new vertices are numbered
@@ -416,34 +429,53 @@ def choose(history: History, here: int, rng: random.Random, goal: tuple[int, int
     return Choice(None, legs, target)
 
 
-def exchange_role(mine: dict[int, int], theirs: dict[int, int]) -> str:
-    """Algorithm 2's decision for a client that found a node: ``"send"`` (it holds more
-    nodes: it sends the difference), ``"pull"`` (the node holds more: the node sends),
-    ``"greet"`` (equal: nothing but the time stamps).
+class Exchange(Name):
+    """Algorithm 2's decision for a client that found a node (:func:`exchange_role`)."""
+
+    SEND = "send"
+    """It holds more nodes: it sends the difference."""
+    PULL = "pull"
+    """The node holds more: the node sends."""
+    GREET = "greet"
+    """Equal: nothing but the time stamps."""
+
+
+def exchange_role(mine: dict[int, int], theirs: dict[int, int]) -> Exchange:
+    """Algorithm 2's decision for a client that found a node (:class:`Exchange`).
 
     Examples:
         >>> exchange_role({0: 6}, {0: 4}), exchange_role({0: 4}, {0: 6}), exchange_role({0: 4}, {0: 4})
-        ('send', 'pull', 'greet')
+        (<Exchange.SEND: 'send'>, <Exchange.PULL: 'pull'>, <Exchange.GREET: 'greet'>)
     """
     total_mine, total_theirs = sum(mine.values()), sum(theirs.values())
     if total_mine > total_theirs:
-        return "send"
+        return Exchange.SEND
     if total_mine < total_theirs:
-        return "pull"
+        return Exchange.PULL
     if any(n > theirs.get(b, 0) for b, n in mine.items()):
-        return "send"
+        return Exchange.SEND
     if any(n > mine.get(b, 0) for b, n in theirs.items()):
-        return "pull"
-    return "greet"
+        return Exchange.PULL
+    return Exchange.GREET
+
+
+class ReadingRule(Name):
+    """Which of §3.2's rules an RA reading a node applies (:class:`Reading`)."""
+
+    FOLLOW = "follow"
+    """Take the first pending path of the array."""
+    IGNORE = "ignore"
+    """The node read last: nothing to do."""
+    AWAY = "away"
+    """Nothing pending: go on away from the node, remembering its id."""
 
 
 @dataclass(frozen=True)
 class Reading:
-    """§3.2's rule for an RA reading a node: ``follow`` (take ``path``, the first
-    pending path of the array), ``ignore`` (the node read last) or ``away`` (nothing
-    pending: go on away from the node, remembering its id)."""
+    """§3.2's rule for an RA reading a node: ``kind`` (:class:`ReadingRule`) and, to
+    follow, ``path`` (the first pending path of the array)."""
 
-    kind: str
+    kind: ReadingRule
     path: tuple[int, int] | None = None
 
 
@@ -452,12 +484,13 @@ def read_node(history: History, node: str, last_read: str | None) -> Reading:
 
     Examples:
         >>> h = History(); _ = h.add((0, 0), None, []); _ = h.add((0, 6), 0, [0])
-        >>> read_node(h, "WA_R1_1", None), read_node(h, "WA_R1_1", "WA_R1_1")
-        (Reading(kind='follow', path=(1, 0)), Reading(kind='ignore', path=None))
+        >>> follow, ignore = read_node(h, "WA_R1_1", None), read_node(h, "WA_R1_1", "WA_R1_1")
+        >>> follow.kind.value, follow.path, ignore.kind.value, ignore.path
+        ('follow', (1, 0), 'ignore', None)
     """
     if node == last_read:
-        return Reading("ignore")
+        return Reading(ReadingRule.IGNORE)
     first = history.first_pending()
     if first is None:
-        return Reading("away")
-    return Reading("follow", first)
+        return Reading(ReadingRule.AWAY)
+    return Reading(ReadingRule.FOLLOW, first)

@@ -35,12 +35,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from petriflow.runtime.channels import ChannelModel, Message
-from petriflow.runtime.radio import LogDistance
+from petriflow.runtime.radio import LogDistance, fade_loss, power_for_range
 
 __all__ = ["CENTRAL", "ESP8266", "TX_AT_1M"]
 
 #: The power at 1 m (dBm) that puts the loss threshold (-64 dBm) at 5 m with exponent 2.
-TX_AT_1M = -64.0 + 20.0 * math.log10(5.0)
+TX_AT_1M = power_for_range(-64.0, 5.0, exponent=2.0)
 #: The central unit's agent name (reached through the pre-installed nodes).
 CENTRAL = "central"
 
@@ -81,12 +81,9 @@ class ESP8266(ChannelModel):
         return self._reach
 
     def loss(self, rssi: float) -> float:
-        """Probability that a frame received at ``rssi`` is lost."""
-        if rssi >= self.threshold_dbm:
-            return 0.0
-        if self.fade_db <= 0:
-            return 1.0
-        return min(1.0, (self.threshold_dbm - rssi) / self.fade_db)
+        """Probability that a frame received at ``rssi`` is lost (the core's
+        :func:`~petriflow.runtime.radio.fade_loss`, from the threshold down to the reach)."""
+        return fade_loss(rssi, self.threshold_dbm - self.fade_db, self.fade_db)
 
     def latency(self, size: int) -> float:
         """Seconds a frame of ``size`` bytes takes."""

@@ -8,9 +8,13 @@ from a neighbour's data. The data it shares is seed 000's history
 :class:`petriflow.agents.comm.framework.History`, with the same three rules): an item is
 a cell ``(id, x, y, sides)``, its source the robot that sensed it.
 
-Messages are seed 000's packets (:class:`~petriflow.agents.comm.framework.Message`,
-codes 0-3, :func:`~petriflow.agents.comm.framework.plan` for Algorithm 1) and travel as
-plain tuples ``(code, source, count, final, items)``. Sizes (:func:`packet_bytes`): a
+Messages are seed 000's packets (:class:`~petriflow.agents.comm.framework.Packet`,
+codes 0-3, :func:`~petriflow.agents.comm.framework.plan` for Algorithm 1). On the air
+they travel as plain tuples ``(code, source, count, final, items)``, several to a frame
+(the runtime :class:`~petriflow.runtime.channel_models.Message` whose payload is
+:meth:`Scout.frame`'s dict): the same packet without its addresses (a frame says who
+sent it, and the receiver is the key it is filed under), kept a tuple because a swarm
+files hundreds of thousands of them. Sizes (:func:`packet_bytes`): a
 header of a code byte, a two-byte source and a two-byte count (a swarm has more than
 255 robots), and per item a two-byte cell id, x and y as half floats (seed 000's
 vertex) and one byte of open sides.
@@ -33,7 +37,7 @@ from dataclasses import dataclass, field
 from itertools import chain
 from typing import Any
 
-from petriflow.agents.comm.framework import History, Message, plan
+from petriflow.agents.comm.framework import Code, History, Packet, Rule, plan
 from petriflow.runtime.agents import AgentState
 
 __all__ = ["Scout", "SwarmHistory", "OPEN", "SIDES", "packet_bytes"]
@@ -179,7 +183,7 @@ class SwarmHistory(History):
             self._more(source, len(new), sender)
         return new
 
-    def outgoing(self, peer: int) -> list[tuple[int, list[Any], str]]:
+    def outgoing(self, peer: int) -> list[tuple[int, list[Any], Rule]]:
         out = []
         rows, clean, counts = self._rows, self._clean, self._counts
         held = self.held.get(peer) or ()
@@ -195,7 +199,7 @@ class SwarmHistory(History):
                 if not items:
                     clean[(peer, source)] = len(entries)
                     continue
-                out.append((source, items, "new"))
+                out.append((source, items, Rule.NEW))
                 continue
             pending = counts[at + 3]
             if pending <= 0:
@@ -210,7 +214,7 @@ class SwarmHistory(History):
             if not items:
                 counts[at + 3] = 0  # the peer holds all of it already: nothing is pending
                 continue
-            out.append((source, items, "pending"))
+            out.append((source, items, Rule.PENDING))
         return out
 
     def sent(self, peer: int, source: int, items: list[Any]) -> None:
@@ -358,7 +362,7 @@ class Scout(AgentState):
             return  # nothing kept since the last plan for this peer: the rules send it nothing new
         self.planned[peer] = self.history.version
         for message in plan(self.history, address):
-            if message.code == 0:
+            if message.code == Code.QUERY:
                 if (peer, message.source) in self.asked:
                     continue
                 self.asked.add((peer, message.source))
@@ -366,9 +370,9 @@ class Scout(AgentState):
                 self.history.sent(address, message.source, message.vertices)
             self._queue(peer, message)
 
-    def _queue(self, peer: str, message: Message) -> None:
+    def _queue(self, peer: str, message: Packet) -> None:
         box = self.outbox.setdefault(peer, [])
-        box.append((message.code, message.source, message.count, message.final, tuple(message.vertices)))
+        box.append((int(message.code), message.source, message.count, message.final, tuple(message.vertices)))
         if len(box) == 1 and sum(1 for b in self.outbox.values() if b) == 1:
             self.touch("outbox")  # the outbox was empty: the guards' answer changes
 
@@ -399,17 +403,17 @@ class Scout(AgentState):
         code, source, count, final, items = packet
         self.names[address] = sender
         history = self.history
-        if code == 0:
+        if code == Code.QUERY:
             wanted = count - history.count(source)
             if wanted > 0:
-                self._queue(sender, Message(1, source, wanted, self.address, address))
+                self._queue(sender, Packet(Code.REQUEST, source, wanted, self.address, address))
             return 0
-        if code == 1:
+        if code == Code.REQUEST:
             self.asked.discard((sender, source))
             chosen = history.unsent(address, source)[:count]
             if chosen:
                 history.sent(address, source, chosen)
-                self._queue(sender, Message(2, source, history.count(source), self.address, address, list(chosen)))
+                self._queue(sender, Packet(Code.BEGIN, source, history.count(source), self.address, address, chosen))
             return 0
         if self.horizon:  # a robot keeps (and passes on) the map around it only
             near = self._near()

@@ -33,12 +33,10 @@ from typing import Any
 
 from petriflow.runtime.channels import Message
 from petriflow.runtime.media import Medium, MediumPort
+from petriflow.agents.slam.radio import TX_AT_1M
 from petriflow.runtime.radio import LogDistance, RadioIndex
 
 __all__ = ["SwarmRadio", "RadioView"]
-
-#: The power at 1 m that puts the ESP8266's -64 dBm threshold at 5 m (exponent 2).
-TX_AT_1M = round(-64.0 + 20.0 * math.log10(5.0), 4)
 
 
 class RadioView:
@@ -73,7 +71,7 @@ class RadioView:
 class SwarmRadio(Medium):
     """The swarm's broadcast radio (see the module)."""
 
-    tx_power_dbm: float = field(default=TX_AT_1M, metadata={"range": (-200.0, 100.0)})
+    tx_power_dbm: float = field(default=round(TX_AT_1M, 4), metadata={"range": (-200.0, 100.0)})
     exponent: float = field(default=2.0, metadata={"range": (0.5, 8.0)})
     threshold_dbm: float = field(default=-64.0, metadata={"range": (-200.0, 100.0)})
     wall_db: float = field(default=3.0, metadata={"range": (0.0, 100.0)})

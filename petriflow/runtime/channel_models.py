@@ -35,8 +35,8 @@ from typing import Any, Callable
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.outcome import Name
 
-__all__ = ["Message", "Fate", "ChannelModel", "IdealChannel", "RangeChannel", "BusChannel", "CHANNEL_MODELS",
-           "build_channel"]
+__all__ = ["Message", "payload_size", "Fate", "ChannelModel", "IdealChannel", "RangeChannel", "BusChannel",
+           "CHANNEL_MODELS", "build_channel"]
 
 
 class Fate(Name):
@@ -50,25 +50,80 @@ class Fate(Name):
 
 @dataclass
 class Message:
-    """A token travelling through a channel place.
+    """A message between agents: the one message type of petriflow.
+
+    The run makes one for every token put into a channel place (the channel model and
+    the ``message`` trace event see it); a scenario's agents use the same type for
+    what they queue, send and receive outside places (an outbox, a medium's frames).
+
+    **A scenario adds a payload type, not a message class.** What a message says is its
+    ``data``: a frozen dataclass of the scenario's (a header, a bid, a map update), with
+
+    * ``size`` (an attribute or property, bytes on a wire): what :func:`payload_size`
+      counts and the channel models time and lose (else 16 bytes);
+    * ``kind`` (a member of a :class:`~petriflow.outcome.Name` enum of the scenario's
+      message kinds): what :attr:`kind` reads, so handlers dispatch on the enum and a
+      trace writes its text.
+
+    Examples:
+        >>> from dataclasses import dataclass
+        >>> from petriflow.outcome import Name
+        >>> class Kind(Name):
+        ...     HELLO = "HELLO"
+        >>> @dataclass(frozen=True)
+        ... class Hello:
+        ...     kind = Kind.HELLO
+        ...     size = 4
+        >>> message = Message(None, "a", "b", Hello())
+        >>> message.kind, message.kind == "HELLO", message.size
+        (<Kind.HELLO: 'HELLO'>, True, 4)
 
     Attributes:
-        place: the channel place.
-        sender: agent of the transition that produced the token (or ``None``).
-        receiver: agent that consumes from the place (or ``None``).
-        data: the token's data.
+        place: the channel place it travels through (``None``: not a place's token).
+        sender: agent that sent it (for a place, the agent of the transition that
+            produced the token), or ``None``.
+        receiver: agent it is for (for a place, the agent that consumes from it), or ``None``.
+        data: the payload (a token's data, for a place).
         time: simulated send time.
-        size: payload size in bytes (from the token data's ``size`` if any).
+        size: payload size in bytes (default: :func:`payload_size` of ``data``).
         distance: sender-receiver distance in metres, when the world knows both.
     """
 
-    place: str
+    place: str | None
     sender: str | None
     receiver: str | None
     data: Any
-    time: float
-    size: int = 16
+    time: float = 0.0
+    size: int = -1
     distance: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.size < 0:
+            self.size = payload_size(self.data)
+
+    @property
+    def kind(self) -> Any:
+        """The payload's kind: its ``kind`` attribute or key, else ``None``."""
+        if isinstance(self.data, dict):
+            return self.data.get("kind")
+        return getattr(self.data, "kind", None)
+
+
+def payload_size(data: Any) -> int:
+    """Bytes a message of payload ``data`` counts: its ``size`` (attribute or key, a
+    whole number > 0), else 16.
+
+    Examples:
+        >>> payload_size({"size": 9}), payload_size(b"xy"), payload_size([1, 2]), payload_size(None)
+        (9, 16, 16, 16)
+    """
+    if isinstance(data, dict):
+        size = data.get("size")
+        return size if isinstance(size, int) and not isinstance(size, bool) and size > 0 else 16
+    if isinstance(data, list):
+        return 16
+    size = getattr(data, "size", 0)
+    return int(size) if isinstance(size, (int, float)) and not isinstance(size, bool) and size > 0 else 16
 
 
 class ChannelModel:

@@ -48,6 +48,7 @@ from petriflow.runtime.channel_models import (
     Message,
     RangeChannel,
     build_channel,
+    payload_size,
 )
 from petriflow.runtime.kernel import APPLY, Kernel, Scheduled
 from petriflow.runtime.media import Medium, MediumPort, ProcessClock
@@ -120,17 +121,6 @@ class Delivery(Scheduled):
 
     def apply(self, tick: int) -> None:
         self.channels.arrive(self)
-
-
-def _size(data: Any) -> int:
-    """Bytes a message counts: the data's ``size`` (attribute or key), else 16."""
-    if isinstance(data, dict):
-        size = data.get("size")
-        return size if isinstance(size, int) and not isinstance(size, bool) and size > 0 else 16
-    if isinstance(data, list):
-        return 16
-    size = getattr(data, "size", 0)
-    return int(size) if isinstance(size, (int, float)) and size > 0 else 16
 
 
 class LinkState(Protocol):
@@ -206,7 +196,7 @@ class Channels:
         if wanted and sender and receiver and self._distance is not None:
             distance = self._distance(sender, receiver)
         now = kernel.now
-        message = Message(place, sender, receiver, data, now, _size(data), distance)
+        message = Message(place, sender, receiver, data, now, payload_size(data), distance)
         links = self.links
         if links.link_down(sender, receiver):
             delay, why = None, "link down"

@@ -9,7 +9,13 @@ between robots, a ZigBee bus) computes received power the same way::
 :class:`LogDistance` holds that formula; :class:`WallCounter` counts the walls a
 straight line between two agents of a pybullet world crosses (a ray test), caching
 each pair of places to the centimetre, since walls do not move. What a channel does
-with the RSSI (a threshold, a fading margin, bit errors) is the channel's.
+with the RSSI (a threshold, a fading margin, bit errors) is the channel's; the two
+parts of a link budget that several channels share live here too:
+:func:`power_for_range` (the transmit power that puts a threshold at a distance, how a
+radio is calibrated from one measured range) and :func:`fade_loss` (a fading margin:
+the chance a frame is lost rising linearly to 1 over ``fade_db`` of RSSI).
+:meth:`LogDistance.rssi_many` is the same formula over a numpy array of distances, for
+code that asks about many links at once.
 
 For many radios at once (a swarm), :func:`pairs_within` finds the pairs closer than
 the free-space range with a spatial index (scipy's ``cKDTree`` when scipy is
@@ -24,6 +30,10 @@ Examples:
     >>> xbee = LogDistance(tx_power_dbm=0.0, reference_loss_db=40.0)
     >>> xbee.rssi(10.0), xbee.rssi(10.0, walls_db=3.0)
     (-60.0, -63.0)
+    >>> free.rssi_many([2.0, 0.001]).round(2).tolist()
+    [-36.02, 10.0]
+    >>> round(power_for_range(-64.0, 5.0), 4), fade_loss(-69.0, floor_dbm=-74.0, fade_db=10.0)
+    (-50.0206, 0.5)
     >>> pairs_within([(0, 0), (1, 0), (5, 0), (5.5, 0.5)], 1.0, method="grid").tolist()
     [[0, 1], [2, 3]]
 """
@@ -36,7 +46,7 @@ from typing import Any, Iterable
 
 from petriflow.capabilities import Bodies, Physics, Poses, missing
 
-__all__ = ["LogDistance", "WallCounter", "walls_between", "pairs_within", "walls_along", "RadioIndex"]
+__all__ = ["LogDistance", "power_for_range", "fade_loss", "WallCounter", "walls_between", "pairs_within", "walls_along", "RadioIndex"]
 
 
 @dataclass(frozen=True)
@@ -65,6 +75,34 @@ class LogDistance:
         """The distance (metres) at which the RSSI falls to ``threshold_dbm``."""
         margin = self.tx_power_dbm - self.reference_loss_db - walls_db - threshold_dbm
         return round(10 ** (margin / (10.0 * self.exponent)), 6)
+
+    def rssi_many(self, distances: Any, walls_db: Any = 0.0) -> Any:
+        """:meth:`rssi` of each of ``distances`` (metres, any array shape) through
+        ``walls_db`` (a number or an array of the same shape), as a numpy array."""
+        import numpy as np
+
+        d = np.maximum(np.asarray(distances, dtype=float), self.min_distance)
+        rssi = self.tx_power_dbm - self.reference_loss_db - 10.0 * self.exponent * np.log10(d)
+        return rssi - walls_db if np.any(walls_db) else rssi
+
+
+def power_for_range(threshold_dbm: float, distance: float, exponent: float = 2.0,
+                    reference_loss_db: float = 0.0) -> float:
+    """The transmit power (dBm) that puts the RSSI at ``threshold_dbm`` at ``distance``
+    metres: what a radio measured to reach that far has (the inverse of
+    :meth:`LogDistance.range`)."""
+    return threshold_dbm + reference_loss_db + 10.0 * exponent * math.log10(distance)
+
+
+def fade_loss(rssi: float, floor_dbm: float, fade_db: float) -> float:
+    """The chance a frame received at ``rssi`` (dBm) is lost to fading: 1 at or below
+    ``floor_dbm`` (where frames stop arriving), 0 at or above ``floor_dbm + fade_db``,
+    linear in between (no margin, ``fade_db`` <= 0: a step at the floor)."""
+    if rssi <= floor_dbm:
+        return 1.0
+    if fade_db <= 0 or rssi >= floor_dbm + fade_db:
+        return 0.0
+    return 1.0 - (rssi - floor_dbm) / fade_db
 
 
 def walls_between(world: Any, a: tuple[float, float], b: tuple[float, float], *, z: float = 0.1,
@@ -302,9 +340,7 @@ class RadioIndex:
         """Which candidate pairs' RSSI through the walls between reaches the threshold."""
         import numpy as np
 
-        d = np.hypot(*(pts[pairs[:, 0]] - pts[pairs[:, 1]]).T)
-        m = self.model
-        rssi = m.tx_power_dbm - m.reference_loss_db - 10.0 * m.exponent * np.log10(np.maximum(d, m.min_distance))
+        rssi = self.model.rssi_many(np.hypot(*(pts[pairs[:, 0]] - pts[pairs[:, 1]]).T))
         if self.world is None or not self.wall_db > 0:
             return rssi >= self.threshold_dbm
         # only the pairs' own points: a radio asking alone has a few candidates among many points

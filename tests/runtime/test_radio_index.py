@@ -6,7 +6,15 @@ import math
 import numpy as np
 import pytest
 
-from petriflow.runtime.radio import LogDistance, RadioIndex, pairs_within, walls_along, walls_between
+from petriflow.runtime.radio import (
+    LogDistance,
+    RadioIndex,
+    fade_loss,
+    pairs_within,
+    power_for_range,
+    walls_along,
+    walls_between,
+)
 from petriflow.world import World
 
 
@@ -89,3 +97,25 @@ def test_who_hears_one_radio_by_the_index_equals_the_all_pairs_links(method):
     for asker in range(0, 500, 7):
         expected = sorted({j for i, j in everyone if i == asker} | {i for i, j in everyone if j == asker})
         assert index.heard_by(points, asker, tree) == expected
+
+
+@pytest.mark.parametrize("model", [LogDistance(-30.0, 0.0, 2.0, 0.01), LogDistance(0.0, 40.0, 3.1, 0.5)])
+def test_the_vectorised_link_budget_is_the_scalar_one(model):
+    """rssi_many gives rssi's value for each distance (reference loss and walls included)."""
+    distances = np.array([0.0, 0.2, 1.0, 7.5, 120.0])
+    walls = np.array([0.0, 3.0, 0.0, 6.0, 9.0])
+    assert model.rssi_many(distances).tolist() == pytest.approx([model.rssi(d) for d in distances])
+    assert model.rssi_many(distances, walls).tolist() == \
+        pytest.approx([model.rssi(d, w) for d, w in zip(distances, walls)])
+
+
+def test_power_for_range_is_the_inverse_of_range():
+    power = power_for_range(-64.0, 5.0, exponent=2.5, reference_loss_db=40.0)
+    assert LogDistance(power, 40.0, 2.5).range(-64.0) == pytest.approx(5.0)
+
+
+def test_fade_loss_rises_from_none_to_all_over_the_margin():
+    assert fade_loss(-60.0, floor_dbm=-70.0, fade_db=10.0) == 0.0
+    assert fade_loss(-65.0, floor_dbm=-70.0, fade_db=10.0) == pytest.approx(0.5)
+    assert fade_loss(-70.0, floor_dbm=-70.0, fade_db=10.0) == 1.0
+    assert fade_loss(-69.9, floor_dbm=-70.0, fade_db=0.0) == 0.0

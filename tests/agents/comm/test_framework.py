@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from petriflow.agents.comm.framework import (History, Message, addresses, decode_vertex, dhcp_pools, dpp,
+from petriflow.agents.comm.framework import (History, Packet, addresses, decode_vertex, dhcp_pools, dpp,
                                              encode_vertex, grid_position, grid_size, plan)
 
 
@@ -88,7 +88,7 @@ def test_rule_3_new_data_becomes_pending_and_goes_by_request():
 def test_process_5_header_and_vertex_bytes():
     vertex = (7, 1.25, 4.75)
     assert decode_vertex(encode_vertex(*vertex)) == vertex
-    message = Message(2, 85, 2, 2, 85, [vertex, (9, 0.5, 0.5)], final=True)
+    message = Packet(2, 85, 2, 2, 85, [vertex, (9, 0.5, 0.5)], final=True)
     data = message.encode()
     assert len(data) == message.size == 3 + 2 * 5 and message.payload == 10
     assert data[0] == 0x82 and data[1] == 85 and data[2] == 2

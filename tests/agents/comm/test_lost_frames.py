@@ -15,7 +15,7 @@ import pytest
 
 from petriflow import examples
 from petriflow.agents.comm.agent import CommAgent, Peer
-from petriflow.agents.comm.framework import History, Message
+from petriflow.agents.comm.framework import History, Packet
 from petriflow.agents.comm.radio import RadioChannel
 from petriflow.io import load_net
 from petriflow.runtime.config import load_config
@@ -44,7 +44,7 @@ def test_a_loss_notice_gives_the_slot_back_and_the_message_arrives_before_the_ne
     config = load_config(examples.path("comm", "run.yaml"))
     robot = CommAgent("robot1", "robot", address=2, history=History(2))
     robot.peers["central"] = Peer("central", 129, "box_robot1_central")
-    lost = Message(3, 128, 1, 129, 2, [(5, 4.6, 0.4)])
+    lost = Packet(3, 128, 1, 129, 2, [(5, 4.6, 0.4)])
     notice = {"lost": True, "why": "channel model", "data": {"size": lost.size, "payload": lost.payload,
                                                              "code": 3, "message": lost}}
     result, events = _receive(net, config, robot, notice)
@@ -53,7 +53,7 @@ def test_a_loss_notice_gives_the_slot_back_and_the_message_arrives_before_the_ne
     assert robot.vertices == {} and robot.lost == {"central": [lost]}
     assert [e.data["data"] for e in events if e.kind == "custom"] == [
         {"sender": "central", "code": 3, "bytes": 8, "source": 128}]
-    later = Message(3, 170, 1, 129, 2, [(6, 1.2, 0.4)])
+    later = Packet(3, 170, 1, 129, 2, [(6, 1.2, 0.4)])
     result, events = _receive(net, config, robot, {"size": later.size, "payload": later.payload, "code": 3,
                                                    "message": later})
     custom = [(e.data["name"], e.data["data"]) for e in events if e.kind == "custom"]

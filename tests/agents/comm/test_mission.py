@@ -162,14 +162,14 @@ def _vertex_ids(maze_meta) -> set[int]:
 
 def test_send_and_receive_move_one_message_through_the_channel_place():
     from petriflow.agents.comm.agent import CommAgent, Peer
-    from petriflow.agents.comm.framework import History, Message
+    from petriflow.agents.comm.framework import History, Packet
 
     net = load_net(examples.path("comm", "comm-decentralised-2.yaml"))
     config = load_config(examples.path("comm", "run.yaml"))
     sender = CommAgent("robot1", "robot", address=2, history=History(2))
     sender.peers["robot2"] = Peer("robot2", 128, "box_robot1_robot2")
     sender.hear({"robot2"})
-    sender.queue(Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))
+    sender.queue(Packet(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))
     sent, events, _ = fire(net, "robot1_send_robot2", {"robot1_out": [None], "slot_robot1_robot2": [None]},
                            states={"robot1": sender}, config=config)
     assert outcome(events, "robot1_send_robot2") == "ok" and sent.marking["robot1_out"] == 1
@@ -177,7 +177,7 @@ def test_send_and_receive_move_one_message_through_the_channel_place():
     on_air = [e.data for e in events if e.kind == "message"]
     assert on_air[0]["fate"] == "sent" and on_air[0]["size"] == 8 and on_air[0]["receiver"] == "robot2"
     assert not sender.outbox["robot2"]
-    packet = {"size": 8, "payload": 5, "code": 3, "message": Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)])}
+    packet = {"size": 8, "payload": 5, "code": 3, "message": Packet(3, 2, 1, 2, 128, [(0, 0.4, 0.4)])}
     receiver = CommAgent("robot2", "robot", address=128, history=History(128))
     receiver.peers["robot1"] = Peer("robot1", 2, "box_robot2_robot1")
     got, events, _ = fire(net, "robot2_receive_robot1", {"box_robot1_robot2": [packet], "robot2_listen": [None]},
@@ -189,7 +189,7 @@ def test_send_and_receive_move_one_message_through_the_channel_place():
 
 def test_a_send_is_not_enabled_while_nothing_waits_or_the_peer_is_not_heard():
     from petriflow.agents.comm.agent import CommAgent, Peer
-    from petriflow.agents.comm.framework import History, Message
+    from petriflow.agents.comm.framework import History, Packet
 
     net = load_net(examples.path("comm", "comm-decentralised-2.yaml"))
     sender = CommAgent("robot1", "robot", address=2, history=History(2))
@@ -198,7 +198,7 @@ def test_a_send_is_not_enabled_while_nothing_waits_or_the_peer_is_not_heard():
     run.set_tokens({"robot1_out": [None], "slot_robot1_robot2": [None]})
     run.firer.agents.set_state("robot1", sender, CommAgent)
     assert "robot1_send_robot2" not in run.enabled()
-    sender.queue(Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))  # waiting, but robot2 not heard
+    sender.queue(Packet(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))  # waiting, but robot2 not heard
     assert "robot1_send_robot2" not in run.enabled()
     sender.hear({"robot2"})  # touches outbox/robot2: the kept answer is forgotten
     assert "robot1_send_robot2" in run.enabled()

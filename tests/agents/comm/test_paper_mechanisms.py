@@ -11,7 +11,7 @@ from types import SimpleNamespace
 import pytest
 
 from petriflow.agents.comm.agent import CommAgent, Peer, vertex_id
-from petriflow.agents.comm.framework import History, Message
+from petriflow.agents.comm.framework import History, Packet
 from petriflow.agents.comm.metrics import complete_per_agent, maps_complete, time_s
 from petriflow.agents.comm.nets import SPEED, build
 from petriflow.agents.comm.radio import RadioChannel
@@ -34,14 +34,14 @@ def forwarded(agent: CommAgent, peer: str) -> list[int]:
 
 def test_the_central_unit_forwards_each_robot_only_the_vertices_it_lacks():
     central = central_unit()
-    central.receive(Message(3, 2, 2, 2, 129, [(5, 0.4, 0.4), (6, 1.2, 0.4)]))        # robot1 mapped 5 and 6
-    central.receive(Message(3, 85, 2, 85, 129, [(5, 0.41, 0.39), (7, 2.1, 0.4)]))    # robot2 mapped 5 too, and 7
+    central.receive(Packet(3, 2, 2, 2, 129, [(5, 0.4, 0.4), (6, 1.2, 0.4)]), 0.0)        # robot1 mapped 5 and 6
+    central.receive(Packet(3, 85, 2, 85, 129, [(5, 0.41, 0.39), (7, 2.1, 0.4)]), 0.0)    # robot2 mapped 5 too, and 7
     assert forwarded(central, "robot1") == [7]           # robot1 holds 5 (its own): not sent again under robot2's name
     assert forwarded(central, "robot2") == [6]           # and robot2 holds 5 too
     assert forwarded(central, "robot3") == [5, 6, 7]     # robot3 lacks all three: 5 goes once
     central.outbox.clear()
     assert forwarded(central, "robot3") == []            # nothing is pending for robot3 any more
-    central.receive(Message(3, 170, 1, 170, 129, [(8, 0.4, 4.6)]))
+    central.receive(Packet(3, 170, 1, 170, 129, [(8, 0.4, 4.6)]), 0.0)
     assert forwarded(central, "robot1") == [8] and forwarded(central, "robot2") == [8]
 
 
@@ -74,11 +74,11 @@ def test_a_robot_that_breaks_down_says_so_and_is_not_waited_for():
     assert sent.stopped and sent.encode()[0] & 0x40       # the header's bit after the final flag
     robot1 = CommAgent("robot1", "robot", address=2, history=History(2))
     robot1.peers["robot3"] = Peer("robot3", 170, "box_robot1_robot3")
-    robot1.receive(sent)
+    robot1.receive(sent, 0.0)
     robot1.history.add_own((0, 0.4, 0.4))
     robot1.final[2] = 1
     assert robot1.stopped == {"robot3"}
-    assert robot1.untold() == []              # it cannot come: nobody drives to tell it
+    assert robot1.untold(0.0) == []              # it cannot come: nobody drives to tell it
 
 
 def test_where_two_robots_talked_is_kept_as_a_place_to_meet_again():

@@ -11,7 +11,7 @@ import pytest
 from petriflow import examples
 from petriflow.agents.comm.actions import Explore, Listen
 from petriflow.agents.comm.agent import CommAgent, Peer
-from petriflow.agents.comm.framework import History, Message
+from petriflow.agents.comm.framework import History, Packet
 from petriflow.errors import NetFormatError
 from petriflow.io.yaml import loads_net
 from petriflow.runtime.binding import bind
@@ -39,7 +39,7 @@ def test_the_state_touches_one_peers_key_when_its_queue_or_hearing_changes():
     state.peers = {"robot2": Peer("robot2", 128, "box_robot1_robot2"), "robot3": Peer("robot3", 170, "b13")}
     touched: list[tuple[str, ...]] = []
     state.attach(touched.append)
-    state.queue(Message(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))
+    state.queue(Packet(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))
     assert touched == [("outbox/robot2",)]
     state.hear({"robot2"})
     state.hear({"robot2"})  # no change: nothing to ask again
