@@ -7,10 +7,10 @@ One concept per module:
 * :mod:`~petriflow.agents.bidding.auction`: autonomous deployment (one call for
   proposals per zone in rank order), re-auction after a breakdown, the operator's
   random deployment lists, the nearest-first visiting order.
-* :mod:`~petriflow.agents.bidding.protocol`: the ten message kinds and the payload a
-  message carries.
-* :mod:`~petriflow.agents.bidding.outbox`: an agent's outgoing queues and broadcasts
-  (the base of every agent's state).
+* :mod:`~petriflow.agents.bidding.protocol`: the ten message kinds and the payload the
+  runtime's one message type carries for them.
+* :mod:`~petriflow.agents.bidding.correspondent`: the base of every agent's state: its
+  outbox (the runtime's), its broadcasts and message counts.
 * :mod:`~petriflow.agents.bidding.agent`: the operator's, the HMIA's and a robot
   agent's state (agent states the run keeps; the guards read them by key).
 * the agents' steps as actions: :mod:`~petriflow.agents.bidding.operator`,

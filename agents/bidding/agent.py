@@ -10,12 +10,12 @@
   (lowest cost, ties to the smallest rank) on every CFP, then maps its zones nearest
   first, sending what its laser sees.
 
-Each is a :class:`~petriflow.agents.bidding.outbox.Outbox`, an agent state the run
+Each is a :class:`~petriflow.agents.bidding.correspondent.Correspondent`, an agent state the run
 keeps (``ctx.state``; registered as ``bidding.operator``, ``bidding.interface`` and
 ``bidding.robot``): the actions (:mod:`~petriflow.agents.bidding.interface`,
-:mod:`~petriflow.agents.bidding.robot`, ...) change them and the guards read them. What a guard asks costs the same whatever the team's
-size: :meth:`Interface.next_step` and :meth:`RobotAgent.next_step` read counters kept
-as messages arrive, not the team.
+:mod:`~petriflow.agents.bidding.robot`, ...) change them and the guards read them.
+What a guard asks costs the same whatever the team's size: :meth:`Interface.next_step`
+and :meth:`RobotAgent.next_step` read counters kept as messages arrive, not the team.
 """
 
 from __future__ import annotations
@@ -24,28 +24,26 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
-from petriflow.agents.bidding.outbox import Outbox
-from petriflow.agents.bidding.protocol import Payload
+from petriflow.agents.bidding.correspondent import Correspondent
+from petriflow.runtime.channel_models import Message
 
 __all__ = ["Interface", "Operator", "RobotAgent", "Auction"]
 
 
-class Operator(Outbox):
+class Operator(Correspondent):
     """The human operator: the mission it asks for."""
 
     def __init__(self, name: str, hmia: str, mission: dict[str, Any]) -> None:
-        super().__init__()
-        self.name = name
+        super().__init__(name)
         self.hmia = hmia
         self.mission = mission
 
 
-class Interface(Outbox):
+class Interface(Correspondent):
     """The HMIA's state (see the module)."""
 
     def __init__(self, name: str) -> None:
-        super().__init__()
-        self.name = name
+        super().__init__(name)
         self.mission: dict[str, Any] | None = None
         self.requested = False
         self.robots: list[str] = []
@@ -58,7 +56,7 @@ class Interface(Outbox):
         self.to_offer: deque[int] = deque()
         self.auction: int | None = None
         self.auction_at = 0.0
-        self.request: Payload | None = None
+        self.request: Message | None = None
         self.owner: dict[int, str] = {}
         self.finished: set[int] = set()
         self.alive: set[str] = set()
@@ -144,19 +142,18 @@ class Auction:
         self.proposals[sender] = cost
 
 
-class RobotAgent(Outbox):
+class RobotAgent(Correspondent):
     """An RA's state (see the module)."""
 
     def __init__(self, name: str, rank: int, hmia: str) -> None:
-        super().__init__()
-        self.name = name
+        super().__init__(name)
         self.rank = rank
         self.hmia = hmia
         self.robot: Any = None        # the KinematicRobot, once initialised
         self.odometry: Any = None     # its Stage odometry (localization odom), else None: the true pose
         self.sight: dict[int, tuple[float, float]] = {}  # the mission's zones (from MAP), to see
         self.sighted: set[int] = set()  # zones this robot's laser had in sight
-        self.initialise: Payload | None = None
+        self.initialise: Message | None = None
         self.initialised = False
         self.auctions: deque[Auction] = deque()
         self.ranks: dict[str, int] = {}

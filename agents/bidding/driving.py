@@ -183,8 +183,8 @@ class Explore(Action):
         ra = self.ra
         zone = ra.plan.pop(0)
         ra.done.add(zone)
-        ra.queue(Payload(Kind.MAPPED, ra.name, ra.hmia, zone=zone, body={"points": None, "finished": [zone],
-                                                                      "rank": ra.rank}))
+        ra.queue(ra.hmia, Payload(Kind.MAPPED, zone=zone, body={"points": None, "finished": [zone],
+                                                                "rank": ra.rank}))
         (bx, by, _), (tx, ty, _) = ra.pose(), ra.robot.pose
         ctx.emit("bidding.zone_done", zone=zone + 1, distance_m=round(ra.robot.travelled, 3),
                  drift_m=round(math.hypot(bx - tx, by - ty), 4))
@@ -261,8 +261,8 @@ class Explore(Action):
         every = p["send"] == "every"
         if not len(points):
             if every or seen:
-                ra.queue(Payload(Kind.MAPPED, ra.name, ra.hmia, body={"points": None, "finished": [], "seen": seen,
-                                                                   "rank": ra.rank}))
+                ra.queue(ra.hmia, Payload(Kind.MAPPED, body={"points": None, "finished": [], "seen": seen,
+                                                             "rank": ra.rank}))
             return
         cells = np.floor(points / p["cell"]).astype(np.int64)
         keys = cells[:, 0] * 1_000_003 + cells[:, 1]
@@ -277,8 +277,8 @@ class Explore(Action):
         for k in new:
             (ra.seen if real_cell[k] else ra.seen_teammate).add(int(keys[k]))
         fresh = points[first[new]].astype(np.float32)
-        ra.queue(Payload(Kind.MAPPED, ra.name, ra.hmia, body={"points": fresh, "finished": [], "seen": seen,
-                                                           "rank": ra.rank, "real": real_cell[new]}))
+        ra.queue(ra.hmia, Payload(Kind.MAPPED, body={"points": fresh, "finished": [], "seen": seen,
+                                                     "rank": ra.rank, "real": real_cell[new]}))
 
     def _team_bodies(self, ctx: ActionContext) -> np.ndarray:
         """The pybullet bodies of the robot's teammates (what its laser may see that is

@@ -1,8 +1,8 @@
 """The guards that route the agents' work loops.
 
 Each is ``f(state, params)`` over the agent's state, and says which of its keys (see
-:class:`~petriflow.agents.bidding.outbox.Outbox`) it reads, so after a firing only the
-guards whose keys changed are asked again: ``bidding.has_message`` reads
+:class:`~petriflow.agents.bidding.correspondent.Correspondent`) it reads, so after a
+firing only the guards whose keys changed are asked again: ``bidding.has_message`` reads
 ``outbox/{peer}``, ``bidding.has_cast`` ``cast``, the step guards ``step``,
 ``bidding.idle`` and ``bidding.finished`` ``step`` and ``pending`` (:data:`GUARDS`).
 """

@@ -119,7 +119,7 @@ class Team(_HmiaStep):
         watch_team(ctx, hmia)
         for rank, robot in enumerate(hmia.robots):
             if robot in hmia.alive:
-                hmia.queue(Payload(Kind.INITIALIZE, hmia.name, robot, body={"rank": rank, "team": list(hmia.robots)}))
+                hmia.queue(robot, Payload(Kind.INITIALIZE, body={"rank": rank, "team": list(hmia.robots)}))
         hmia.initialise_sent = True
         if hmia.mode == "autonomous":
             hmia.to_offer.extend(range(len(hmia.zones)))
@@ -134,7 +134,7 @@ class Inform(_HmiaStep):
             for zone in zones:
                 hmia.owner[zone] = robot
             if robot in hmia.alive:
-                hmia.queue(Payload(Kind.INFORM, hmia.name, robot, body={
+                hmia.queue(robot, Payload(Kind.INFORM, body={
                     "zones": list(zones), "positions": [hmia.zones[z] for z in zones]}))
         hmia.informed = True
         for zone in range(len(hmia.zones)):
@@ -154,7 +154,7 @@ class Offer(_HmiaStep):
         hmia.auction = zone
         hmia.auction_at = ctx.now
         bidders = [r for r in hmia.robots if r in hmia.alive]
-        hmia.broadcast(Kind.CFP, hmia.name, bidders, zone, {"position": hmia.zones[zone], "bidders": bidders})
+        hmia.broadcast(Kind.CFP, bidders, zone, {"position": hmia.zones[zone], "bidders": bidders})
         ctx.emit("bidding.cfp", zone=zone + 1, bidders=len(bidders))
 
 
@@ -164,7 +164,7 @@ class StartMapping(_HmiaStep):
     def step(self, ctx: ActionContext, hmia: Interface) -> None:
         # mapping until the world is mapped: the RAs look out for every zone (its position in sight)
         body = {"zones": [tuple(z) for z in hmia.zones]} if hmia.until == "mapped" else None
-        hmia.broadcast(Kind.MAP, hmia.name, [r for r in hmia.robots if r in hmia.alive], body=body)
+        hmia.broadcast(Kind.MAP, [r for r in hmia.robots if r in hmia.alive], body=body)
         hmia.map_sent = ctx.now
         ctx.emit("bidding.map", owners={str(z + 1): r for z, r in sorted(hmia.owner.items())})
 
@@ -177,7 +177,7 @@ class End(_HmiaStep):
 
     def step(self, ctx: ActionContext, hmia: Interface) -> None:
         watch_team(ctx, hmia)
-        hmia.broadcast(Kind.END, hmia.name, [r for r in hmia.robots if r in hmia.alive])
+        hmia.broadcast(Kind.END, [r for r in hmia.robots if r in hmia.alive])
         hmia.end_sent = ctx.now
         report: dict[str, Any] = {"time_s": round(ctx.now - (hmia.map_sent or 0.0), 6), "points": hmia.points}
         if hmia.global_map is not None:

@@ -7,8 +7,9 @@ receivers' mailboxes in one firing. Each is recorded as a ``bidding.sent`` event
 
 from __future__ import annotations
 
-from petriflow.agents.bidding.outbox import Outbox
-from petriflow.agents.bidding.protocol import Payload
+from petriflow.agents.bidding.correspondent import Correspondent
+from petriflow.agents.bidding.protocol import token
+from petriflow.runtime.channel_models import Message
 from petriflow.runtime.action import ActionContext, ActionFailure, InstantAction, Param
 
 __all__ = ["Send", "Cast", "post"]
@@ -19,7 +20,7 @@ class Send(InstantAction):
     outbox changes: the guards reading ``outbox/<peer>`` and ``pending`` are asked again,
     not the agent's step guards.)"""
 
-    agent_state = Outbox
+    agent_state = Correspondent
     params = {"peer": Param(str, doc="the receiving agent"),
               "box": Param(str, doc="its mailbox (channel place)", places="")}
 
@@ -30,12 +31,12 @@ class Send(InstantAction):
         post(ctx, self.params["box"], message)
 
 
-def post(ctx: ActionContext, box: str, message: Payload) -> None:
+def post(ctx: ActionContext, box: str, message: Message) -> None:
     """Put ``message`` into the mailbox ``box`` as a token and record it as sent."""
-    token = message.token()
-    ctx.put(box, token)
-    ctx.emit("bidding.sent", message=message.kind.value, to=message.receiver, bytes=token["size"],
-             broadcast=message.cast)
+    data = token(message)
+    ctx.put(box, data)
+    ctx.emit("bidding.sent", message=message.kind.value, to=message.receiver, bytes=data["size"],
+             broadcast=message.data.cast)
 
 
 class Cast(InstantAction):
@@ -43,7 +44,7 @@ class Cast(InstantAction):
     mailboxes in one firing, once every copy of it is first in its receiver's queue
     (``bidding.has_cast``). Each copy is put and recorded as :class:`Send` does."""
 
-    agent_state = Outbox
+    agent_state = Correspondent
     params = {"boxes": Param(dict, doc="receiving agent -> its mailbox (channel place)", places="*")}
 
     def run(self, ctx: ActionContext) -> None:

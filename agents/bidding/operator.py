@@ -88,8 +88,8 @@ class MakeOperator(InstantAction):
                                         f" {len(zones)} once, got {[[z + 1 for z in zs] for zs in lists]}")
         mission = {"deployment": p["deployment"], "robots": robots, "zones": zones, "lists": lists}
         operator = ctx.state = Operator(ctx.agent or ctx.transition, p["hmia"], mission)
-        operator.queue(Payload(Kind.REQUEST, operator.name, p["hmia"], body={"task": "map"}))
-        operator.queue(Payload(Kind.INFORM, operator.name, p["hmia"], body={
+        operator.queue(p["hmia"], Payload(Kind.REQUEST, body={"task": "map"}))
+        operator.queue(p["hmia"], Payload(Kind.INFORM, body={
             "deployment": p["deployment"], "zones": [tuple(z) for z in zones],
             "lists": None if lists is None else [list(zs) for zs in lists], "robots": list(robots)}))
         ctx.emit("bidding.mission", deployment=p["deployment"], robots=len(robots), zones=len(zones),

@@ -7,25 +7,27 @@ bidder) and ``ALLOCATED`` (the winner tells the HMIA); ``INFORM`` (random deploy
 the operator's zone list for an RA); ``MAP`` (start mapping), ``MAPPED`` (an RA's world
 points) and ``END``.
 
-A bidding message is a :class:`Payload`, the data of one token through a channel
-place: the run carries it as any token, in the runtime's one message type
-(:class:`petriflow.runtime.channel_models.Message`, whose ``data`` it is), so the
-run's trace counts them (``core.messages``) and the ``bidding.messages`` metric counts
-them per kind. The payload names its sender and receiver because the token is all a
-receiver gets, and an agent's outgoing queues (:mod:`~petriflow.agents.bidding.outbox`)
-hold it before it is sent.
+A bidding message is the runtime's one message type
+(:class:`petriflow.runtime.channel_models.Message`: sender, receiver, data) carrying a
+:class:`Payload` (what it says: its kind, the zone, the body) as its ``data``. An agent
+queues it in its outbox (:mod:`~petriflow.agents.bidding.correspondent`) and sends it
+as the data of one token through the receiver's mailbox, a channel place
+(:meth:`token`), so the run's trace counts them (``core.messages``) and the
+``bidding.messages`` metric counts them per kind.
 
 A payload's size is what it would take on a wire: a 4-byte header (kind, sender,
 receiver, zone) plus its body (a number is 8 bytes, a list or tuple 8 per item, a
 world point two 32-bit floats).
 
 Examples:
-    >>> cfp = Payload(Kind.CFP, "hmia", "robot1", zone=2, body={"position": (1.0, 2.0)})
+    >>> from petriflow.runtime.channel_models import Message
+    >>> cfp = Payload(Kind.CFP, zone=2, body={"position": (1.0, 2.0)})
     >>> cfp.kind is Kind.CFP, cfp.size
     (True, 20)
-    >>> cfp.token()["kind"]
-    'CFP'
-    >>> Payload("HELLO", "a", "b")
+    >>> message = Message(None, "hmia", "robot1", cfp)
+    >>> message.kind, message.size, token(message)["kind"]
+    (<Kind.CFP: 'CFP'>, 20, 'CFP')
+    >>> Payload("HELLO")
     Traceback (most recent call last):
     ...
     petriflow.agents.bidding.errors.BiddingError: unknown message kind 'HELLO' (one of REQUEST, INFORM, INITIALIZE, INITIALIZED, CFP, PROPOSE, ALLOCATED, MAP, MAPPED, END)
@@ -40,8 +42,9 @@ import numpy as np
 
 from petriflow.agents.bidding.errors import BiddingError
 from petriflow.outcome import Name
+from petriflow.runtime.channel_models import Message
 
-__all__ = ["Kind", "KINDS", "Payload"]
+__all__ = ["Kind", "KINDS", "Payload", "token"]
 
 
 class Kind(Name):
@@ -69,11 +72,12 @@ SCORING = ("real",)
 
 @dataclass(frozen=True, eq=False)
 class Payload:
-    """One bidding message, as the data of a token (never changed once made).
+    """What one bidding message says (never changed once made): the ``data`` of a
+    :class:`~petriflow.runtime.channel_models.Message`, which names its sender and
+    receiver.
 
     Attributes:
         kind: a :class:`Kind` (its text is accepted).
-        sender, receiver: agent names.
         zone: the zone it is about (CFP, PROPOSE, ALLOCATED), else ``None``.
         body: anything else (a cost, a position, a zone list, world points).
         cast: the broadcast this is one copy of (``None``: a message to one agent).
@@ -82,8 +86,6 @@ class Payload:
     """
 
     kind: Kind
-    sender: str
-    receiver: str
     zone: int | None = None
     body: dict[str, Any] = field(default_factory=dict)
     cast: int | None = None
@@ -110,11 +112,7 @@ class Payload:
                 size += 8
         return size
 
-    def token(self) -> dict[str, Any]:
-        """The token data carrying it through a channel place."""
-        return {"kind": self.kind.value, "size": self.size, "message": self}
 
-    def to_token(self) -> str:
-        """What a trace records of it: its place in the token (``<Message>``, the
-        bidding message; the kind and size stand beside it)."""
-        return "<Message>"
+def token(message: Message) -> dict[str, Any]:
+    """The token data carrying ``message`` (a bidding payload's) through a mailbox."""
+    return {"kind": message.kind.value, "size": message.size, "message": message}

@@ -103,13 +103,13 @@ class Ready(_RobotStep):
             ra.odometry = Odometry(ra.robot.pose, draw_errors(STAGE_ODOM_ERROR if limits is None else limits,
                                                               ctx.rng))
         if ra.initialise is not None:
-            ra.rank = int(ra.initialise.body.get("rank", ra.rank))
-            ra.team = list(ra.initialise.body.get("team", [ra.name]))
+            ra.rank = int(ra.initialise.data.body.get("rank", ra.rank))
+            ra.team = list(ra.initialise.data.body.get("team", [ra.name]))
         ra.ranks.update({name: rank for rank, name in enumerate(ra.team)})
         watch_teammates(ctx, ra)
         ra.initialised = True
         x, y, yaw = ra.pose()
-        ra.queue(Payload(Kind.INITIALIZED, ra.name, ra.hmia, body={"pose": (x, y, yaw)}))
+        ra.queue(ra.hmia, Payload(Kind.INITIALIZED, body={"pose": (x, y, yaw)}))
         ctx.emit("bidding.ready", pose=[round(x, 3), round(y, 3), round(yaw, 4)],
                  odometry=None if ra.odometry is None else ra.odometry.to_dict()["errors"])
 
@@ -145,7 +145,7 @@ class Bid(_RobotStep):
         auction.own = cost
         others = [b for b in auction.bidders if b != ra.name]
         if others:
-            ra.broadcast(Kind.PROPOSE, ra.name, others, auction.zone, {"cost": cost, "rank": ra.rank})
+            ra.broadcast(Kind.PROPOSE, others, auction.zone, {"cost": cost, "rank": ra.rank})
         ctx.emit("bidding.bid", zone=auction.zone + 1, cost=round(cost, 6), held=held)
 
 
@@ -162,7 +162,7 @@ class Decide(_RobotStep):
         if winner_rank == ra.rank:
             if auction.zone not in ra.mine:
                 ra.mine.append(auction.zone)
-            ra.queue(Payload(Kind.ALLOCATED, ra.name, ra.hmia, zone=auction.zone, body={"cost": auction.own}))
+            ra.queue(ra.hmia, Payload(Kind.ALLOCATED, zone=auction.zone, body={"cost": auction.own}))
         ctx.emit("bidding.decided", zone=auction.zone + 1, won=winner_rank == ra.rank)
 
 

@@ -1,35 +1,45 @@
-"""An agent's outgoing queues: the bidding messages waiting to be sent, per receiver.
+"""A bidding agent as a correspondent: what it has to send, its broadcasts, its counts.
 
 An agent's mailbox (where messages arrive) is the run's: a channel place, from which
-``bidding.receive`` takes one token at a time. What an agent has still to *send* is
-part of its state: an :class:`Outbox` (the base of every bidding agent's state, kept by
-the run), one queue per receiver, oldest first, from which ``bidding.send`` and
-``bidding.cast`` put messages into the receivers' mailboxes.
+``bidding.receive`` takes one token at a time. What an agent has still to *send* waits
+in its state's :class:`~petriflow.runtime.outbox.Outbox` (the runtime's: one queue per
+receiver, oldest first), as the one message type
+(:class:`~petriflow.runtime.channel_models.Message`) carrying a bidding
+:class:`~petriflow.agents.bidding.protocol.Payload`; ``bidding.send`` and
+``bidding.cast`` put them into the receivers' mailboxes. A :class:`Correspondent` (the
+base of every bidding agent's state) adds what the bidding protocol needs besides: a
+broadcast is one message with a copy per receiver, which may leave in one firing when
+every copy is first in its queue, and the messages waiting are counted (``pending``).
 
 Examples:
     >>> from petriflow.agents.bidding.protocol import Kind, Payload
-    >>> box = Outbox()
-    >>> box.queue(Payload(Kind.CFP, "hmia", "robot1", zone=2))
-    >>> box.has_for("robot1"), box.has_for("robot2")
+    >>> hmia = Correspondent("hmia")
+    >>> hmia.queue("robot1", Payload(Kind.CFP, zone=2))
+    >>> hmia.has_for("robot1"), hmia.has_for("robot2")
     (True, False)
-    >>> box.take("robot1").size
-    4
+    >>> message = hmia.take("robot1")
+    >>> message.sender, message.receiver, message.kind, message.size
+    ('hmia', 'robot1', <Kind.CFP: 'CFP'>, 4)
 """
 
 from __future__ import annotations
 
-from collections import deque
 from typing import Any
 
 from petriflow.agents.bidding.protocol import Kind, Payload
 from petriflow.runtime.agents import AgentState
+from petriflow.runtime.channel_models import Message
+from petriflow.runtime.outbox import Outbox
 
-__all__ = ["Outbox"]
+__all__ = ["Correspondent"]
 
 
-class Outbox(AgentState):
-    """Messages waiting to be sent, per receiver (oldest first), and counts of those
-    sent and received.
+class Correspondent(AgentState):
+    """An agent's messages waiting to be sent, per receiver (oldest first: its
+    :attr:`outbox`), its broadcasts, and counts of those sent and received.
+
+    Args:
+        name: the agent.
 
     The base of an agent's state (:class:`~petriflow.runtime.agents.AgentState`, kept
     by the run, never a token). It says what changed, so guards are asked again only
@@ -48,10 +58,11 @@ class Outbox(AgentState):
       first in its receiver's queue).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, name: str = "") -> None:
         super().__init__()
+        self.name = name
         self.casts = 0
-        self.outbox: dict[str, deque[Payload]] = {}
+        self.outbox = Outbox(self)  # touches outbox/<peer> as a message is queued or taken
         self.queued = 0  # messages in the outbox, all peers together
         self.sent: dict[Kind, int] = {}
         self.received: dict[Kind, int] = {}
@@ -64,23 +75,20 @@ class Outbox(AgentState):
 
     def to_token(self) -> dict[str, Any]:
         """What a trace records of an agent's state: who it is and its message counts."""
-        return {"agent": getattr(self, "name", type(self).__name__), "casts": self.casts,
+        return {"agent": self.name or type(self).__name__, "casts": self.casts,
                 "sent": sum(self.sent.values()), "received": sum(self.received.values())}
 
-    def queue(self, message: Payload) -> None:
-        box = self.outbox.get(message.receiver)
-        if box is None:
-            box = self.outbox[message.receiver] = deque()
-        box.append(message)
+    def queue(self, receiver: str, payload: Payload) -> None:
+        """Queue ``payload`` for ``receiver`` (last), as a message from this agent."""
+        outbox = self.outbox
+        outbox.put(receiver, Message(None, self.name, receiver, payload))
         self.queued += 1
-        if len(box) == 1:
-            self._first(message.cast)
+        if outbox.waiting(receiver) == 1:
+            self._first(payload.cast)
         if self.queued == 1:
-            self.touch("outbox/" + message.receiver, "pending")
-        else:
-            self.touch("outbox/" + message.receiver)
+            self.touch("pending")
 
-    def broadcast(self, kind: Kind, sender: str, receivers: list[str], zone: int | None = None,
+    def broadcast(self, kind: Kind, receivers: list[str], zone: int | None = None,
                   body: dict[str, Any] | None = None) -> None:
         """Queue one broadcast: a copy for each receiver, all with the same ``cast``."""
         self.casts += 1
@@ -88,7 +96,7 @@ class Outbox(AgentState):
             self._cast_to[self.casts] = frozenset(receivers)
             self._heads[self.casts] = 0
         for receiver in receivers:
-            self.queue(Payload(kind, sender, receiver, zone, dict(body or {}), self.casts))
+            self.queue(receiver, Payload(kind, zone, dict(body or {}), self.casts))
 
     def track_casts(self) -> None:
         """Follow each broadcast queued from now on, so that it may leave in one firing
@@ -128,7 +136,7 @@ class Outbox(AgentState):
                 return cast
         return None
 
-    def take_cast(self, receivers: Any) -> list[Payload]:
+    def take_cast(self, receivers: Any) -> list[Message]:
         """Take the copies of the broadcast :meth:`ready_cast` names, one per receiver in
         name order (``[]`` when none is ready)."""
         cast = self.ready_cast(receivers)
@@ -136,56 +144,49 @@ class Outbox(AgentState):
             return []
         peers = sorted(self._cast_to[cast])
         self._alone(cast)
-        taken = []
-        for peer in peers:
-            box = self.outbox[peer]
-            message = box.popleft()
-            if box:
-                self._first(box[0].cast)
-            self.queued -= 1
-            self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
-            self.touch("outbox/" + peer)
-            taken.append(message)
+        taken = [self._taken(peer) for peer in peers]
         if self.queued == 0:
             self.touch("pending")
         return taken
 
     def has_for(self, peer: str) -> bool:
-        box = self.outbox.get(peer)
-        return bool(box)
+        """Whether a message waits for ``peer``."""
+        return self.outbox.waiting(peer) > 0
 
     def pending(self) -> bool:
+        """Whether any message waits (for anyone)."""
         return self.queued > 0
 
-    def take(self, peer: str) -> Payload | None:
-        box = self.outbox.get(peer)
-        if not box:
+    def take(self, peer: str) -> Message | None:
+        """The oldest message for ``peer``, taken out (``None``: nothing waits)."""
+        if not self.outbox.waiting(peer):
             return None
-        message = box.popleft()
-        self._alone(message.cast)
-        if box:
-            self._first(box[0].cast)
+        message = self._taken(peer)
+        self._alone(message.data.cast)
+        if self.queued == 0:
+            self.touch("pending")
+        return message
+
+    def _taken(self, peer: str) -> Message:
+        """The oldest message for ``peer`` out of its queue, counted as sent."""
+        outbox = self.outbox
+        message = outbox.take(peer)
+        if outbox.waiting(peer):
+            self._first(outbox[peer][0].data.cast)
         self.queued -= 1
         self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
-        if self.queued == 0:
-            self.touch("outbox/" + peer, "pending")
-        else:
-            self.touch("outbox/" + peer)
         return message
 
     def drop(self, peer: str) -> int:
         """Forget what waits for ``peer`` (it stopped); how many were dropped."""
-        box = self.outbox.pop(peer, None)
-        if not box:
-            return 0
-        for message in box:
-            self._alone(message.cast)
-        self.queued -= len(box)
-        if self.queued == 0:
-            self.touch("outbox/" + peer, "pending")
-        else:
-            self.touch("outbox/" + peer)
-        return len(box)
+        dropped = 0
+        while (message := self.outbox.take(peer)) is not None:
+            self._alone(message.data.cast)
+            dropped += 1
+        self.queued -= dropped
+        if dropped and self.queued == 0:
+            self.touch("pending")
+        return dropped
 
     def signature(self) -> Any:
         """What the agent's step guards answer by (subclasses: the next step, whether
