@@ -20,7 +20,7 @@ from __future__ import annotations
 from typing import Any
 
 from petriflow.agents.bidding.agent import Interface
-from petriflow.agents.bidding.needs import LIVE, OFFICE, office_of
+from petriflow.agents.bidding.needs import LIVE, OFFICE, Step, office_of
 from petriflow.agents.bidding.protocol import Kind, Payload
 from petriflow.capabilities import Bodies
 from petriflow.runtime.action import ActionContext, InstantAction, Param
@@ -90,20 +90,11 @@ def watch_team(ctx: ActionContext, hmia: Interface) -> None:
         ctx.emit("bidding.breakdown", robot=robot, reoffered=[z + 1 for z in lost])
 
 
-class _HmiaStep(InstantAction):
-    """A step of the HMIA's work loop: :meth:`step` changes its state, which then says
-    its next step may have changed."""
+class _HmiaStep(Step):
+    """A step of the HMIA's work loop."""
 
     agent_state = Interface
     resources = LIVE
-
-    def run(self, ctx: ActionContext) -> None:
-        hmia = ctx.state
-        self.step(ctx, hmia)
-        hmia.changed()
-
-    def step(self, ctx: ActionContext, hmia: Interface) -> None:
-        raise NotImplementedError
 
 
 class Team(_HmiaStep):

@@ -1,6 +1,6 @@
 """What the bidding actions declare of their run: the resources they read and the
 world capabilities they use (checked when a net binds; see docs/runtime.md,
-"Declared needs").
+"Declared needs"), and the base of the agents' work-loop steps (:class:`Step`).
 
 * :data:`OFFICE`: the run's office plan (the ``bidding.office`` resource, a
   :class:`~petriflow.agents.bidding.office.Plan` made from the world file's
@@ -20,10 +20,10 @@ from __future__ import annotations
 from typing import Any
 
 from petriflow.capabilities import Bodies, Physics, Poses, Stepped
-from petriflow.runtime.action import ActionContext
+from petriflow.runtime.action import ActionContext, InstantAction
 from petriflow.runtime.settings import Section, Setting
 
-__all__ = ["OFFICE", "OFFICE_SETTINGS", "LIVE", "DRIVEN", "office_of"]
+__all__ = ["OFFICE", "OFFICE_SETTINGS", "LIVE", "DRIVEN", "office_of", "Step"]
 
 #: The run's office plan, as actions declare it.
 OFFICE = {"office": "bidding.office"}
@@ -65,3 +65,17 @@ def office_of(ctx: ActionContext) -> Any:
     world has none)."""
     plan = ctx.resource("office")
     return None if plan is None else plan.office
+
+
+class Step(InstantAction):
+    """A step of an agent's work loop: :meth:`step` changes the agent's state, which then
+    says whether its next step changed (subclasses declare ``agent_state``)."""
+
+    def run(self, ctx: ActionContext) -> None:
+        state = ctx.state
+        self.step(ctx, state)
+        state.changed()
+
+    def step(self, ctx: ActionContext, state: Any) -> None:
+        """Change ``state`` (the agent's)."""
+        raise NotImplementedError

@@ -18,7 +18,7 @@ from typing import Any
 from petriflow.agents.bidding.agent import RobotAgent
 from petriflow.agents.bidding.auction import best
 from petriflow.agents.bidding.cost import AREA_M2, SPEED_M_S, Weights, bid_costs
-from petriflow.agents.bidding.needs import DRIVEN, LIVE, OFFICE, office_of
+from petriflow.agents.bidding.needs import DRIVEN, LIVE, OFFICE, Step, office_of
 from petriflow.agents.bidding.protocol import Kind, Payload
 from petriflow.runtime.action import ActionContext, ActionFailure, InstantAction, Param
 
@@ -41,19 +41,10 @@ class MakeRobot(InstantAction):
 
 
 
-class _RobotStep(InstantAction):
-    """A step of an RA's work loop: :meth:`step` changes its state, which then says its
-    next step may have changed."""
+class _RobotStep(Step):
+    """A step of an RA's work loop."""
 
     agent_state = RobotAgent
-
-    def run(self, ctx: ActionContext) -> None:
-        ra = ctx.state
-        self.step(ctx, ra)
-        ra.changed()
-
-    def step(self, ctx: ActionContext, ra: RobotAgent) -> None:
-        raise NotImplementedError
 
 
 class Ready(_RobotStep):
