@@ -38,10 +38,11 @@ import math
 from typing import Any
 
 from petriflow.agents.comm.agent import CommAgent, Peer, vertex_id
-from petriflow.agents.comm.framework import History, addresses, dhcp_pools, dpp, grid_position, grid_size
+from petriflow.agents.comm.framework import History, Packet, addresses, dhcp_pools, dpp, grid_position, grid_size
 from petriflow.agents.comm.radio import RadioChannel, pick_threshold, threshold_sweep
 
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
+from petriflow.runtime.channel_models import Message
 from petriflow.runtime.resources import LIVENESS, Liveness
 
 __all__ = [
@@ -518,8 +519,11 @@ class Listen(InstantAction):
 
 
 class Send(InstantAction):
-    """Process 5: the next message waiting for ``peer`` into the channel place towards it
-    (the packet is that place's token; the agent's work loop gets a plain token back)."""
+    """Process 5: the next packet waiting for ``peer`` into the channel place towards it:
+    the place's token is ``{"size", "payload", "code", "message"}``, ``message`` the
+    runtime's :class:`~petriflow.runtime.channel_models.Message` from this agent to the
+    peer carrying the :class:`~petriflow.agents.comm.framework.Packet` (the agent's
+    work loop gets a plain token back)."""
 
     params = {"peer": Param(str, doc="the peer agent"),
               "box": Param(str, doc="the channel place towards it", places="")}
@@ -527,12 +531,13 @@ class Send(InstantAction):
 
     def run(self, ctx: ActionContext) -> None:
         state = ctx.state
-        message = state.take(self.params["peer"])
+        peer, box = self.params["peer"], self.params["box"]
+        message = state.take(peer)
         if message is None:
-            raise ActionFailure(f"comm.send: nothing waiting for {self.params['peer']!r}")
-        state.met(self.params["peer"])  # it hears the peer here
-        ctx.put(self.params["box"], {"size": message.size, "payload": message.payload, "code": int(message.code),
-                                     "message": message})
+            raise ActionFailure(f"comm.send: nothing waiting for {peer!r}")
+        state.met(peer)  # it hears the peer here
+        ctx.put(box, {"size": message.size, "payload": message.payload, "code": int(message.code),
+                      "message": Message(box, state.name, peer, message, ctx.now)})
         ctx.emit("comm.sent", to=self.params["peer"], code=int(message.code), bytes=message.size,
                  payload=message.payload, source=message.source)
 
@@ -541,7 +546,7 @@ class Receive(InstantAction):
     """Take one message from a channel place into this agent's history and map.
 
     The token may be the run's loss notice instead (``{"lost": True, "why": ...,
-    "data": <the packet>}``: the radio model lost the frame, and the comm radio's
+    "data": <the token>}``: the radio model lost the frame, and the comm radio's
     ``on_loss`` is ``notify``): the slot goes back all the same, so the pair can talk
     again, and the lost message is kept for TCP's retransmission
     (:meth:`~petriflow.agents.comm.agent.CommAgent.keep_lost`): it is taken in, before
@@ -557,9 +562,10 @@ class Receive(InstantAction):
         notice = isinstance(packet, dict) and packet.get("lost") is True
         if notice:
             packet = packet.get("data")
-        message = packet.get("message") if isinstance(packet, dict) else None
-        if message is None:
-            raise ActionFailure(f"comm.receive: the token of {self.params['box']!r} carries no message")
+        carried = packet.get("message") if isinstance(packet, dict) else None
+        message = carried.data if isinstance(carried, Message) else None
+        if not isinstance(message, Packet):
+            raise ActionFailure(f"comm.receive: the token of {self.params['box']!r} carries no packet")
         state.acted_at = ctx.now
         sender = state.by_address(message.sender)
         name = sender.name if sender is not None else str(message.sender)

@@ -20,9 +20,9 @@ the rows that already sent that source elsewhere.
 
 Process 5, the packet header: code 0 asks how many packets are pending, 1 requests a
 number of packets, 2 begins a transmission, 3 transfers a packet at once
-(:class:`Code`; :data:`CODES` names them). :func:`plan` is Algorithm 1: towards one peer in range, a source with
-a row of pending data goes by request (codes 0, 1, 2), one never sent to that peer
-goes at once (code 3). A :class:`Packet` is a header of three bytes (code, source id,
+(:class:`Code`; :data:`CODES` names them). :func:`plan` is Algorithm 1: towards one
+peer in range, a source with a row of pending data goes by request (codes 0, 1, 2),
+one never sent to that peer goes at once (code 3). A :class:`Packet` is a header of three bytes (code, source id,
 count) and, for codes 2 and 3, five bytes per map vertex (a 1-byte id and two 16-bit
 floats, §4.1): the payload a :class:`~petriflow.runtime.channel_models.Message` carries.
 
@@ -61,6 +61,7 @@ __all__ = [
     "grid_size",
     "plan",
 ]
+
 
 class Code(enum.IntEnum):
     """A packet header's code (§3.2.5): the kind of a :class:`Packet`. An ``int`` enum: the

@@ -42,7 +42,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from petriflow.agents.slam.agent import Air, Base, Central, FrameKind, Robot, Wireless, frame, merge_seen
+from petriflow.agents.slam.agent import (Air, Base, Central, FrameKind, RadioKind, Robot, Role, Wireless, frame,
+                                         merge_seen)
 from petriflow.agents.slam.corridors import HALF_WIDTH, to_map
 from petriflow.agents.slam.history import Exchange, ReadingRule, choose, exchange_role, read_node, update
 from petriflow.capabilities import Bodies, Physics, Poses
@@ -173,7 +174,7 @@ def _evaluate(ctx: ActionContext, state: Robot, air_place: str, boot: bool = Fal
     nearest gets the RA's array if it holds fewer nodes, or gives its own if more."""
     air: Air = ctx.resource("air")
     radio = _radio(ctx, air_place)
-    heard = air.heard(state.name, radio, ("wa",), now=ctx.now)
+    heard = air.heard(state.name, radio, (RadioKind.WA,), now=ctx.now)
     in_range = any(rssi >= radio.threshold_dbm for rssi, _, _ in heard)
     if not boot and not in_range and state.installed < getattr(state, "hopper", 0) and not state.needs_wa:
         state.needs_wa = True
@@ -420,14 +421,14 @@ class Scan(Action):
         air: Air = ctx.resource("air")
         radio = _radio(ctx, p["air"])
         neighbours = []
-        for heard in air.heard(state.name, radio, ("ra", "wa"), now=ctx.now):
-            if heard[2].kind == "ra":
+        for heard in air.heard(state.name, radio, (RadioKind.RA, RadioKind.WA), now=ctx.now):
+            if heard[2].kind == RadioKind.RA:
                 state.seen[heard[1]] = ctx.now
             else:
                 neighbours.append(heard)
                 merge_seen(state.seen, heard[2].seen)
-        if state.role == "client":
-            aps = [h for h in neighbours if h[2].role == "ap"]
+        if state.role == Role.CLIENT:
+            aps = [h for h in neighbours if h[2].role == Role.AP]
             role = exchange_role(state.history.counts(), aps[0][2].counts) if aps else Exchange.GREET
             if role != Exchange.GREET:  # the nearest access point holds other nodes: exchange (Algorithm 2)
                 _, peer, beacon = aps[0]
@@ -437,15 +438,15 @@ class Scan(Action):
                 state.queue(frame(state.name, peer, kind, counts=mine, seen=dict(state.seen), **extra))
                 state.connected_at = ctx.now
                 state.exchanges += 1
-                state.role = "ap"
+                state.role = Role.AP
             elif ctx.now >= state.window_end - 1e-9:
-                state.role = "ap"
-            if state.role == "ap":
+                state.role = Role.AP
+            if state.role == Role.AP:
                 state.window_end = ctx.now + p["window"] * (1.0 + 2.0 * ctx.rng.random())
         elif ctx.now >= state.window_end - 1e-9:
             # an access point nobody joined for a while looks for one again (not in the
             # paper: with only its client-to-AP rule, every WA ends an access point)
-            state.role = "client"
+            state.role = Role.CLIENT
             state.window_end = ctx.now + p["window"]
         _publish(ctx, state)
         for ra, heard in sorted(state.seen.items()):
@@ -572,7 +573,7 @@ def _wa_hears(ctx: ActionContext, state: Wireless, data: dict[str, Any], window:
     if str(sender).startswith("wa_"):
         state.connected_at = ctx.now
         state.exchanges += 1
-    state.role = "client"
+    state.role = Role.CLIENT
     state.window_end = ctx.now + window
     _publish(ctx, state)
 

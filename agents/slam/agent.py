@@ -35,8 +35,26 @@ from petriflow.agents.slam.history import History
 from petriflow.outcome import Name
 from petriflow.runtime.agents import AgentState
 
-__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "FrameKind", "FrameSender", "Robot", "Wireless", "frame",
-           "merge_seen", "payload_size"]
+__all__ = ["make_air", "Air", "Base", "Beacon", "Central", "FrameKind", "FrameSender", "RadioKind", "Robot", "Role",
+           "Wireless", "frame", "merge_seen", "payload_size"]
+
+
+class RadioKind(Name):
+    """Whose radio a beacon is."""
+
+    RA = "ra"
+    """A robot agent's."""
+    WA = "wa"
+    """A wireless agent's (a node an RA put down)."""
+
+
+class Role(Name):
+    """A radio's Algorithm 2 role."""
+
+    CLIENT = "client"
+    """Looking for an access point to exchange with."""
+    AP = "ap"
+    """An access point: others connect to it."""
 
 
 class FrameKind(Name):
@@ -60,13 +78,13 @@ class FrameKind(Name):
 
 @dataclass
 class Beacon:
-    """What a scan hears of a radio: ``kind`` (``ra``, ``wa``), ``ssid``, ``role``
-    (``client``, ``ap``), ``counts`` (nodes per block of ids) and, for a WA, ``seen``
+    """What a scan hears of a radio: ``kind`` (:class:`RadioKind`), ``ssid``, ``role``
+    (:class:`Role`), ``counts`` (nodes per block of ids) and, for a WA, ``seen``
     (when it last heard of each RA)."""
 
-    kind: str
+    kind: RadioKind
     ssid: str
-    role: str
+    role: Role
     counts: dict[int, int]
     seen: dict[str, float] | None = None
     position: tuple[float, float] | None = None  # where a radio that does not move stands (world)
@@ -108,7 +126,7 @@ class Air:
             cached = self._moving[name] = (now, radio.position(name))
         return cached[1]
 
-    def heard(self, name: str, radio: Any, kinds: tuple[str, ...] = ("wa",),
+    def heard(self, name: str, radio: Any, kinds: tuple[RadioKind, ...] = (RadioKind.WA,),
               now: float | None = None) -> list[tuple[float, str, Beacon]]:
         """``(RSSI, radio, beacon)`` of the radios of ``kinds`` that ``name`` hears (a
         frame has some chance to pass), strongest first. ``now``: positions of moving
@@ -238,7 +256,7 @@ class Robot(FrameSender):
         return self.mode == "decentralised" or self.here is None or self.decision is not None
 
     def beacon(self) -> Beacon:
-        return Beacon("ra", self.name, "client", self.history.counts())
+        return Beacon(RadioKind.RA, self.name, Role.CLIENT, self.history.counts())
 
     def to_token(self) -> dict[str, Any]:
         return {"ra": self.name, "vertices": len(self.history), "installed": self.installed}
@@ -248,7 +266,7 @@ class Wireless(FrameSender):
     """A WA's state (see the module)."""
 
     def __init__(self, name: str, ssid: str, owner: str, position: tuple[float, float], *, radius: float = 1.0,
-                 role: str = "client") -> None:
+                 role: Role = Role.CLIENT) -> None:
         super().__init__()
         self.name = name
         self.ssid = ssid
@@ -265,7 +283,7 @@ class Wireless(FrameSender):
         self.exchanges = 0
 
     def beacon(self) -> Beacon:
-        return Beacon("wa", self.ssid, self.role, self.history.counts(), dict(self.seen), self.spot)
+        return Beacon(RadioKind.WA, self.ssid, self.role, self.history.counts(), dict(self.seen), self.spot)
 
     def to_token(self) -> dict[str, Any]:
         return {"wa": self.ssid, "role": self.role, "vertices": len(self.history)}

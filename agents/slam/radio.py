@@ -37,7 +37,7 @@ from typing import Any
 from petriflow.runtime.channels import ChannelModel, Message
 from petriflow.runtime.radio import LogDistance, fade_loss, power_for_range
 
-__all__ = ["CENTRAL", "ESP8266", "TX_AT_1M"]
+__all__ = ["CENTRAL", "ESP8266", "Esp8266Link", "TX_AT_1M"]
 
 #: The power at 1 m (dBm) that puts the loss threshold (-64 dBm) at 5 m with exponent 2.
 TX_AT_1M = power_for_range(-64.0, 5.0, exponent=2.0)
@@ -46,15 +46,28 @@ CENTRAL = "central"
 
 
 @dataclass
-class ESP8266(ChannelModel):
-    """An ESP8266 Wi-Fi link (see the module)."""
+class Esp8266Link:
+    """The ESP8266's measured link (see the module): its power at 1 m, path-loss
+    exponent and loss threshold, and its packets. The parameters every model of this
+    radio shares: the SLAM channel (:class:`ESP8266`) and the swarm's broadcast medium
+    (:class:`~petriflow.agents.swarm.radio.SwarmRadio`) add theirs."""
 
     tx_power_dbm: float = field(default=round(TX_AT_1M, 4), metadata={"range": (-200.0, 100.0)})
     exponent: float = field(default=2.0, metadata={"range": (0.5, 8.0)})
     threshold_dbm: float = field(default=-64.0, metadata={"range": (-200.0, 100.0)})
-    fade_db: float = field(default=10.0, metadata={"range": (0.0, 60.0)})
     packet_ms: float = field(default=1.88, metadata={"range": (0.0, 10_000.0)})
     packet_bytes: int = field(default=1024, metadata={"range": (1, 1_000_000)})
+
+    def packets(self, size: int) -> int:
+        """Packets a frame of ``size`` bytes takes (at least one)."""
+        return max(1, math.ceil(size / self.packet_bytes))
+
+
+@dataclass
+class ESP8266(Esp8266Link, ChannelModel):
+    """An ESP8266 Wi-Fi link (see the module)."""
+
+    fade_db: float = field(default=10.0, metadata={"range": (0.0, 60.0)})
     backbone_ms: float = field(default=10.0, metadata={"range": (0.0, 10_000.0)})
 
     def __post_init__(self) -> None:
@@ -87,7 +100,7 @@ class ESP8266(ChannelModel):
 
     def latency(self, size: int) -> float:
         """Seconds a frame of ``size`` bytes takes."""
-        return max(1, math.ceil(size / self.packet_bytes)) * self.packet_ms / 1000.0
+        return self.packets(size) * self.packet_ms / 1000.0
 
     # Positions ------------------------------------------------------------------------
     def position(self, name: str) -> tuple[float, float] | None:

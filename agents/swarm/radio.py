@@ -26,14 +26,13 @@ Examples:
 
 from __future__ import annotations
 
-import math
 from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
+from petriflow.agents.slam.radio import Esp8266Link
 from petriflow.runtime.channels import Message
 from petriflow.runtime.media import Medium, MediumPort
-from petriflow.agents.slam.radio import TX_AT_1M
 from petriflow.runtime.radio import LogDistance, RadioIndex
 
 __all__ = ["SwarmRadio", "RadioView"]
@@ -68,15 +67,11 @@ class RadioView:
 
 
 @dataclass
-class SwarmRadio(Medium):
-    """The swarm's broadcast radio (see the module)."""
+class SwarmRadio(Esp8266Link, Medium):
+    """The swarm's broadcast radio (see the module): the ESP8266's link and packets,
+    walls, and each robot's receive buffer."""
 
-    tx_power_dbm: float = field(default=round(TX_AT_1M, 4), metadata={"range": (-200.0, 100.0)})
-    exponent: float = field(default=2.0, metadata={"range": (0.5, 8.0)})
-    threshold_dbm: float = field(default=-64.0, metadata={"range": (-200.0, 100.0)})
     wall_db: float = field(default=3.0, metadata={"range": (0.0, 100.0)})
-    packet_ms: float = field(default=1.88, metadata={"range": (0.0, 10_000.0)})
-    packet_bytes: int = field(default=1024, metadata={"range": (1, 1_000_000)})
     buffer: int = field(default=256, metadata={"range": (1, 1_000_000)})
     antenna_z: float = field(default=0.1, metadata={"range": (0.0, 100.0)})
     wall_cell: float = field(default=0.0, metadata={"range": (0.0, 1000.0)})
@@ -88,7 +83,7 @@ class SwarmRadio(Medium):
 
     def airtime(self, size: int) -> float:
         """Seconds a frame of ``size`` bytes takes on the air."""
-        return round(max(1, math.ceil(size / self.packet_bytes)) * self.packet_ms / 1000.0, 9)
+        return round(self.packets(size) * self.packet_ms / 1000.0, 9)
 
     def attach(self, port: MediumPort) -> None:
         self.port = port

@@ -1,7 +1,6 @@
 """An agent's outbox: per-receiver order, and only the changed receiver's key touched."""
 
 from petriflow.runtime.agents import AgentState
-from petriflow.runtime.channel_models import Message, payload_size
 from petriflow.runtime.outbox import KEY, Outbox
 
 
@@ -27,17 +26,3 @@ def test_only_the_receiver_whose_queue_changed_is_touched():
     box.take("robot2")
     assert touched == [(KEY.format(peer="robot2"),), ("outbox/robot2",)]
 
-
-def test_a_message_takes_its_kind_and_size_from_its_payload():
-    from dataclasses import dataclass
-
-    @dataclass(frozen=True)
-    class Bid:
-        cost: float
-        kind = "PROPOSE"
-        size = 12
-
-    message = Message(None, "robot1", "robot2", Bid(3.5))
-    assert (message.kind, message.size, message.data.cost) == ("PROPOSE", 12, 3.5)
-    assert Message("box", "a", "b", {"size": 40, "kind": "MAP"}).kind == "MAP"
-    assert payload_size({"size": True}) == 16 and Message("box", "a", "b", None, 0.0, 7).size == 7

@@ -18,6 +18,7 @@ from petriflow.agents.comm.agent import CommAgent, Peer
 from petriflow.agents.comm.framework import History, Packet
 from petriflow.agents.comm.radio import RadioChannel
 from petriflow.io import load_net
+from petriflow.runtime.channel_models import Message
 from petriflow.runtime.config import load_config
 from petriflow.runtime.scheduler import Scheduler
 
@@ -45,8 +46,9 @@ def test_a_loss_notice_gives_the_slot_back_and_the_message_arrives_before_the_ne
     robot = CommAgent("robot1", "robot", address=2, history=History(2))
     robot.peers["central"] = Peer("central", 129, "box_robot1_central")
     lost = Packet(3, 128, 1, 129, 2, [(5, 4.6, 0.4)])
-    notice = {"lost": True, "why": "channel model", "data": {"size": lost.size, "payload": lost.payload,
-                                                             "code": 3, "message": lost}}
+    notice = {"lost": True, "why": "channel model",
+              "data": {"size": lost.size, "payload": lost.payload, "code": 3,
+                       "message": Message(None, "central", "robot1", lost)}}
     result, events = _receive(net, config, robot, notice)
     ends = [e.data["outcome"] for e in events if e.kind == "end"]
     assert ends == ["ok"] and result.marking["slot_central_robot1"] == 1  # the pair can talk again
@@ -55,7 +57,7 @@ def test_a_loss_notice_gives_the_slot_back_and_the_message_arrives_before_the_ne
         {"sender": "central", "code": 3, "bytes": 8, "source": 128}]
     later = Packet(3, 170, 1, 129, 2, [(6, 1.2, 0.4)])
     result, events = _receive(net, config, robot, {"size": later.size, "payload": later.payload, "code": 3,
-                                                   "message": later})
+                                                   "message": Message(None, "central", "robot1", later)})
     custom = [(e.data["name"], e.data["data"]) for e in events if e.kind == "custom"]
     assert custom == [("comm.resent", {"sender": "central", "code": 3, "source": 128}),  # first, in order
                       ("comm.learnt", {"ids": [5]}), ("comm.learnt", {"ids": [6]})]

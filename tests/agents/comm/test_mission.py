@@ -163,6 +163,7 @@ def _vertex_ids(maze_meta) -> set[int]:
 def test_send_and_receive_move_one_message_through_the_channel_place():
     from petriflow.agents.comm.agent import CommAgent, Peer
     from petriflow.agents.comm.framework import History, Packet
+    from petriflow.runtime.channel_models import Message
 
     net = load_net(examples.path("comm", "comm-decentralised-2.yaml"))
     config = load_config(examples.path("comm", "run.yaml"))
@@ -177,7 +178,8 @@ def test_send_and_receive_move_one_message_through_the_channel_place():
     on_air = [e.data for e in events if e.kind == "message"]
     assert on_air[0]["fate"] == "sent" and on_air[0]["size"] == 8 and on_air[0]["receiver"] == "robot2"
     assert not sender.outbox["robot2"]
-    packet = {"size": 8, "payload": 5, "code": 3, "message": Packet(3, 2, 1, 2, 128, [(0, 0.4, 0.4)])}
+    packet = {"size": 8, "payload": 5, "code": 3,
+              "message": Message(None, "robot1", "robot2", Packet(3, 2, 1, 2, 128, [(0, 0.4, 0.4)]))}
     receiver = CommAgent("robot2", "robot", address=128, history=History(128))
     receiver.peers["robot1"] = Peer("robot1", 2, "box_robot2_robot1")
     got, events, _ = fire(net, "robot2_receive_robot1", {"box_robot1_robot2": [packet], "robot2_listen": [None]},
