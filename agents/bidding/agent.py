@@ -10,12 +10,12 @@
   (lowest cost, ties to the smallest rank) on every CFP, then maps its zones nearest
   first, sending what its laser sees.
 
-Each is a :class:`~petriflow.agents.bidding.protocol.Mailbox`, an agent state the run
+Each is a :class:`~petriflow.agents.bidding.correspondent.Correspondent`, an agent state the run
 keeps (``ctx.state``; registered as ``bidding.operator``, ``bidding.interface`` and
-``bidding.robot``): the actions of :mod:`~petriflow.agents.bidding.actions` change
-them and the guards read them. What a guard asks costs the same whatever the team's
-size: :meth:`Interface.next_step` and :meth:`RobotAgent.next_step` read counters kept
-as messages arrive, not the team.
+``bidding.robot``): the actions (:mod:`~petriflow.agents.bidding.interface`,
+:mod:`~petriflow.agents.bidding.robot`, ...) change them and the guards read them.
+What a guard asks costs the same whatever the team's size: :meth:`Interface.next_step`
+and :meth:`RobotAgent.next_step` read counters kept as messages arrive, not the team.
 """
 
 from __future__ import annotations
@@ -24,27 +24,26 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
-from petriflow.agents.bidding.protocol import Mailbox, Message
+from petriflow.agents.bidding.correspondent import Correspondent
+from petriflow.runtime.channel_models import Message
 
 __all__ = ["Interface", "Operator", "RobotAgent", "Auction"]
 
 
-class Operator(Mailbox):
+class Operator(Correspondent):
     """The human operator: the mission it asks for."""
 
     def __init__(self, name: str, hmia: str, mission: dict[str, Any]) -> None:
-        super().__init__()
-        self.name = name
+        super().__init__(name)
         self.hmia = hmia
         self.mission = mission
 
 
-class Interface(Mailbox):
+class Interface(Correspondent):
     """The HMIA's state (see the module)."""
 
     def __init__(self, name: str) -> None:
-        super().__init__()
-        self.name = name
+        super().__init__(name)
         self.mission: dict[str, Any] | None = None
         self.requested = False
         self.robots: list[str] = []
@@ -66,7 +65,6 @@ class Interface(Mailbox):
         self.global_map: Any = None
         self.truth: Any = None
         self.points = 0
-        self.now = 0.0
         self.until = "mapped"          # END when every zone is mapped (in sight or reached), or only reached
         self.seen: set[int] = set()   # zones a robot's laser has had in sight
 
@@ -144,12 +142,11 @@ class Auction:
         self.proposals[sender] = cost
 
 
-class RobotAgent(Mailbox):
+class RobotAgent(Correspondent):
     """An RA's state (see the module)."""
 
     def __init__(self, name: str, rank: int, hmia: str) -> None:
-        super().__init__()
-        self.name = name
+        super().__init__(name)
         self.rank = rank
         self.hmia = hmia
         self.robot: Any = None        # the KinematicRobot, once initialised
@@ -178,7 +175,6 @@ class RobotAgent(Mailbox):
         self.seen: set[int] = set()           # cells sent as real returns
         self.seen_teammate: set[int] = set()  # cells sent as returns off teammates
         self.scans = 0
-        self.now = 0.0
         self.waiting = 0.0
         self.ranks[name] = rank
         self._members_of: list[str] | None = None

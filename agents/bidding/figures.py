@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from petriflow.agents.bidding.actions import MakeInterface
+from petriflow.agents.bidding.interface import MakeInterface
 
 __all__ = ["mission_map", "draw_trends"]
 

@@ -46,6 +46,7 @@ import numpy as np
 
 from petriflow.agents.bidding.errors import BiddingError
 from petriflow.agents.bidding.grid import Grid, dilate
+from petriflow.agents.bidding.needs import OFFICE_SETTINGS
 from petriflow.worldfile import COLOURS
 
 __all__ = [
@@ -392,15 +393,19 @@ class Plan:
 
 
 def plan_resource(context: Any) -> Plan | None:
-    """The ``bidding.office`` resource of a run: the :class:`Plan` of its world's
-    ``meta.office`` (``None``: no world, or a world without an office; the actions then
-    need their zones given).
+    """The ``bidding.office`` resource of a run: the :class:`Plan` of its world file's
+    ``meta.office`` (:data:`OFFICE_SETTINGS`, read and checked when the world loaded:
+    ``context.settings["office"]``); ``None``: no world, or a world without an office
+    (the actions then need their zones given).
 
     Raises:
-        BiddingError: ``meta.office`` is not an office description.
+        BiddingError: ``meta.office`` is not an office description (geometry the
+            settings' types do not catch: a box of three numbers, a size <= 0).
     """
-    meta = (getattr(context.world, "meta", None) or {}).get("office")
-    return None if meta is None else Plan(from_meta(meta))
+    values = context.settings.get(OFFICE_SETTINGS.name)
+    if values is None or values.get("size") is None:
+        return None
+    return Plan(from_meta(values))
 
 
 # Building offices ---------------------------------------------------------------------

@@ -8,30 +8,30 @@ from __future__ import annotations
 
 __all__ = ["register"]
 
-_A = "petriflow.agents.bidding.actions"
+_P = "petriflow.agents.bidding"
 ACTIONS = {
-    "bidding.operator": (f"{_A}:MakeOperator", "the operator: the mission (REQUEST, INFORM)"),
-    "bidding.interface": (f"{_A}:MakeInterface", "the interface agent's state and global map"),
-    "bidding.robot": (f"{_A}:MakeRobot", "a robot agent's state"),
-    "bidding.receive": (f"{_A}:Receive", "one message from the agent's mailbox into its state"),
-    "bidding.team": (f"{_A}:Team", "HMIA: INITIALIZE every robot agent"),
-    "bidding.inform": (f"{_A}:Inform", "HMIA, random deployment: INFORM each robot of its zones"),
-    "bidding.cfp": (f"{_A}:Offer", "HMIA: CFP, the next zone to every living robot agent"),
-    "bidding.map": (f"{_A}:StartMapping", "HMIA: MAP, mapping starts"),
-    "bidding.end": (f"{_A}:End", "HMIA: END, and the map's accuracy (eq. 10)"),
-    "bidding.ready": (f"{_A}:Ready", "RA: laser and pose; INITIALIZED"),
-    "bidding.bid": (f"{_A}:Bid", "RA: eq. 6 cost to the other bidders (PROPOSE)"),
-    "bidding.decide": (f"{_A}:Decide", "RA: lowest cost wins, ties to the smallest rank (ALLOCATED)"),
-    "bidding.explore": (f"{_A}:Explore", "RA: map its zones nearest first, laser scans (MAPPED)"),
-    "bidding.send": (f"{_A}:Send", "the next message for one peer into its mailbox"),
-    "bidding.cast": (f"{_A}:Cast", "a broadcast into every receiver's mailbox in one firing"),
-    "bidding.wait": (f"{_A}:Wait", "an agent with nothing to do waits for news"),
+    "bidding.operator": (f"{_P}.operator:MakeOperator", "the operator: the mission (REQUEST, INFORM)"),
+    "bidding.interface": (f"{_P}.interface:MakeInterface", "the interface agent's state and global map"),
+    "bidding.robot": (f"{_P}.robot:MakeRobot", "a robot agent's state"),
+    "bidding.receive": (f"{_P}.receive:Receive", "one message from the agent's mailbox into its state"),
+    "bidding.team": (f"{_P}.interface:Team", "HMIA: INITIALIZE every robot agent"),
+    "bidding.inform": (f"{_P}.interface:Inform", "HMIA, random deployment: INFORM each robot of its zones"),
+    "bidding.cfp": (f"{_P}.interface:Offer", "HMIA: CFP, the next zone to every living robot agent"),
+    "bidding.map": (f"{_P}.interface:StartMapping", "HMIA: MAP, mapping starts"),
+    "bidding.end": (f"{_P}.interface:End", "HMIA: END, and the map's accuracy (eq. 10)"),
+    "bidding.ready": (f"{_P}.robot:Ready", "RA: laser and pose; INITIALIZED"),
+    "bidding.bid": (f"{_P}.robot:Bid", "RA: eq. 6 cost to the other bidders (PROPOSE)"),
+    "bidding.decide": (f"{_P}.robot:Decide", "RA: lowest cost wins, ties to the smallest rank (ALLOCATED)"),
+    "bidding.explore": (f"{_P}.driving:Explore", "RA: map its zones nearest first, laser scans (MAPPED)"),
+    "bidding.send": (f"{_P}.mail:Send", "the next message for one peer into its mailbox"),
+    "bidding.cast": (f"{_P}.mail:Cast", "a broadcast into every receiver's mailbox in one firing"),
+    "bidding.wait": (f"{_P}.waiting:Wait", "an agent with nothing to do waits for news"),
 }
 
 
 def register(registry) -> None:
     from petriflow.agents.bidding import metrics
-    from petriflow.agents.bidding.actions import GUARDS
+    from petriflow.agents.bidding.guards import GUARDS
     from petriflow.agents.bidding.agent import Interface, Operator, RobotAgent
 
     for name, (target, doc) in ACTIONS.items():
@@ -41,5 +41,8 @@ def register(registry) -> None:
         registry.register_state(name, cls)
     for name, (function, reads) in GUARDS.items():
         registry.predicate(name, reads=reads)(function)
-    registry.register_resource("bidding.office", "petriflow.agents.bidding.office:plan_resource")
+    from petriflow.agents.bidding.needs import OFFICE_SETTINGS
+
+    registry.register_resource("bidding.office", "petriflow.agents.bidding.office:plan_resource",
+                               settings=OFFICE_SETTINGS)
     metrics.register(registry)

@@ -1,55 +1,83 @@
-"""The messages of seed 004's agents (§3.3) and the mailboxes that hold them.
+"""The messages of the bidding mission (§3.3): their kinds and their payload.
 
-Ten kinds: the operator's ``REQUEST`` and ``INFORM`` to the interface agent (HMIA);
-``INITIALIZE`` (HMIA to each robot agent, RA) and ``INITIALIZED`` back; ``CFP`` (HMIA
-offers a zone to every RA), ``PROPOSE`` (an RA's cost, to every other bidder) and
-``ALLOCATED`` (the winner tells the HMIA); ``INFORM`` (random deployment: the
-operator's zone list for an RA); ``MAP`` (start mapping), ``MAPPED`` (an RA's world
-points) and ``END``. Every message is one token through a channel place, so the run's
-trace counts them (``core.messages``) and the ``bidding.messages`` metric counts them
-per kind.
+Ten kinds (:class:`Kind`): the operator's ``REQUEST`` and ``INFORM`` to the interface
+agent (HMIA); ``INITIALIZE`` (HMIA to each robot agent, RA) and ``INITIALIZED`` back;
+``CFP`` (HMIA offers a zone to every RA), ``PROPOSE`` (an RA's cost, to every other
+bidder) and ``ALLOCATED`` (the winner tells the HMIA); ``INFORM`` (random deployment:
+the operator's zone list for an RA); ``MAP`` (start mapping), ``MAPPED`` (an RA's world
+points) and ``END``.
 
-A message's size is what it would take on a wire: a 4-byte header (kind, sender,
-receiver, zone) plus its body (a cost or a position is 8 bytes, a world point two
-32-bit floats).
+A bidding message is the runtime's one message type
+(:class:`petriflow.runtime.channel_models.Message`: sender, receiver, data) carrying a
+:class:`Payload` (what it says: its kind, the zone, the body) as its ``data``. An agent
+queues it in its outbox (:mod:`~petriflow.agents.bidding.correspondent`) and sends it
+as the data of one token through the receiver's mailbox, a channel place
+(:meth:`token`), so the run's trace counts them (``core.messages``) and the
+``bidding.messages`` metric counts them per kind.
+
+A payload's size is what it would take on a wire: a 4-byte header (kind, sender,
+receiver, zone) plus its body (a number is 8 bytes, a list or tuple 8 per item, a
+world point two 32-bit floats).
 
 Examples:
-    >>> box = Mailbox()
-    >>> box.queue(Message("CFP", "hmia", "robot1", zone=2))
-    >>> box.has_for("robot1"), box.has_for("robot2")
-    (True, False)
-    >>> box.take("robot1").size
-    4
+    >>> from petriflow.runtime.channel_models import Message
+    >>> cfp = Payload(Kind.CFP, zone=2, body={"position": (1.0, 2.0)})
+    >>> cfp.kind is Kind.CFP, cfp.size
+    (True, 20)
+    >>> message = Message(None, "hmia", "robot1", cfp)
+    >>> message.kind, message.size, token(message)["kind"]
+    (<Kind.CFP: 'CFP'>, 20, 'CFP')
+    >>> Payload("HELLO")
+    Traceback (most recent call last):
+    ...
+    petriflow.agents.bidding.errors.BiddingError: unknown message kind 'HELLO' (one of REQUEST, INFORM, INITIALIZE, INITIALIZED, CFP, PROPOSE, ALLOCATED, MAP, MAPPED, END)
 """
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from petriflow.agents.bidding.errors import BiddingError
-from petriflow.runtime.agents import AgentState
+from petriflow.outcome import Name
+from petriflow.runtime.channel_models import Message
 
-__all__ = ["KINDS", "Mailbox", "Message"]
+__all__ = ["Kind", "KINDS", "Payload", "token"]
 
-KINDS = ("REQUEST", "INFORM", "INITIALIZE", "INITIALIZED", "CFP", "PROPOSE", "ALLOCATED", "MAP", "MAPPED", "END")
 
+class Kind(Name):
+    """What a bidding message says (its text is what traces and metrics record)."""
+
+    REQUEST = "REQUEST"
+    INFORM = "INFORM"
+    INITIALIZE = "INITIALIZE"
+    INITIALIZED = "INITIALIZED"
+    CFP = "CFP"
+    PROPOSE = "PROPOSE"
+    ALLOCATED = "ALLOCATED"
+    MAP = "MAP"
+    MAPPED = "MAPPED"
+    END = "END"
+
+
+#: The ten kinds, in protocol order.
+KINDS = tuple(Kind)
 
 #: Body keys the simulator adds for scoring only (which returns were off teammates, for
-#: eq. 10): nothing a robot knows, nothing on a wire (not in :attr:`Message.size`).
+#: eq. 10): nothing a robot knows, nothing on a wire (not in :attr:`Payload.size`).
 SCORING = ("real",)
 
 
-@dataclass
-class Message:
-    """One protocol message.
+@dataclass(frozen=True, eq=False)
+class Payload:
+    """What one bidding message says (never changed once made): the ``data`` of a
+    :class:`~petriflow.runtime.channel_models.Message`, which names its sender and
+    receiver.
 
     Attributes:
-        kind: one of :data:`KINDS`.
-        sender, receiver: agent names.
+        kind: a :class:`Kind` (its text is accepted).
         zone: the zone it is about (CFP, PROPOSE, ALLOCATED), else ``None``.
         body: anything else (a cost, a position, a zone list, world points).
         cast: the broadcast this is one copy of (``None``: a message to one agent).
@@ -57,16 +85,17 @@ class Message:
             the network, delivered to every mailbox.
     """
 
-    kind: str
-    sender: str
-    receiver: str
+    kind: Kind
     zone: int | None = None
     body: dict[str, Any] = field(default_factory=dict)
     cast: int | None = None
 
     def __post_init__(self) -> None:
-        if self.kind not in KINDS:
-            raise BiddingError(f"unknown message kind {self.kind!r} (one of {', '.join(KINDS)})")
+        if not isinstance(self.kind, Kind):
+            try:
+                object.__setattr__(self, "kind", Kind(self.kind))
+            except ValueError:
+                raise BiddingError(f"unknown message kind {self.kind!r} (one of {', '.join(KINDS)})") from None
 
     @property
     def size(self) -> int:
@@ -83,183 +112,7 @@ class Message:
                 size += 8
         return size
 
-    def token(self) -> dict[str, Any]:
-        """The token data carrying it through a channel place."""
-        return {"kind": self.kind, "size": self.size, "message": self}
 
-
-class Mailbox(AgentState):
-    """Messages waiting to be sent, per receiver (oldest first), and those received.
-
-    The base of an agent's state (:class:`~petriflow.runtime.agents.AgentState`, kept
-    by the run, never a token). It says what changed, so guards are asked again only
-    when what they read did:
-
-    * ``outbox/<peer>``: a message for ``peer`` was queued, sent or dropped (the guard of
-      the send transition to that peer, ``bidding.has_message``, reads it);
-    * ``pending``: the outbox went from empty to not, or back (:meth:`pending`, which
-      costs nothing whatever the team's size: the messages waiting are counted);
-    * ``step``: the step the agent's state calls for, or whether its part is over,
-      changed (:meth:`changed`, which the agents' actions call when they end, compares
-      :meth:`signature` with what it was: a message that changes neither, a proposal
-      among many, asks no guard again);
-    * ``cast`` (once :meth:`track_casts` was called): a broadcast became ready to leave
-      in one firing, or stopped being ready (:meth:`ready_cast`: every copy of it is
-      first in its receiver's queue).
-    """
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.casts = 0
-        self.outbox: dict[str, deque[Message]] = {}
-        self.queued = 0  # messages in the outbox, all peers together
-        self.sent: dict[str, int] = {}
-        self.received: dict[str, int] = {}
-        self._signature: Any = None
-        self._track = False  # see track_casts
-        # per broadcast whose copies are all still queued: its receivers and how many of
-        # the copies are first in their queue (all of them: it may leave in one firing)
-        self._cast_to: dict[int, frozenset[str]] = {}
-        self._heads: dict[int, int] = {}
-
-    def to_token(self) -> dict[str, Any]:
-        """What a trace records of an agent's state: who it is and its message counts."""
-        return {"agent": getattr(self, "name", type(self).__name__), "casts": self.casts,
-                "sent": sum(self.sent.values()), "received": sum(self.received.values())}
-
-    def queue(self, message: Message) -> None:
-        box = self.outbox.get(message.receiver)
-        if box is None:
-            box = self.outbox[message.receiver] = deque()
-        box.append(message)
-        self.queued += 1
-        if len(box) == 1:
-            self._first(message.cast)
-        if self.queued == 1:
-            self.touch("outbox/" + message.receiver, "pending")
-        else:
-            self.touch("outbox/" + message.receiver)
-
-    def broadcast(self, kind: str, sender: str, receivers: list[str], zone: int | None = None,
-                  body: dict[str, Any] | None = None) -> None:
-        """Queue one broadcast: a copy for each receiver, all with the same ``cast``."""
-        self.casts += 1
-        if self._track and len(set(receivers)) == len(receivers) > 0:
-            self._cast_to[self.casts] = frozenset(receivers)
-            self._heads[self.casts] = 0
-        for receiver in receivers:
-            self.queue(Message(kind, sender, receiver, zone, dict(body or {}), self.casts))
-
-    def track_casts(self) -> None:
-        """Follow each broadcast queued from now on, so that it may leave in one firing
-        (:meth:`ready_cast`, :meth:`take_cast`; the ``cast`` key): for an agent whose
-        net has a ``cast`` transition."""
-        self._track = True
-
-    def _first(self, cast: int | None) -> None:
-        """A copy of broadcast ``cast`` became first in its queue (it leaves that place
-        only with the whole broadcast, or alone: :meth:`_alone`)."""
-        if cast is None or cast not in self._heads:
-            return
-        self._heads[cast] += 1
-        if self._ready(cast):
-            self.touch("cast")
-
-    def _ready(self, cast: int) -> bool:
-        """Every copy of broadcast ``cast`` is first in its queue."""
-        return self._heads[cast] == len(self._cast_to[cast])
-
-    def _alone(self, cast: int | None) -> None:
-        """Broadcast ``cast`` no longer leaves in one firing (a copy of it left alone, or
-        was dropped, or all left together): its copies go one by one."""
-        if cast is None or cast not in self._cast_to:
-            return
-        ready = self._ready(cast)
-        del self._cast_to[cast], self._heads[cast]
-        if ready:
-            self.touch("cast")
-
-    def ready_cast(self, receivers: Any) -> int | None:
-        """The broadcast to exactly ``receivers`` (a set of agent names) that can leave in
-        one firing now (:meth:`take_cast`): every copy first in its receiver's queue; or
-        ``None``."""
-        for cast, to in self._cast_to.items():  # the broadcasts in flight: a few
-            if to == receivers and self._ready(cast):
-                return cast
-        return None
-
-    def take_cast(self, receivers: Any) -> list[Message]:
-        """Take the copies of the broadcast :meth:`ready_cast` names, one per receiver in
-        name order (``[]`` when none is ready)."""
-        cast = self.ready_cast(receivers)
-        if cast is None:
-            return []
-        peers = sorted(self._cast_to[cast])
-        self._alone(cast)
-        taken = []
-        for peer in peers:
-            box = self.outbox[peer]
-            message = box.popleft()
-            if box:
-                self._first(box[0].cast)
-            self.queued -= 1
-            self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
-            self.touch("outbox/" + peer)
-            taken.append(message)
-        if self.queued == 0:
-            self.touch("pending")
-        return taken
-
-    def has_for(self, peer: str) -> bool:
-        box = self.outbox.get(peer)
-        return bool(box)
-
-    def pending(self) -> bool:
-        return self.queued > 0
-
-    def take(self, peer: str) -> Message | None:
-        box = self.outbox.get(peer)
-        if not box:
-            return None
-        message = box.popleft()
-        self._alone(message.cast)
-        if box:
-            self._first(box[0].cast)
-        self.queued -= 1
-        self.sent[message.kind] = self.sent.get(message.kind, 0) + 1
-        if self.queued == 0:
-            self.touch("outbox/" + peer, "pending")
-        else:
-            self.touch("outbox/" + peer)
-        return message
-
-    def drop(self, peer: str) -> int:
-        """Forget what waits for ``peer`` (it stopped); how many were dropped."""
-        box = self.outbox.pop(peer, None)
-        if not box:
-            return 0
-        for message in box:
-            self._alone(message.cast)
-        self.queued -= len(box)
-        if self.queued == 0:
-            self.touch("outbox/" + peer, "pending")
-        else:
-            self.touch("outbox/" + peer)
-        return len(box)
-
-    def signature(self) -> Any:
-        """What the agent's step guards answer by (subclasses: the next step, whether
-        the agent's part is over)."""
-        return None
-
-    def changed(self) -> None:
-        """The state may have changed: touch ``step`` if its :meth:`signature` did."""
-        signature = self.signature()
-        if signature != self._signature:
-            self._signature = signature
-            self.touch("step")
-
-    def clear(self) -> None:
-        """Forget every message waiting (a test's reset)."""
-        for peer in list(self.outbox):
-            self.drop(peer)
+def token(message: Message) -> dict[str, Any]:
+    """The token data carrying ``message`` (a bidding payload's) through a mailbox."""
+    return {"kind": message.kind.value, "size": message.size, "message": message}

@@ -26,7 +26,9 @@ polling it every tick: it sets :attr:`~petriflow.runtime.action.Action.wake_on` 
 generator action yields a :class:`~petriflow.runtime.action.StateChange`) and the run
 registers its firing here (:class:`Sleepers`). A :meth:`AgentState.touch` of one of
 those keys wakes it; a wait on ``"*"`` wakes on any touch, and on anything its agent's
-transitions do (as a guard reading ``"*"`` is checked again). The woken firing is
+transitions do (as a guard reading ``"*"`` is checked again). A wait on
+:data:`RUNNING` wakes when which agents of the run are running changes (a teammate
+killed, or joining late). The woken firing is
 polled at the tick a firing polled at every tick would first see the change: in the
 same instant when its poll there is still to come (the change happened in a timed
 event, or in the poll of an earlier firing), else at the next tick. So a sleeping
@@ -55,11 +57,15 @@ if TYPE_CHECKING:
     from petriflow.runtime.enabling import EnabledSet
     from petriflow.runtime.index import RunIndex
 
-__all__ = ["AgentState", "Agents", "ANY", "Sleepers", "Sleeper"]
+__all__ = ["AgentState", "Agents", "ANY", "RUNNING", "Sleepers", "Sleeper"]
 
 #: The key a guard reads (or a sleeping action waits on) to be re-checked after
 #: anything its agent does.
 ANY = ANY_KEY
+#: The key a guard reads (or a sleeping action waits on) to be re-checked when which
+#: agents of the run are running changes (a fault kills one, one joins late), whatever
+#: the agent: no state touches it, the run does (:meth:`Agents.running_changed`).
+RUNNING = "running"
 
 
 class AgentState:
@@ -148,6 +154,13 @@ class Sleepers:
         """A firing of ``agent`` started or ended: wake the firings asleep on ``"*"``."""
         self._wake(self.any.pop(agent, ()))
 
+    def woken_by(self, agent: str, key: str) -> None:
+        """Wake the firings of ``agent`` asleep on ``key`` (not those on ``"*"``: nothing
+        of the state itself changed)."""
+        keyed = self._keyed.get(agent)
+        if keyed:
+            self._wake(keyed.pop(key, ()))
+
     @staticmethod
     def _wake(entries: Iterable[tuple[Sleeper, int]]) -> None:
         for firing, nap in entries:
@@ -229,6 +242,19 @@ class Agents:
                 for t in readers.get(key, ()):
                     forget(t)
         self.sleepers.touched(agent, keys)
+
+    def running_changed(self) -> None:
+        """Which agents of the run are running changed (a fault killed one, or one
+        joined late): for every agent, forget the answers of the guards reading
+        :data:`RUNNING` and wake its firings asleep on it, so an action can sleep until a
+        teammate stops (``StateChange(RUNNING)``) instead of asking at every tick."""
+        forget = self.enabled.forget
+        for agent in self.index.agents:
+            readers = self._readers.get(agent)
+            if readers:
+                for t in readers.get(RUNNING, ()):
+                    forget(t)
+            self.sleepers.woken_by(agent, RUNNING)
 
     def acted(self, agent: str | None) -> None:
         """``agent`` did something (a firing of its started or ended, a new state):

@@ -83,7 +83,11 @@ class Firing(Scheduled):
         self.nap = 0  # the sleep on its state it is in (0: awake)
 
     def live(self, tick: int) -> bool:
-        return self.running and self.wake == tick
+        # an entry left by an earlier firing of this transition (a wake-up it no longer
+        # needed) is dead even at the tick the current firing wakes: polled there, it
+        # would poll the current firing out of firing order (its key is the older number)
+        polling = self.runner.kernel.polling
+        return self.running and self.wake == tick and (polling is None or polling == self.number)
 
     def apply(self, tick: int) -> None:
         if self.polled != tick:  # once per tick, whichever entry comes first

@@ -163,7 +163,7 @@ class Scheduler:
         running: dict[int, Firing] = {}  # the firings running now (the runner's; enabling reads it)
         states: dict[str, Any] = {}  # the agents' states (the agents'; state guards read them)
         enabled = self.enabled_set = EnabledSet(index, tokens, faults.stopped, running, states)
-        agents = Agents(index, enabled, states)
+        agents = self.agent_states = Agents(index, enabled, states)
         self.channels = Channels(net, config.channel_models(self.registry), seed, kernel=kernel, recorder=recorder,
                                  links=faults, world=world, deliver=self.deliver)
         self.resources = Resources(self.registry, ResourceContext(world, Liveness(faults.alive, index.agents), config,
@@ -248,6 +248,7 @@ class Scheduler:
         transitions = self.index.of_agent.get(agent, [])
         self.enabled_set.mark(transitions)
         self.runner.drive(self.runner.cancel(transitions))
+        self.agent_states.running_changed()
 
     def agent_lost(self, agent: str, why: str = "") -> None:
         """``agent`` (a remote one) stopped answering: its running actions end
@@ -267,6 +268,7 @@ class Scheduler:
     def agent_started(self, agent: str) -> None:
         """``agent`` started (a late joiner): its transitions may fire."""
         self.enabled_set.mark(self.index.of_agent.get(agent, ()))
+        self.agent_states.running_changed()
 
     def set_tokens(self, tokens: dict[str, list[Any]]) -> None:
         """Replace the tokens (with their data) before the run starts: ``{place: [data,

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from petriflow.io.yaml import loads_net
 from petriflow.outcome import StopReason
 from petriflow.runtime.action import Action, InstantAction, Param, StateChange, Status
-from petriflow.runtime.agents import AgentState
+from petriflow.runtime.agents import RUNNING, AgentState
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.scheduler import Scheduler
 
@@ -292,3 +292,92 @@ transitions: [{id: t, action: demo.odd, in: [i], out: [o]}]
 """)
     result = Scheduler(net, registry=made).run()
     assert result.reason == StopReason.FAILED and "yield nothing, a number of seconds or a StateChange" in result.error
+
+
+# Two edges: a sleep on RUNNING wakes when a teammate stops, and a firing's left-over
+# wake-up never polls a later firing of its transition out of firing order.
+
+class Watch(Action):
+    """Until the counter ``key`` moves, or a teammate stops (``key: running``), or
+    ``within`` s; polled at every tick (``sleeping = False``) or asleep."""
+
+    needs_world = False
+    sleeping = False
+    params = {"key": Param(str, "a"), "within": Param(float, 1.0), "peer": Param(str, "")}
+
+    def start(self, ctx):
+        self.seen = dict(ctx.state.n)
+        self.until = ctx.now + self.params["within"]
+
+    def poll(self, ctx):
+        key, peer = self.params["key"], self.params["peer"]
+        moved = ctx.state.n[key] != self.seen[key] if key != RUNNING else not ctx.running(peer)
+        if ctx.now > ctx.started and moved or ctx.now >= self.until - 1e-9:
+            ctx.result = {"at": round(ctx.now, 6)}
+            return Status.OK
+        if self.sleeping:  # moved already when it started: it ends at the next tick
+            self.wake_on, self.wake_at = (key,), ctx.now if moved else self.until - 2e-9
+        return Status.RUNNING
+
+
+class SleepingWatch(Watch):
+    sleeping = True
+
+
+def watch_events(text: str, sleeping: bool, config: dict | None = None, seed: int = 0) -> list[tuple]:
+    made = registry(sleeping)
+    made.register("demo.watch", SleepingWatch if sleeping else Watch)
+    scheduler = Scheduler(loads_net(text), registry=made, config={"dt": 0.1, **(config or {})},
+                          seed=seed)
+    seen: list[tuple] = []
+    scheduler.on_event(lambda e: seen.append((e.seq, e.kind, e.time, e.transition, repr(e.data))))
+    result = scheduler.run(until=3)
+    return seen + [(result.reason, result.time, result.firings)]
+
+
+LOOPS = """
+petriflow: 1
+subnets:
+  - id: r
+    state: demo.counts
+    places: [{id: go, tokens: 1}, a0, b0, c0, c1]
+    transitions:
+      - {id: begin, action: demo.begin, in: [go], out: [a0, b0, c0]}
+      - {id: bump, action: demo.bump_every, params: {key: a, period: 0.5, times: 4}, in: [c0], out: [c1]}
+      - {id: watch_a, action: demo.watch, params: {key: a, within: 1.0}, in: [a0], out: [a0]}
+      - {id: watch_b, action: demo.watch, params: {key: b, within: 0.5}, in: [b0], out: [b0]}
+"""
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_left_over_wake_ups_do_not_change_the_order_of_polls(seed):
+    """A watch that ends early leaves a wake-up behind; its transition's next firing,
+    woken at that same tick, is still polled in firing order: the same events as polled
+    watches."""
+    assert watch_events(LOOPS, sleeping=True, seed=seed) == watch_events(LOOPS, sleeping=False, seed=seed)
+
+
+TEAM = """
+petriflow: 1
+subnets:
+  - id: r1
+    state: demo.counts
+    places: [{id: go, tokens: 1}, s, e]
+    transitions:
+      - {id: begin, action: demo.begin, in: [go], out: [s]}
+      - {id: watch, action: demo.watch, params: {key: running, within: 5.0, peer: r2}, in: [s], out: [e]}
+  - id: r2
+    places: [{id: idle, tokens: 1}, gone]
+    transitions:
+      - {id: linger, action: core.wait, params: {seconds: 9.0}, in: [idle], out: [gone]}
+"""
+
+
+@pytest.mark.parametrize("at", [0.0, 0.35, 1.2])
+def test_a_sleep_on_running_wakes_when_a_teammate_stops(at):
+    """Asleep on RUNNING, the watch ends at the tick a watch asking every tick sees r2 stop."""
+    config = {"faults": [{"kill": "r2", "at": at}]}
+    sleeping = watch_events(TEAM, sleeping=True, config=config)
+    assert sleeping == watch_events(TEAM, sleeping=False, config=config)
+    ended = [e for e in sleeping if e[1] == "end" and e[3] == "watch"]
+    assert ended and ended[0][2] < 5.0

@@ -10,7 +10,8 @@ import pytest
 from petriflow.agents.bidding.auction import autonomous, best, random_deployment, tour
 from petriflow.agents.bidding.cost import Weights, bid_costs, cost_matrix, load_term
 from petriflow.agents.bidding.errors import BiddingError
-from petriflow.agents.bidding.protocol import KINDS, Mailbox, Message
+from petriflow.agents.bidding.correspondent import Correspondent
+from petriflow.agents.bidding.protocol import KINDS, Payload
 
 STARTS = [(6, -9), (7, -9), (8, -9), (9, -9), (10, -9)]
 ZONES = [(10.5, 8.1), (2, 8.1), (-5, 8.1), (-12.5, 8.1), (13, -8.1), (0.5, -5.5), (-8.1, -5.5), (0, 2)]
@@ -95,12 +96,12 @@ def test_tour_visits_nearest_first():
 def test_messages_have_the_ten_kinds_and_sizes():
     assert len(KINDS) == 10
     with pytest.raises(BiddingError, match="unknown message kind"):
-        Message("HELLO", "a", "b")
-    mapped = Message("MAPPED", "robot1", "hmia", body={"points": np.zeros((10, 2), np.float32), "rank": 0})
+        Payload("HELLO")
+    mapped = Payload("MAPPED", body={"points": np.zeros((10, 2), np.float32), "rank": 0})
     assert mapped.size == 4 + 80 + 8
-    box = Mailbox()
-    box.queue(Message("PROPOSE", "robot1", "robot2", zone=0, body={"cost": 1.0}))
-    box.queue(Message("PROPOSE", "robot1", "robot3", zone=0, body={"cost": 1.0}))
+    box = Correspondent()
+    box.queue("robot2", Payload("PROPOSE", zone=0, body={"cost": 1.0}))
+    box.queue("robot3", Payload("PROPOSE", zone=0, body={"cost": 1.0}))
     assert box.pending() and box.take("robot3").receiver == "robot3" and box.take("robot3") is None
     assert box.drop("robot2") == 1 and not box.pending() and box.sent == {"PROPOSE": 1}
 

@@ -11,7 +11,8 @@ from petriflow.agents.bidding.agent import Interface, Operator, RobotAgent
 from petriflow.agents.bidding.auction import autonomous
 from petriflow.agents.bidding.nets import build
 from petriflow.agents.bidding.office import paper_office
-from petriflow.agents.bidding.protocol import Message
+from petriflow.agents.bidding.protocol import Payload, token
+from petriflow.runtime.channel_models import Message
 from petriflow.analysis import check_net
 from petriflow.io import load_net
 from petriflow.io.yaml import dumps_net
@@ -140,7 +141,7 @@ def test_transitions_fire_one_at_a_time():
         _, _, run = fire(net, "hmia_create", {"hmia_start": [None]}, world=world, config=config)
         hmia = run.firer.agents.states["hmia"]
         for message in mission:
-            got, _, _ = fire(net, "hmia_receive", {"box_hmia": [message.token()], "hmia_listen": [None]},
+            got, _, _ = fire(net, "hmia_receive", {"box_hmia": [token(message)], "hmia_listen": [None]},
                              states={"hmia": hmia}, world=world, config=config)
             assert got.marking["slot_hmia"] == 1 and got.tokens["hmia_listen"] == [None]
         assert hmia.requested and hmia.robots == ["robot1", "robot2"] and len(hmia.zones) == 8
@@ -153,7 +154,7 @@ def test_transitions_fire_one_at_a_time():
         robot = run.firer.agents.states["robot1"]
 
         def receive(message):
-            fire(net, "robot1_receive", {"box_robot1": [message.token()], "robot1_listen": [None]},
+            fire(net, "robot1_receive", {"box_robot1": [token(message)], "robot1_listen": [None]},
                  states={"robot1": robot}, world=world, config=config)
 
         def step(name):
@@ -163,15 +164,16 @@ def test_transitions_fire_one_at_a_time():
         receive(hmia.outbox["robot1"][0])
         assert step("ready") == "ok"
         assert robot.initialised and robot.outbox["hmia"][0].kind == "INITIALIZED"
-        cfp = Message("CFP", "hmia", "robot1", zone=5, body={"position": (0.5, -5.5), "bidders": ["robot1", "robot2"]})
+        cfp = Message(None, "hmia", "robot1", Payload("CFP", zone=5, body={"position": (0.5, -5.5),
+                                                                  "bidders": ["robot1", "robot2"]}))
         receive(cfp)
         step("bid")
         propose = robot.outbox["robot2"][0]
-        assert propose.kind == "PROPOSE" and propose.body["cost"] == pytest.approx(((6 - 0.5) ** 2 + 3.5 ** 2) ** 0.5
-                                                                                  / 0.4 / 3)
+        cost = ((6 - 0.5) ** 2 + 3.5 ** 2) ** 0.5 / 0.4 / 3
+        assert propose.kind == "PROPOSE" and propose.data.body["cost"] == pytest.approx(cost)
         assert not robot.bids_in()  # robot2's proposal is missing
         # robot2 bids lower: robot1 loses and sends no ALLOCATED
-        receive(Message("PROPOSE", "robot2", "robot1", zone=5, body={"cost": 1.0, "rank": 1}))
+        receive(Message(None, "robot2", "robot1", Payload("PROPOSE", zone=5, body={"cost": 1.0, "rank": 1})))
         assert robot.bids_in() and robot.next_step() == "decide"
         step("decide")
         assert robot.mine == [] and [m.kind for m in robot.outbox["hmia"]] == ["INITIALIZED"]
@@ -258,7 +260,7 @@ def test_hmia_steps_and_a_robots_exploration_fire_alone():
         assert _outcome(events, "hmia_cfp") == "ok" and hmia.auction == 0
         assert result.tokens["hmia_work"] == [None]  # a plain token
         calls = [hmia.outbox[r][0] for r in ("robot1", "robot2")]
-        assert {m.kind for m in calls} == {"CFP"} and calls[0].cast == calls[1].cast  # one broadcast
+        assert {m.kind for m in calls} == {"CFP"} and calls[0].data.cast == calls[1].data.cast  # one broadcast
         hmia.clear()
         assert not hmia.pending()
         hmia.auction, hmia.to_offer = None, type(hmia.to_offer)()
@@ -272,7 +274,8 @@ def test_hmia_steps_and_a_robots_exploration_fire_alone():
         assert report["accuracy_pct"] == 100.0 and report["sigma"] == 0  # nothing mapped, nothing wrong
 
         robot = RobotAgent("robot1", 0, "hmia")
-        robot.initialise = Message("INITIALIZE", "hmia", "robot1", body={"rank": 0, "team": ["robot1", "robot2"]})
+        robot.initialise = Message(None, "hmia", "robot1",
+                                   Payload("INITIALIZE", body={"rank": 0, "team": ["robot1", "robot2"]}))
         step("robot1", "ready", robot)
         robot.clear()
         robot.mapping, robot.mine, robot.zones = True, [4], {4: (13.0, -8.1)}
@@ -281,7 +284,7 @@ def test_hmia_steps_and_a_robots_exploration_fire_alone():
         assert _outcome(events, "robot1_explore") == "ok"
         assert 0.0 < result.time <= 1.0 + 1e-9  # at most one step of 1 s
         assert robot.robot.pose != before and robot.outbox["hmia"][0].kind == "MAPPED"  # turning towards Z5
-        points = robot.outbox["hmia"][0].body["points"]
+        points = robot.outbox["hmia"][0].data.body["points"]
         assert len(points) > 50 and abs(points).max() < 17  # world points inside the office
     finally:
         world.close()

@@ -241,3 +241,47 @@ def test_draw_writes_a_png(office, tmp_path):
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
     with pytest.raises(BiddingError):
         draw(office, tmp_path / "x.png", robots=6)
+
+
+def _run_with(tmp_path, lines):
+    """Exit code and error line of the one-robot net run over a world file of ``lines``."""
+    pytest.importorskip("pybullet")
+    from petriflow import examples
+    from petriflow.cli import main
+
+    world = tmp_path / "world.yaml"
+    world.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    net = examples.path("bidding", "bidding-autonomous-1.yaml")
+    return main(["run", str(net), "--world", str(world), "--until", "0"]), world
+
+
+def _world_lines():
+    from petriflow import examples
+
+    return examples.path("bidding", "world.yaml").read_text(encoding="utf-8").splitlines()
+
+
+@pytest.mark.parametrize("setting, typo, why", [
+    ("size", "siz", "unknown setting 'siz' (did you mean 'size'?)"),
+    ("xmin", "xmn", "unknown setting 'xmn' (did you mean 'xmin'?)"),
+])
+def test_a_misspelt_office_setting_stops_the_run_at_its_line(tmp_path, capsys, setting, typo, why):
+    """meta.office is a declared settings section: a typo fails before the run, at the world file's line."""
+    lines = _world_lines()
+    office = lines.index("  office:")
+    at = next(i for i, line in enumerate(lines) if i > office and line.strip().startswith(f"{setting}:"))
+    lines[at] = lines[at].replace(f"{setting}:", f"{typo}:", 1)
+    code, world = _run_with(tmp_path, lines)
+    error = capsys.readouterr().err.strip()
+    assert code == 2 and error.startswith(f"petriflow: {world}:{at + 1}: 'meta.office"), error
+    assert why in error and "Traceback" not in error
+
+
+def test_a_mistyped_office_setting_stops_the_run_at_its_line(tmp_path, capsys):
+    """A zone that is not a list of numbers fails at its line, exit 2."""
+    lines = _world_lines()
+    lines.insert(lines.index("    zones:") + 1, "    - [north, 1.0]")
+    code, world = _run_with(tmp_path, lines)
+    error = capsys.readouterr().err.strip()
+    assert code == 2 and error.startswith(f"petriflow: {world}:"), error
+    assert "'meta.office'" in error and "north" in error, error

@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import pytest
 
-from petriflow.agents.bidding.actions import GUARDS
+from petriflow.agents.bidding.guards import GUARDS
 from petriflow.agents.bidding.agent import Auction, Interface, Operator, RobotAgent
+from petriflow.agents.bidding.needs import OFFICE_SETTINGS
 from petriflow.agents.bidding.office import Plan, paper_office, plan_resource
-from petriflow.agents.bidding.protocol import Mailbox, Message
+from petriflow.agents.bidding.correspondent import Correspondent
+from petriflow.agents.bidding.protocol import Payload
 from petriflow.runtime.agents import AgentState
 from petriflow.runtime.registry import default_registry
 from petriflow.runtime.resources import ResourceContext
@@ -22,11 +24,11 @@ def watched(state):
 
 
 def test_the_outbox_touches_the_peer_and_pending_when_it_empties_or_fills():
-    box = Mailbox()
+    box = Correspondent()
     assert isinstance(box, AgentState)
     touched = watched(box)
-    box.queue(Message("CFP", "hmia", "robot1", zone=0))
-    box.broadcast("MAP", "hmia", ["robot1", "robot2"])
+    box.queue("robot1", Payload("CFP", zone=0))
+    box.broadcast("MAP", ["robot1", "robot2"])
     assert touched == ["outbox/robot1", "pending", "outbox/robot1", "outbox/robot2"]
     assert box.pending() and box.queued == 3 and box.has_for("robot2")
     touched.clear()
@@ -117,13 +119,18 @@ class _World:
 
 def test_the_office_resource_is_the_worlds_plan_made_once_with_its_navigators():
     office = paper_office()
-    plan = plan_resource(ResourceContext(world=_World({"office": office.meta()}), liveness=None))
+
+    def made(meta):
+        return plan_resource(ResourceContext(world=_World(meta), liveness=None,
+                                             settings={"office": OFFICE_SETTINGS.read(meta.get("office"))}))
+
+    plan = made({"office": office.meta()})
     assert isinstance(plan, Plan) and plan.office == office
     assert plan.navigator(0.35) is plan.navigator(0.35) and plan.navigator(0.3) is not plan.navigator(0.35)
     assert plan_resource(ResourceContext(world=None, liveness=None)) is None
-    assert plan_resource(ResourceContext(world=_World({}), liveness=None)) is None
-    with pytest.raises(Exception, match="meta.office"):
-        plan_resource(ResourceContext(world=_World({"office": {"size": [1, 1]}}), liveness=None))
+    assert made({}) is None
+    with pytest.raises(Exception, match="must be 4 finite numbers"):
+        made({"office": {"size": [1, 1], "walls": [[0.0, 0.0, 1.0]]}})
 
 
 def test_near_reads_the_positions_once_per_step_and_misses_nobody_within_the_radius():
@@ -143,31 +150,31 @@ def test_near_reads_the_positions_once_per_step_and_misses_nobody_within_the_rad
 
 
 def test_a_broadcast_leaves_in_one_firing_once_every_copy_is_first_in_its_queue():
-    box = Mailbox()
+    box = Correspondent()
     box.track_casts()
     touched = watched(box)
     team = frozenset({"robot1", "robot2", "robot3"})
-    box.queue(Message("ALLOCATED", "robot4", "robot2", zone=1))  # robot2's queue is not free yet
-    box.broadcast("PROPOSE", "robot4", ["robot3", "robot1", "robot2"], zone=2, body={"cost": 1.0})
+    box.queue("robot2", Payload("ALLOCATED", zone=1))  # robot2's queue is not free yet
+    box.broadcast("PROPOSE", ["robot3", "robot1", "robot2"], zone=2, body={"cost": 1.0})
     assert box.ready_cast(team) is None and "cast" not in touched
     assert box.take("robot2").kind == "ALLOCATED"
     assert box.ready_cast(team) == box.casts and "cast" in touched
     assert box.ready_cast(frozenset({"robot1", "robot2"})) is None  # exactly its receivers
-    box.broadcast("PROPOSE", "robot4", ["robot1", "robot2", "robot3"], zone=3)
+    box.broadcast("PROPOSE", ["robot1", "robot2", "robot3"], zone=3)
     copies = box.take_cast(team)
-    assert [(m.receiver, m.zone) for m in copies] == [("robot1", 2), ("robot2", 2), ("robot3", 2)]
+    assert [(m.receiver, m.data.zone) for m in copies] == [("robot1", 2), ("robot2", 2), ("robot3", 2)]
     assert box.ready_cast(team) == box.casts  # the next broadcast is first everywhere now
     assert box.queued == 3 and box.sent == {"ALLOCATED": 1, "PROPOSE": 3}
     touched.clear()
-    assert box.take("robot1").zone == 3  # a copy sent alone: the rest go one by one
+    assert box.take("robot1").data.zone == 3  # a copy sent alone: the rest go one by one
     assert box.ready_cast(team) is None and "cast" in touched and box.take_cast(team) == []
-    assert [box.take(p).zone for p in ("robot2", "robot3")] == [3, 3] and not box.pending()
-    box.broadcast("END", "robot4", ["robot1", "robot2"])
+    assert [box.take(p).data.zone for p in ("robot2", "robot3")] == [3, 3] and not box.pending()
+    box.broadcast("END", ["robot1", "robot2"])
     assert box.drop("robot2") == 1 and box.ready_cast(frozenset({"robot1", "robot2"})) is None
 
 
 def test_without_track_casts_a_mailbox_follows_no_broadcast():
-    box = Mailbox()
+    box = Correspondent()
     touched = watched(box)
-    box.broadcast("MAP", "hmia", ["robot1", "robot2"])
+    box.broadcast("MAP", ["robot1", "robot2"])
     assert box.ready_cast(frozenset({"robot1", "robot2"})) is None and "cast" not in touched
