@@ -111,7 +111,7 @@ class AgentServer:
         self.actions = announcement(self.registry)
         self.inbox: queue.SimpleQueue[tuple[str, bytes]] = queue.SimpleQueue()
         self.running: dict[str, _Running] = {}
-        self.ended: dict[str, protocol.Message] = {}
+        self.ended: dict[str, protocol.BridgeMessage] = {}
         self.instances: dict[tuple[str, str, str], Action] = {}
         self.executed = 0
         self.dropped = 0
@@ -129,7 +129,7 @@ class AgentServer:
     def _receive(self, topic: str, payload: bytes) -> None:
         self.inbox.put((topic, payload))
 
-    def _send(self, agent: str, message: protocol.Message) -> None:
+    def _send(self, agent: str, message: protocol.BridgeMessage) -> None:
         self.transport.publish(from_agent(agent), protocol.encode(message))
 
     def announce(self) -> None:
@@ -244,7 +244,7 @@ class AgentServer:
             del self.running[goal_id]
             self._remember(goal_id, protocol.Cancelled(goal_id, running.goal.agent))
 
-    def _remember(self, goal_id: str, answer: protocol.Message) -> None:
+    def _remember(self, goal_id: str, answer: protocol.BridgeMessage) -> None:
         self.ended[goal_id] = answer
         if len(self.ended) > REMEMBERED:
             del self.ended[next(iter(self.ended))]

@@ -192,7 +192,7 @@ class Dispatcher:
                 state.reason = "the agent restarted while the goal ran (its outcome is unknown)"
         self._ended.notify_all()
 
-    def _apply(self, state: GoalState, message: protocol.Message, now: float) -> None:
+    def _apply(self, state: GoalState, message: protocol.BridgeMessage, now: float) -> None:
         with self._lock:
             if state.ended:
                 replayed = True

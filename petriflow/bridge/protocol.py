@@ -50,7 +50,7 @@ from petriflow.errors import PetriflowError
 from petriflow.outcome import Name
 
 __all__ = ["VERSION", "MAX_MESSAGE", "Kind", "Drop", "Refused", "Announce", "Heartbeat", "Goal", "Accepted",
-           "Rejected", "Feedback", "Result", "Cancel", "Cancelled", "Message", "About", "encode", "decode", "goal_id",
+           "Rejected", "Feedback", "Result", "Cancel", "Cancelled", "BridgeMessage", "About", "encode", "decode", "goal_id",
            "to_data"]
 
 #: The protocol version this code speaks (a message of another version is dropped).
@@ -103,14 +103,16 @@ class Refused(PetriflowError):
 
 
 @dataclass(frozen=True)
-class Message:
-    """Fields every message has (subclasses add theirs)."""
+class BridgeMessage:
+    """Fields every message of the bridge protocol has (subclasses add theirs): what
+    travels between a run and its agents, not the runtime's
+    :class:`~petriflow.runtime.channel_models.Message` between agents of a run."""
 
     kind: ClassVar[Kind]
 
 
 @dataclass(frozen=True)
-class Announce(Message):
+class Announce(BridgeMessage):
     """An agent says who it is and what it serves.
 
     Attributes:
@@ -129,7 +131,7 @@ class Announce(Message):
 
 
 @dataclass(frozen=True)
-class Heartbeat(Message):
+class Heartbeat(BridgeMessage):
     """Alive. From an agent, ``running`` lists the goal ids it is executing; the
     orchestrator's has ``agent`` ``""``."""
 
@@ -140,7 +142,7 @@ class Heartbeat(Message):
 
 
 @dataclass(frozen=True)
-class Goal(Message):
+class Goal(BridgeMessage):
     """Run ``action`` with ``params`` on ``inputs`` (``{place: [token data]}``).
 
     ``id`` is idempotent: the same goal sent again (after a reconnect) carries the same
@@ -159,7 +161,7 @@ class Goal(Message):
 
 
 @dataclass(frozen=True)
-class About(Message):
+class About(BridgeMessage):
     """A message about the goal ``id`` of ``agent`` (the answers, and a cancel)."""
 
     id: str
@@ -204,7 +206,7 @@ Accepted = _bare("Accepted", Kind.ACCEPTED, "The goal ``id`` runs.")
 Cancel = _bare("Cancel", Kind.CANCEL, "Stop the goal ``id``.")
 Cancelled = _bare("Cancelled", Kind.CANCELLED, "The goal ``id`` stopped (acknowledges :class:`Cancel`).")
 
-_TYPES: dict[str, type[Message]] = {cls.kind.value: cls for cls in
+_TYPES: dict[str, type[BridgeMessage]] = {cls.kind.value: cls for cls in
                                     (Announce, Heartbeat, Goal, Accepted, Rejected, Feedback, Result, Cancel,
                                      Cancelled)}
 _OUTCOMES = ("ok", "failed")
@@ -247,7 +249,7 @@ def to_data(value: Any, depth: int = 0) -> Any:
     return f"<{type(value).__name__}>"
 
 
-def encode(message: Message) -> bytes:
+def encode(message: BridgeMessage) -> bytes:
     """``message`` as the bytes sent (compact JSON, ``v`` and ``type`` first).
 
     Raises:
@@ -277,7 +279,7 @@ _FIELD_TYPES = {"str": str, "dict[str, Any]": dict, "dict[str, dict[str, Any]]":
                 "dict[str, list[Any]]": dict, "list[str]": list}
 
 
-def decode(data: bytes | bytearray | memoryview | str) -> Message:
+def decode(data: bytes | bytearray | memoryview | str) -> BridgeMessage:
     """The message in ``data``, checked (see the module).
 
     Raises:
