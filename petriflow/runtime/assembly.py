@@ -31,6 +31,7 @@ from typing import Any, Iterator
 from petriflow.net import Net
 from petriflow.runtime.binding import Binding
 from petriflow.runtime.clock import Clock, RealtimeClock, SimulatedClock
+from petriflow.runtime.control import Control
 from petriflow.runtime.config import RunConfig
 from petriflow.runtime.scheduler import Scheduler
 from petriflow.runtime.validation import CheckedRun, validate
@@ -41,7 +42,7 @@ __all__ = ["open_run", "CheckedRun", "validate"]
 @contextmanager
 def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunConfig | None = None, *,
              seed: int | None = None, world: Any = None, gui: bool = False, realtime: bool = False,
-             clock: Clock | None = None) -> Iterator[Scheduler]:
+             clock: Clock | None = None, control: Control | None = None) -> Iterator[Scheduler]:
     """A run put together: yields its :class:`~petriflow.runtime.scheduler.Scheduler`.
 
     Args:
@@ -53,6 +54,8 @@ def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunC
         gui: open pybullet's GUI for a world built here.
         realtime: pace the run to the wall clock (a :class:`RealtimeClock`).
         clock: the clock (overrides ``realtime``).
+        control: the run's control queue, if it is steered
+            (:class:`~petriflow.runtime.control.Control`).
     """
     if isinstance(run, Net):
         run = CheckedRun(run, binding, config or RunConfig())
@@ -66,7 +69,8 @@ def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunC
         settings = None  # read from the world given (its meta), by the scheduler
     try:
         scheduler = Scheduler(run.net, world=world, config=run.config, seed=seed, binding=run.binding,
-                              clock=clock or (RealtimeClock() if realtime else SimulatedClock()), settings=settings)
+                              clock=clock or (RealtimeClock() if realtime else SimulatedClock()), settings=settings,
+                              control=control)
         with scheduler:
             yield scheduler
     finally:

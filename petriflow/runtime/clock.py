@@ -52,12 +52,27 @@ class SimulatedClock:
 
 class RealtimeClock:
     """Paced: after each tick, wait until the wall clock has caught up with simulated
-    time (a run that is slower than real time just runs behind)."""
+    time divided by ``factor`` (a run that is slower than that just runs behind).
 
-    def __init__(self) -> None:
+    Args:
+        factor: simulated seconds per wall-clock second (2: twice as fast as real time).
+        now: the simulated time the clock starts from (a run paced from the middle on).
+    """
+
+    def __init__(self, factor: float = 1.0, now: float = 0.0) -> None:
+        if not factor > 0:
+            raise ValueError(f"a real-time factor is > 0, got {factor!r}")
+        self.factor = factor
+        self._from = now
         self._start = wallclock.perf_counter()
 
     def start(self) -> None:
+        self._start = wallclock.perf_counter()
+
+    def rebase(self, now: float) -> None:
+        """Pace from simulated time ``now`` as from this moment on (after a pause: the
+        run does not rush to catch up with the time it stood still)."""
+        self._from = now
         self._start = wallclock.perf_counter()
 
     def advance(self, kernel: Kernel, world: Any, tick: int) -> None:
@@ -65,6 +80,6 @@ class RealtimeClock:
             if world is not None:
                 world.step()
             kernel.tick += 1
-            ahead = kernel.now - (wallclock.perf_counter() - self._start)
+            ahead = (kernel.now - self._from) / self.factor - (wallclock.perf_counter() - self._start)
             if ahead > 0:
                 wallclock.sleep(ahead)
