@@ -18,7 +18,7 @@ Examples:
 from __future__ import annotations
 
 import time as wallclock
-from typing import Any, Protocol
+from typing import Any, Callable, Protocol
 
 from petriflow.runtime.kernel import Kernel
 
@@ -32,11 +32,20 @@ class Clock(Protocol):
         """The run starts now (wall-clock reference)."""
 
     def advance(self, kernel: Kernel, world: Any, tick: int) -> None:
-        """Bring ``kernel.tick`` to ``tick``, stepping ``world`` once per tick."""
+        """Bring ``kernel.tick`` to ``tick``, stepping ``world`` once per tick (or stop
+        earlier, when its ``interrupt`` says so)."""
 
 
 class SimulatedClock:
-    """As fast as the machine goes: simulated time is decoupled from the wall clock."""
+    """As fast as the machine goes: simulated time is decoupled from the wall clock.
+
+    Attributes:
+        interrupt: called after each world step; ``True`` stops the advance at that tick
+            (someone steering the run wants it to stop there, :mod:`~.control`).
+    """
+
+    def __init__(self) -> None:
+        self.interrupt: Callable[[], bool] | None = None
 
     def start(self) -> None:
         pass
@@ -45,9 +54,12 @@ class SimulatedClock:
         if world is None:
             kernel.tick = max(kernel.tick, tick)
             return
+        interrupt = self.interrupt
         while kernel.tick < tick:
             world.step()
             kernel.tick += 1
+            if interrupt is not None and interrupt():
+                return
 
 
 class RealtimeClock:
@@ -57,6 +69,9 @@ class RealtimeClock:
     Args:
         factor: simulated seconds per wall-clock second (2: twice as fast as real time).
         now: the simulated time the clock starts from (a run paced from the middle on).
+
+    Attributes:
+        interrupt: called after each tick; ``True`` stops the advance at that tick.
     """
 
     def __init__(self, factor: float = 1.0, now: float = 0.0) -> None:
@@ -65,6 +80,7 @@ class RealtimeClock:
         self.factor = factor
         self._from = now
         self._start = wallclock.perf_counter()
+        self.interrupt: Callable[[], bool] | None = None
 
     def start(self) -> None:
         self._start = wallclock.perf_counter()
@@ -83,3 +99,5 @@ class RealtimeClock:
             ahead = (kernel.now - self._from) / self.factor - (wallclock.perf_counter() - self._start)
             if ahead > 0:
                 wallclock.sleep(ahead)
+            if self.interrupt is not None and self.interrupt():
+                return

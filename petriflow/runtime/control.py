@@ -308,7 +308,8 @@ class Control:
         self.paused = paused
         self.interactive = interactive
         self.steps = 0  # firings still allowed while paused (a step)
-        self.point = 0  # checkpoints passed (where an intervention applies)
+        self.point = 0  # checkpoints passed at this instant (where an intervention applies)
+        self._at = -1.0  # the instant they are counted at
         self.closed = False
         self._queue: deque[Intervention] = deque()
         self._wakeup = threading.Condition()
@@ -317,7 +318,7 @@ class Control:
         self._signals: list[dict[str, Any]] = []  # lost messages and failures seen since the last checkpoint
         self._armed: dict[str, bool] = {}  # per place breakpoint: may trigger (its condition was false)
         self._transitions: set[str] = set()
-        self._hit_at = -1  # the checkpoint a transition breakpoint last triggered at
+        self._hit_at: tuple[float, int] | None = None  # the checkpoint a transition breakpoint last triggered at
         self._watching = False
         self.breakpoints: list[Breakpoint] = []
         for spec in breakpoints:
@@ -354,15 +355,36 @@ class Control:
         self._run = run
         run.on_event(self._observe, kinds=["message", "end"])
 
-    @property
-    def active(self) -> bool:
-        """Whether a checkpoint has anything to do (the firing loop's cheap test)."""
-        return bool(self.paused or self._queue or self._script or self._watching)
+    def interrupt(self) -> bool:
+        """The clock asks after each tick of an advance: ``True`` stops it there (paused,
+        or something queued), so that a checkpoint comes at once, not at the next
+        instant (which may be far off in a paced run)."""
+        return bool(self.interactive and (self._queue or (self.paused and not self.steps)) and not self._script)
+
+    def cut(self, now: int, tick: int, ticks_at: Any) -> int:
+        """The tick to advance to from ``now``, ``tick`` unless a replayed intervention
+        came between (the original run stopped there: :meth:`interrupt`)."""
+        if self._script:
+            at = ticks_at(self._script[0].time)
+            if now < at < tick:
+                return at
+        return tick
+
+    def _count(self) -> None:
+        """One more checkpoint at this instant (checkpoints are numbered per instant: a
+        resumed run finds the same ones)."""
+        now = self._run.now
+        if now != self._at:
+            self._at, self.point = now, 0
+        self.point += 1
 
     def admit(self, t: int) -> bool:
         """A checkpoint before transition index ``t`` fires: apply what is queued, pause
         for a breakpoint or while paused. ``False``: ``t`` can no longer fire (an
         intervention took its tokens); it is checked again with the others."""
+        if not (self.paused or self._queue or self._script or self._watching):
+            self._count()
+            return True
         changed = self._checkpoint(t)
         if self.paused and self.steps:
             self.steps -= 1
@@ -372,18 +394,18 @@ class Control:
         """A checkpoint between instants; ``True`` when an intervention changed the
         marking (the run then fires at this instant again before time moves on)."""
         if not (self.paused or self._queue or self._script or self._watching):
-            self.point += 1
+            self._count()
             return False
         return self._checkpoint(None)
 
     def _checkpoint(self, t: int | None) -> bool:
-        self.point += 1
+        self._count()
         changed = waited = False
         while True:
             before = len(self._script)
             changed |= self._drain()
             hits = self._triggers(t)
-            if self._script and self._script[0].data.get("point") == self.point:
+            if self._script and self._here(self._script[0]):
                 if len(self._script) == before and not hits:
                     head = self._script[0]
                     raise ControlError(f"the journal's control event {head.seq} ({head.data.get('action')}) does"
@@ -399,6 +421,10 @@ class Control:
                 self._run.rebase_clock()
             return changed
 
+    def _here(self, event: Event) -> bool:
+        """Whether a journaled control event was applied at this checkpoint."""
+        return event.data.get("point") == self.point and event.time == round(self._run.now, 9)
+
     def _drain(self) -> bool:
         """Apply the queued interventions (the script's, replaying); ``True`` if the
         marking changed."""
@@ -407,7 +433,7 @@ class Control:
         while True:
             if self._script:
                 event = self._script[0]
-                if event.data.get("point") != self.point or event.seq != run.recorder_count():
+                if not self._here(event) or event.seq != run.recorder_count():
                     return changed
                 self._script.popleft()
                 data = dict(event.data)
@@ -519,9 +545,10 @@ class Control:
                 self._armed[b.text] = not true
         if t is not None and self._transitions:
             name = run.transition_of(t)
-            if name in self._transitions and self._hit_at != self.point:  # once per checkpoint
+            here = (self._at, self.point)
+            if name in self._transitions and self._hit_at != here:  # once per checkpoint
                 hits.append((name, {"spec": f"transition {name}"}))
-                self._hit_at = self.point
+                self._hit_at = here
         for transition, details in hits:
             self.paused, self.steps = True, 0
             run.emit(_CONTROL, transition, None, action=Command.HIT.value, point=self.point, **details)

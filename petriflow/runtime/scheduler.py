@@ -176,6 +176,7 @@ class Scheduler:
         if control is not None:
             self.firer.control = control
             control.attach(self)
+            self.clock.interrupt = control.interrupt  # a pause stops the clock between instants too
         self._started = self._closed = self._opened = False  # _opened: the instant at tick 0 was processed
         self._watchers: list[Any] = []
         self._finished: RunResult | None = None
@@ -323,6 +324,8 @@ class Scheduler:
     def set_speed(self, factor: float) -> None:
         """Pace the run at ``factor`` times real time from now on (0: as fast as it goes)."""
         self.clock = SimulatedClock() if factor == 0 else RealtimeClock(factor, self.now)
+        if self.control is not None:
+            self.clock.interrupt = self.control.interrupt
 
     def rebase_clock(self) -> None:
         """The run stood still: a paced run goes on from now, without rushing to catch up."""
@@ -437,7 +440,10 @@ class Scheduler:
                 stop = self._stop_reason(limit)
                 if stop is not None:
                     return stop
-                self._advance(kernel.peek())
+                tick = kernel.peek()
+                if control is not None:  # a resumed run stops where an intervention came between instants
+                    tick = control.cut(kernel.tick, tick, kernel.ticks_at)
+                self._advance(tick)
                 self._instant()
         except Unrouted as exc:
             return self._end(StopReason.FAILED, str(exc.failure))
