@@ -65,7 +65,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                          ". Breakpoints: transition NAME | place NAME >= N | lost | failed. Exit 0: applied;"
                          " 1: refused by the run; 2: malformed, or the run cannot be reached.")
     ctl.add_argument("url", help="the live page's URL, with its token, as petriflow run --live printed it")
-    ctl.add_argument("words", nargs=argparse.REMAINDER, metavar="COMMAND ...", help=USAGE)
+    ctl.add_argument("words", nargs="+", metavar="COMMAND ...", help=USAGE)
     ctl.add_argument("--by", help="who asks (recorded in the trace; default: your user name)")
     ctl.add_argument("--json", action="store_true", help="print the run's whole reply as JSON")
     ctl.set_defaults(handler=cmd_ctl)
