@@ -36,7 +36,7 @@ from urllib.parse import parse_qs, urlsplit
 from petriflow.errors import PetriflowError
 from petriflow.runtime.control import Control, ControlError, Intervention
 from petriflow.runtime.trace import Event
-from petriflow.live.state import WINDOW, LiveState
+from petriflow.live.state import WINDOW, LiveState, Sample
 
 __all__ = ["LiveServer", "parse_address", "RATE", "MAX_CLIENTS", "MAX_FRAME"]
 
@@ -100,6 +100,37 @@ class LiveServer:
     def __call__(self, event: Event) -> None:
         """An observer of the run's events (``scheduler.on_event``)."""
         self._inbox.append(event)
+
+    def watch(self, scheduler: Any) -> None:
+        """Follow ``scheduler``: its rare events (``run``, ``control``, ``stop``), and
+        samples of its state after an instant at most :data:`RATE` times a second of
+        wall time, and whenever its control queue waits (a paused run)."""
+        import time as wallclock
+
+        tokens, ids, agents = scheduler.tokens, scheduler.index.ids, scheduler.index.agent
+        places, counts = tokens.places, tokens.counts
+        seen = [-1] * len(places)
+        period = 1.0 / RATE
+        last = [0.0]
+
+        def sample(*_: Any, force: bool = False) -> None:
+            now = wallclock.perf_counter()
+            if not force and now - last[0] < period:
+                return
+            last[0] = now
+            changed = {}
+            for i, n in enumerate(counts):
+                if n != seen[i]:
+                    seen[i] = n
+                    changed[places[i]] = n
+            running = tuple({"t": ids[f.index], "agent": agents[f.index], "firing": f.number,
+                             "since": f.ctx.started if f.ctx is not None else f.started}
+                            for f in scheduler.runner.in_firing_order())
+            self._inbox.append(Sample(round(scheduler.now, 9), changed, running))
+
+        scheduler.on_event(self, kinds=["run", "control", "stop"])
+        scheduler.on_instant(sample)
+        self.control.waiting.append(lambda: sample(force=True))
 
     @property
     def url(self) -> str:
@@ -256,6 +287,8 @@ class LiveServer:
             item = inbox.popleft()
             if isinstance(item, Event):
                 state.apply(item)
+            elif isinstance(item, Sample):
+                state.take(item)
             else:
                 state.control = item
 

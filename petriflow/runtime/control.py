@@ -323,8 +323,11 @@ class Control:
         self.breakpoints: list[Breakpoint] = []
         for spec in breakpoints:
             self._add(parse_breakpoint(spec))
-        #: Called with each applied intervention's event data (a live page's state).
+        #: Called with :meth:`state` when an intervention is applied or a breakpoint hits.
         self.listeners: list[Any] = []
+        #: Called (in the run's thread) when the run stops to wait (paused): a live page
+        #: samples the run's state then.
+        self.waiting: list[Any] = []
 
     # Any thread -------------------------------------------------------------------
     def submit(self, intervention: Intervention) -> Reply:
@@ -401,6 +404,7 @@ class Control:
     def _checkpoint(self, t: int | None) -> bool:
         self._count()
         changed = waited = False
+        told = -1
         while True:
             before = len(self._script)
             changed |= self._drain()
@@ -412,6 +416,11 @@ class Control:
                                        " not come where it did: this run is not the one journaled")
                 continue  # replaying: what was applied after a hit at this point comes next
             if self.paused and not self.steps and self.interactive and not self._script and not self.closed:
+                seen = self._run.recorder_count()
+                if seen != told:  # something happened since the watchers last looked
+                    told = seen
+                    for watcher in self.waiting:
+                        watcher()
                 with self._wakeup:
                     if not self._queue and not self.closed:
                         self._wakeup.wait(0.25)

@@ -168,7 +168,7 @@ def _observed(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal |
               keep_events: bool, extras: RunExtras, keep: bool, control: Control | None, server: Any) -> RunResult:
     with open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime, control=control) as scheduler:
         if server is not None:
-            scheduler.on_event(server)
+            server.watch(scheduler)
         if inputs.get("poses"):  # the world's body poses as trace events (petriflow.runtime.poses)
             from petriflow.runtime.poses import PoseSampler
 
