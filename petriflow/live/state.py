@@ -1,4 +1,4 @@
-"""What a live page shows of a run, kept up to date from samples and a few events.
+r"""What a live page shows of a run, kept up to date from samples and a few events.
 
 A run at full speed makes tens of thousands of events a second; building each one for
 a page that shows 20 updates a second would cost the run a third more CPU. So

@@ -320,6 +320,7 @@ class Control:
         self._transitions: set[str] = set()
         self._hit_at: tuple[float, int] | None = None  # the checkpoint a transition breakpoint last triggered at
         self._watching = False
+        self._observing = False  # watching the run's end and message events (lost, failed)
         self.breakpoints: list[Breakpoint] = []
         for spec in breakpoints:
             self._add(parse_breakpoint(spec))
@@ -356,7 +357,7 @@ class Control:
     def attach(self, run: Steerable) -> None:
         """Steer ``run`` (called once by the scheduler that takes this control)."""
         self._run = run
-        run.on_event(self._observe, kinds=["message", "end"])
+        self._reindex()
 
     def interrupt(self) -> bool:
         """The clock asks after each tick of an advance: ``True`` stops it there (paused,
@@ -523,6 +524,11 @@ class Control:
         self._transitions = {b.name for b in self.breakpoints if b.kind == "transition"}
         self._armed = {b.text: self._armed.get(b.text, True) for b in self.breakpoints if b.kind == "place"}
         self._watching = bool(self.breakpoints)
+        kinds = {b.kind for b in self.breakpoints} & {"lost", "failed"}
+        if kinds and not self._observing and self._run is not None:
+            # only now: watching every end and message would make the run build them all
+            self._observing = True
+            self._run.on_event(self._observe, kinds=["message", "end"])
 
     def _observe(self, event: Event) -> None:
         """Watch for lost messages and failures (the ``lost`` and ``failed`` breakpoints)."""

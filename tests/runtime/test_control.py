@@ -177,3 +177,22 @@ def test_unsteered_control_changes_no_event():
     b.on_event(with_control.append)
     b.run()
     assert [e.to_json() for e in plain] == [e.to_json() for e in with_control]
+
+
+def test_failed_breakpoint_triggers_at_each_failure_before_the_next_firing():
+    """`failed` triggers after an action ends failed, at the next checkpoint, naming it."""
+    net = loads_net("""
+petriflow: 1
+places: [{id: i, tokens: 2}, o, bad]
+transitions:
+- {id: work, action: core.fail, in: [i], out: [o], outcomes: {failed: [bad]}}
+""")
+    scheduler = Scheduler(net, seed=1, control=Control(breakpoints=["failed"]))
+    events: list = []
+    scheduler.on_event(events.append)
+    scheduler.run()
+    hits = [e for e in controls(events) if e.data["action"] == "hit"]
+    assert [(h.data["spec"], h.data["failed"]) for h in hits] == [("failed", "work")] * 2
+    ends = [e.seq for e in events if e.kind == "end"]
+    starts = [e.seq for e in events if e.kind == "start"]
+    assert ends[0] < hits[0].seq < starts[1]  # before the next firing
