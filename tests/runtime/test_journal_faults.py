@@ -132,20 +132,23 @@ def _petriflow(*argv) -> subprocess.Popen:
 
 def test_two_processes_never_write_one_journal(tmp_path):
     """A second process on a journal in use (a new run on its file, or a second resume)
-    gets one line and exit 2; the first finishes the journal alone, event for event."""
+    gets one line and exit 2; the journal, resumed alone, ends event for event as the
+    whole run."""
     net = tmp_path / "ticker.yaml"
     net.write_text(TICKER)
-    # 4 s of real time: enough for the rival processes to start while it runs, on a busy machine too
-    run_files(net, until=4.0, trace=tmp_path / "whole.jsonl")
+    # 60 s of real time: the rivals start while it runs however busy the machine is; the
+    # real-time processes are killed once the rivals have been refused, and a last resume
+    # (simulated time) finishes the run in a moment
+    run_files(net, until=60.0, trace=tmp_path / "whole.jsonl")
     whole = (tmp_path / "whole.jsonl").read_text().splitlines()
     db = tmp_path / "run.sqlite"
-    first = _petriflow("run", net, "--until", "4", "--db", db, "--realtime", "--trace", tmp_path / "a.jsonl")
+    first = _petriflow("run", net, "--until", "60", "--db", db, "--realtime", "--trace", tmp_path / "a.jsonl")
     try:
         _wait_for_events(db, 4, first)
         second = _petriflow("run", net, "--until", "1", "--db", db, "--trace", tmp_path / "b.jsonl")
         assert second.wait(60) == 2 and "already exists" in second.stderr.read()
-        os.kill(first.pid, signal.SIGKILL)  # killed mid-run: now two resumes race
     finally:
+        os.kill(first.pid, signal.SIGKILL)  # killed mid-run: now two resumes race
         first.wait(60)
     resumed = _petriflow("run", "--resume", "--db", db, "--realtime")
     try:
@@ -154,7 +157,10 @@ def test_two_processes_never_write_one_journal(tmp_path):
         err = rival.communicate(timeout=60)[1]
         assert rival.returncode == 2 and "in use by another run" in err and err.count("\n") == 1, err
     finally:
-        assert resumed.wait(60) == 0, resumed.stderr.read()
+        os.kill(resumed.pid, signal.SIGKILL)
+        resumed.wait(60)
+    last = _petriflow("run", "--resume", "--db", db)
+    assert last.wait(120) == 0, last.stderr.read()
     assert (tmp_path / "a.jsonl").read_text().splitlines() == whole
     assert _journal_seqs(db) == list(range(len(whole)))
     assert not (tmp_path / "b.jsonl").exists()
