@@ -309,7 +309,7 @@ class Control:
         self.interactive = interactive
         self.steps = 0  # firings still allowed while paused (a step)
         self.point = 0  # checkpoints passed at this instant (where an intervention applies)
-        self._at = -1.0  # the instant they are counted at
+        self._at = 0.0  # the instant they are counted at
         self.closed = False
         self._queue: deque[Intervention] = deque()
         self._wakeup = threading.Condition()
@@ -374,20 +374,17 @@ class Control:
                 return at
         return tick
 
-    def _count(self) -> None:
-        """One more checkpoint at this instant (checkpoints are numbered per instant: a
-        resumed run finds the same ones)."""
-        now = self._run.now
-        if now != self._at:
-            self._at, self.point = now, 0
-        self.point += 1
+    def new_instant(self, now: float) -> None:
+        """Time moved on to ``now``: checkpoints are numbered per instant (so a resumed
+        run finds the same ones)."""
+        self._at, self.point = now, 0
 
     def admit(self, t: int) -> bool:
         """A checkpoint before transition index ``t`` fires: apply what is queued, pause
         for a breakpoint or while paused. ``False``: ``t`` can no longer fire (an
         intervention took its tokens); it is checked again with the others."""
         if not (self.paused or self._queue or self._script or self._watching):
-            self._count()
+            self.point += 1
             return True
         changed = self._checkpoint(t)
         if self.paused and self.steps:
@@ -398,12 +395,12 @@ class Control:
         """A checkpoint between instants; ``True`` when an intervention changed the
         marking (the run then fires at this instant again before time moves on)."""
         if not (self.paused or self._queue or self._script or self._watching):
-            self._count()
+            self.point += 1
             return False
         return self._checkpoint(None)
 
     def _checkpoint(self, t: int | None) -> bool:
-        self._count()
+        self.point += 1
         changed = waited = False
         told = -1
         while True:

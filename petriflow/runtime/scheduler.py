@@ -379,6 +379,8 @@ class Scheduler:
     def _advance(self, tick: int) -> None:
         self.clock.advance(self.kernel, self.world, tick)
         self.firer.new_instant()
+        if self.control is not None:
+            self.control.new_instant(self.kernel.now)
 
     def _instant(self, fire: bool = True) -> None:
         """Process the current tick: due polls and events, then the firings."""
