@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from petriflow.capabilities import Bodies, Physics, Poses
 from petriflow.runtime.action import Action, ActionFailure, Param, Status
 
 __all__ = ["DiffDrive", "GoTo", "wheel_speeds", "heading_error"]
@@ -106,6 +107,7 @@ class GoTo(Action):
     }
     needs_world = True
     requires = frozenset({"world", "robot"})
+    uses = (Physics, Bodies, Poses)
 
     def setup(self, world: Any) -> None:
         if world is None:

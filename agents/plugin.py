@@ -31,4 +31,6 @@ def register(registry) -> None:
         registry.register(name, target, doc=doc)
     for name, function in GUARDS.items():
         registry.predicate(name)(function)
-    registry.register_resource("smart.arena", "petriflow.agents.smart.arena:arena_resource")
+    from petriflow.agents.smart.arena import SMART
+
+    registry.register_resource("smart.arena", "petriflow.agents.smart.arena:arena_resource", settings=SMART)

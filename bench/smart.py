@@ -7,8 +7,8 @@ only when a capture transition (T0, T2) fires. Prints Markdown tables: simulated
 wall seconds, the real-time factor (simulated seconds per wall second) against the
 targets (>= 1x at 640 x 480, >= 3x at 320 x 240), and the split of the wall time
 into render / vision / planning / physics / gait control / net
-(:class:`petriflow.agents.smart.timing.Timers` wraps those functions; the rest is the
-net: scheduler, guards, token data and trace events).
+(:class:`petriflow.agents.smart.timing.Timers`, the run's stopwatch, to which those
+parts report; the rest is the net: scheduler, guards, token data and trace events).
 
 Run: ``python bench/smart.py`` (``--quick`` for a short smoke run: 5 s simulated,
 ``--json OUT`` to keep the numbers).
@@ -41,7 +41,7 @@ def measure(size: tuple[int, int], until: float | None, folder: Path) -> dict:
     warm_up()  # numba's compilation is not part of the run
     kwargs = {} if until is None else {"until": until}
     with Timers() as timers:
-        outcome = run_files(NETS / "smart.yaml", world=world, seed=1, **kwargs)
+        outcome = run_files(NETS / "smart.yaml", world=world, seed=1, stopwatch=timers, **kwargs)
     result = outcome.result
     split = timers.split(outcome.wall)
     renders = timers.calls["render"]

@@ -8,20 +8,26 @@ that the run's world provides every one (``file:line`` and the missing members),
 it checks parameters and places, so an action never probes its world with
 ``getattr``/``hasattr``: what it declared is there.
 
-==================  ===========================================================  =======================
-capability          what the action may use                                      :class:`~petriflow.world.World`
-==================  ===========================================================  =======================
-:class:`Distances`  ``distance``                                                  yes
-:class:`Poses`      ``pose``, ``position`` (and ``distance``)                     yes
-:class:`Bodies`     ``bodies``, ``agents``, ``body``, ``remove``                  yes
-:class:`RayTests`   ``rays``, ``request_rays``, ``flush_sensors``                 yes
-:class:`Cameras`    ``cameras``, ``camera``                                       yes
-:class:`KinematicDrive`  ``command``, ``set_pose``, ``is_kinematic``              yes
-:class:`Physics`    ``p`` (the pybullet module), ``client``, ``sync``             yes
-==================  ===========================================================  =======================
+=======================  ======================================================================  ===============================
+capability               what the action may use                                                 :class:`~petriflow.world.World`
+=======================  ======================================================================  ===============================
+:class:`Distances`       ``distance``                                                            yes
+:class:`Positions`       ``position`` (and ``distance``)                                         yes
+:class:`Poses`           ``pose`` (and ``position``, ``distance``)                               yes
+:class:`Bodies`          ``bodies``, ``agents``, ``body``, ``remove``                            yes
+:class:`RayTests`        ``rays``, ``request_rays``, ``flush_sensors``                           yes
+:class:`Cameras`         ``cameras``, ``camera``                                                 yes
+:class:`KinematicDrive`  ``command``, ``set_pose``, ``is_kinematic``                             yes
+:class:`Physics`         ``p`` (the pybullet module), ``client``, ``sync``                       yes
+:class:`PoseArrays`      ``mode``, ``poses``, ``active``, ``agents``, ``row``, ``is_kinematic``  yes
+:class:`Described`       ``meta``, ``path`` (settings: :mod:`petriflow.runtime.settings`)        yes
+=======================  ======================================================================  ===============================
 
 A world made in code (a test double, another simulator) provides what its class
-defines; :func:`missing` says what it lacks.
+defines; :func:`missing` says what it lacks. Code that works with and without a
+capability (a channel model that counts walls only where the world places its agents)
+asks once, with :func:`provides` (or ``isinstance(world, Poses)``: the protocols are
+runtime-checkable), and keeps the answer; it never probes the world member by member.
 
 Examples:
     >>> class Flatland:
@@ -32,16 +38,19 @@ Examples:
     ['position', 'distance']
     >>> missing(Flatland(), Stepped), name_of(RayTests)
     ([], 'ray tests')
+    >>> provides(Flatland(), Stepped), provides(Flatland(), Poses), provides(None, Stepped)
+    (True, False, False)
 """
 
 from __future__ import annotations
 
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
-__all__ = ["Stepped", "Distances", "Poses", "Bodies", "RayTests", "Cameras", "KinematicDrive", "Physics", "Described",
-           "missing", "name_of", "CAPABILITIES"]
+__all__ = ["Stepped", "Distances", "Positions", "Poses", "Bodies", "RayTests", "Cameras", "KinematicDrive", "Physics", "Described",
+           "PoseArrays", "missing", "provides", "name_of", "CAPABILITIES"]
 
 
+@runtime_checkable
 class Stepped(Protocol):
     """What every world gives a run: its physics step and a way to advance it."""
 
@@ -52,6 +61,7 @@ class Stepped(Protocol):
         """Advance the world by ``dt``."""
 
 
+@runtime_checkable
 class Distances(Protocol):
     """How far apart agents' robots are (what a radio channel model reads)."""
 
@@ -59,16 +69,24 @@ class Distances(Protocol):
         """Metres between two agents' robots (``None`` if either has none)."""
 
 
-class Poses(Distances, Protocol):
-    """Where bodies and agents' robots are (and so how far apart: :class:`Distances`)."""
-
-    def pose(self, name: str) -> tuple[float, float, float]:
-        """``(x, y, yaw)`` of a body or an agent's robot."""
+@runtime_checkable
+class Positions(Distances, Protocol):
+    """Where agents' robots stand on the ground (and so how far apart: :class:`Distances`)."""
 
     def position(self, agent: str) -> tuple[float, float] | None:
         """``(x, y)`` of an agent's robot, ``None`` if the agent has no body."""
 
 
+@runtime_checkable
+class Poses(Positions, Protocol):
+    """Where bodies and agents' robots are, and which way they face (and where they
+    stand: :class:`Positions`)."""
+
+    def pose(self, name: str) -> tuple[float, float, float]:
+        """``(x, y, yaw)`` of a body or an agent's robot."""
+
+
+@runtime_checkable
 class Bodies(Protocol):
     """The world's bodies by name."""
 
@@ -84,6 +102,7 @@ class Bodies(Protocol):
         """Take a body (or an agent's robot) out of the scene."""
 
 
+@runtime_checkable
 class RayTests(Protocol):
     """Rays cast into the scene (range sensors, line of sight)."""
 
@@ -97,6 +116,7 @@ class RayTests(Protocol):
         """Cast every pending ray request now."""
 
 
+@runtime_checkable
 class Cameras(Protocol):
     """Fixed cameras that render frames."""
 
@@ -107,6 +127,7 @@ class Cameras(Protocol):
         """A camera by id."""
 
 
+@runtime_checkable
 class KinematicDrive(Protocol):
     """Robots driven by commanded velocities."""
 
@@ -120,6 +141,7 @@ class KinematicDrive(Protocol):
         """Whether a body (or an agent's robot) moves kinematically."""
 
 
+@runtime_checkable
 class Physics(Protocol):
     """The physics simulator itself, for actions that call pybullet directly."""
 
@@ -132,6 +154,7 @@ class Physics(Protocol):
         """Write the kinematic robots' poses to the simulator before reading it."""
 
 
+@runtime_checkable
 class Described(Protocol):
     """A world built from a world file, which keeps the file's ``meta`` (its scenario
     settings, read through declared sections: :mod:`petriflow.runtime.settings`)."""
@@ -142,10 +165,31 @@ class Described(Protocol):
     """The world file (named in errors)."""
 
 
+@runtime_checkable
+class PoseArrays(Protocol):
+    """The kinematic robots' poses as arrays, one row per robot (what vectorised code,
+    such as a radio that finds who hears whom for every robot at once, reads)."""
+
+    mode: str
+    """``kinematic`` (the arrays are the robots' poses) or ``dynamic``."""
+    poses: Any
+    """``(robots, 3)`` array of ``x, y, yaw``."""
+    active: Any
+    """``(robots,)`` boolean array: the rows of robots still in the scene."""
+    agents: dict[str, str]
+    """``{agent: body name}`` of the agents' robots."""
+
+    def row(self, name: str) -> int:
+        """The row of a kinematic robot (a body or an agent's)."""
+
+    def is_kinematic(self, name: str) -> bool:
+        """Whether a body (or an agent's robot) moves kinematically."""
+
+
 #: The capabilities an action may declare, with the words errors use for them.
 CAPABILITIES: dict[type, str] = {
-    Stepped: "steps", Distances: "distances", Poses: "poses", Bodies: "bodies", RayTests: "ray tests", Cameras: "cameras",
-    KinematicDrive: "kinematic drive", Physics: "physics", Described: "world file",
+    Stepped: "steps", Distances: "distances", Positions: "positions", Poses: "poses", Bodies: "bodies", RayTests: "ray tests", Cameras: "cameras",
+    KinematicDrive: "kinematic drive", Physics: "physics", Described: "world file", PoseArrays: "pose arrays",
 }
 
 
@@ -176,6 +220,18 @@ def missing(world: Any, capability: type) -> list[str]:
             annotated.update(getattr(klass, "__annotations__", {}))
         return [name for name in _members(capability) if not hasattr(world, name) and name not in annotated]
     return [name for name in _members(capability) if not hasattr(world, name)]
+
+
+def provides(world: Any, *capabilities: type) -> bool:
+    """Whether ``world`` (an object or a class; ``None``: no world) provides every one of
+    ``capabilities``: the one check of an optional capability.
+
+    Examples:
+        >>> from petriflow.world import World
+        >>> provides(World, Poses, RayTests, Cameras), provides(None, Poses)
+        (True, False)
+    """
+    return world is not None and all(not missing(world, capability) for capability in capabilities)
 
 
 def name_of(capability: type) -> str:

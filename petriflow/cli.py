@@ -318,7 +318,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                                 until=args.until, trace=args.trace, xes=args.xes, db=args.db, poses=args.poses,
                                 realtime=args.realtime, gui=args.gui, progress=_progress(args),
                                 max_firings=args.max_firings, metrics=_metric_names(args.metrics),
-                                picture=args.picture, live=live)
+                                picture=args.picture, wait_agents=args.wait_agents, live=live)
     except BaseException:
         if made_up_trace is not None:  # the page's made-up trace, in a folder of its own
             shutil.rmtree(made_up_trace.parent, ignore_errors=True)
@@ -527,6 +527,9 @@ def build_parser() -> argparse.ArgumentParser:
                      " start the run from its beginning, saying so)")
     run.add_argument("--realtime", action="store_true", help="pace simulated time to the wall clock")
     run.add_argument("--gui", action="store_true", help="open pybullet's GUI (needs a display)")
+    run.add_argument("--wait-agents", type=limits.number_argument, metavar="SECONDS",
+                     help="a bridged run: wait this long for its remote agents before binding (default: the"
+                     " configuration's bridge: wait)")
     from petriflow.view.command import add_parser as add_view, add_run_options
 
     add_run_options(run)
@@ -580,9 +583,11 @@ def build_parser() -> argparse.ArgumentParser:
                        " them); default 100,000,000 steps (about 0.2 s) for P-semiflows and, for"
                        " T-semiflows, 100 steps per state and edge explored (10,000,000 to"
                        " 100,000,000); beyond it they are 'not computed (over budget)'")
+    from petriflow.bridge.command import add_parser as add_bridge
     from petriflow.sweep.command import add_parser as add_sweep
 
     add_sweep(sub)
+    add_bridge(sub)
     add_view(sub)
     from petriflow.live.command import add_parser as add_ctl
 

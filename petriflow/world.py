@@ -209,6 +209,10 @@ class World:
     meta: dict[str, Any]
     #: The description's file (``None``: built in code).
     path: str | None
+    #: ``dynamic`` or ``kinematic`` (see the module).
+    mode: str
+    #: ``(robots, 3)``: the kinematic robots' ``x, y, yaw``, one row each.
+    poses: Any
 
     def __init__(self, description: dict[str, Any] | None = None, *, base: str | Path = ".",
                  gui: bool = False, path: str | None = None) -> None:

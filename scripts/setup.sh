@@ -20,6 +20,8 @@ command -v chromium >/dev/null 2>&1 || packages+=(chromium)
 command -v chromedriver >/dev/null 2>&1 || packages+=(chromium-driver)
 # Node.js runs the page's pure replay script in the tests (tests/view/test_replay_js.py)
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
+# the MQTT broker the bridge's tests start on loopback (docs/bridge.md); Zenoh needs none
+command -v mosquitto >/dev/null 2>&1 || [ -x /usr/sbin/mosquitto ] || packages+=(mosquitto)
 if [ ! -x .venv/bin/python ] && ! "$PYTHON" -c 'import ensurepip, venv' >/dev/null 2>&1; then
     packages+=("python3-venv")
 fi

@@ -26,6 +26,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from petriflow.capabilities import Cameras
 from petriflow.errors import PetriflowError
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
 
@@ -59,7 +60,7 @@ class Frame(np.ndarray):
         self.camera = getattr(obj, "camera", None)
 
 
-def camera_for(world: Any, camera: str | None = None, width: int | None = None,
+def camera_for(world: Cameras, camera: str | None = None, width: int | None = None,
                height: int | None = None) -> Any:
     """A world's camera, resized if ``width``/``height`` differ from its own.
 
@@ -84,7 +85,7 @@ def camera_for(world: Any, camera: str | None = None, width: int | None = None,
         >>> world.close()
     """
     if camera is None:
-        cameras = list(getattr(world, "cameras", {}))
+        cameras = list(world.cameras)
         if len(cameras) != 1:
             names = ", ".join(cameras) or "none"
             raise ValueError(f"say which camera: the world has {len(cameras)} ({names})")
@@ -116,6 +117,7 @@ class Capture(Action):
     }
     needs_world = False
     requires = frozenset({"world"})
+    uses = (Cameras,)
 
     def setup(self, world: Any) -> None:
         self.world = world
@@ -123,7 +125,7 @@ class Capture(Action):
 
     def start(self, ctx: ActionContext) -> None:
         world = ctx.world if ctx.world is not None else self.world
-        if world is None or not hasattr(world, "cameras"):
+        if world is None:
             raise ActionFailure("vision.capture needs a world with a camera (run with --world)")
         if self._camera is None or self._camera.world is not world:
             try:
@@ -131,7 +133,9 @@ class Capture(Action):
                                           self.params["height"])
             except (ValueError, PetriflowError) as exc:  # unknown camera, bad size
                 raise ActionFailure(str(exc)) from None
-        ctx.result = Frame.of(self._camera.capture(), self._camera)
+        with ctx.stopwatch.measure("render", keep=True):
+            image = self._camera.capture()
+        ctx.result = Frame.of(image, self._camera)
 
     def poll(self, ctx: ActionContext) -> Status:
         return Status.OK

@@ -46,6 +46,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from petriflow.capabilities import Cameras, provides
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
 from petriflow.vision.capture import camera_for
 from petriflow.vision.markers import DEFAULT_GEOMETRY, ROBOT_COLOURS
@@ -304,7 +305,7 @@ class Locate(Action):
             elif taken is not None:
                 same = (taken.width, taken.height) == (width, height)
                 camera = taken if same else dataclasses.replace(taken, width=width, height=height)
-            elif world is not None and len(getattr(world, "cameras", {})) == 1:
+            elif provides(world, Cameras) and len(world.cameras) == 1:  # a world is optional here
                 camera = camera_for(world, None, width, height)
             else:
                 camera = None
@@ -317,7 +318,8 @@ class Locate(Action):
         config = VisionConfig(mode_filter=self.params["mode_filter"], marker_z=self.params["marker_z"],
                               robot_side=self.params["robot_side"])
         try:
-            scene = process(frame, camera, config)
+            with ctx.stopwatch.measure("vision", keep=True):
+                scene = process(frame, camera, config)
         except ValueError as exc:
             raise ActionFailure(str(exc)) from None
         ctx.result = scene

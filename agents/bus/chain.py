@@ -77,7 +77,7 @@ def _body(world: Any) -> int:
 
 def joint_of(world: Any, module: str) -> tuple[int, int] | None:
     """``(body, joint index)`` of ``module``'s hinge, or ``None`` if the world's chain has none."""
-    if "chain" not in getattr(world, "bodies", {}):
+    if "chain" not in world.bodies:
         return None
     p, body = world.p, _body(world)
     for j in range(p.getNumJoints(body, physicsClientId=world.client)):
@@ -97,7 +97,7 @@ def front_is_free(world: Any, module: str) -> bool:
     """The module's front proximity sensor: a ray from the front face of its segment,
     ``REACH`` m forward along it, hits nothing (the head's); every other module's
     front touches the segment of the module in front of it."""
-    if "chain" not in getattr(world, "bodies", {}):
+    if "chain" not in world.bodies:
         return False
     p, body = world.p, _body(world)
     number = int(module[1:]) if module[1:].isdigit() else 0

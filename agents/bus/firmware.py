@@ -44,6 +44,7 @@ from typing import Any
 from petriflow.agents.bus.algorithms import BusAwareScheme, NativeScheme
 from petriflow.agents.bus.cpg import CpgParameters, motor_angle, wrap
 from petriflow.agents.bus.packet import Packet, can_identifier, decode, encode
+from petriflow.capabilities import Bodies, Physics, provides
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 
 __all__ = ["GUARDS", "Module", "Oscillator"]
@@ -153,11 +154,18 @@ class _Timed(Action):
         pass
 
 
-def _front_free(ctx: ActionContext, chain: list[str], name: str) -> bool:
-    """The front proximity sensor: a ray ahead of the module's body finds nothing
-    within ``reach`` (without a world: the first module of the chain is the head)."""
+def _chain_world(ctx: ActionContext) -> Any:
+    """The run's world when it is a physics scene with the chain's body in it (the
+    modules then sense and drive it), else ``None``: the firmware runs on the bus
+    alone. The one place the optional world is asked what it provides."""
     world = ctx.world
-    if world is None or "chain" not in getattr(world, "bodies", {}):
+    return world if provides(world, Bodies, Physics) and "chain" in world.bodies else None
+
+
+def _front_free(world: Any, chain: list[str], name: str) -> bool:
+    """The front proximity sensor: a ray ahead of the module's body finds nothing
+    within ``reach`` (without a chain in the world: the first module is the head)."""
+    if world is None:
         return chain.index(name) == 0
     from petriflow.agents.bus.chain import front_is_free
 
@@ -205,7 +213,8 @@ class Boot(_Timed):
         from petriflow.agents.bus.addressing import auto_address
 
         behind = {m: (chain[i + 1] if i + 1 < len(chain) else None) for i, m in enumerate(chain)}
-        addresses = auto_address(behind, {m: _front_free(ctx, chain, m) for m in chain})
+        world = _chain_world(ctx)
+        addresses = auto_address(behind, {m: _front_free(world, chain, m) for m in chain})
         address = addresses[name]
         rng = ctx.rng
         rate = 1.0 + rng.uniform(-p["crystal_ppm"], p["crystal_ppm"]) * 1e-6
@@ -224,10 +233,10 @@ class Boot(_Timed):
         self.module.updated = self.module.next_overflow = self.wake_at = ctx.now + max(0.0, self.duration(ctx))
         for place in p["mailboxes"]:  # the reception routine runs once per iteration, from the first
             ctx.medium(place).reads_every(read_every, start=self.wake_at)
-        if ctx.world is not None:
+        if world is not None:
             from petriflow.agents.bus.chain import joint_of
 
-            self.module.joint = joint_of(ctx.world, name)
+            self.module.joint = joint_of(world, name)
         ctx.emit("bus.addressed", address=address, delay=round(getattr(scheme, "delay", 0.0), 6),
                  read_every=round(read_every, 9), started=round(self.wake_at, 9), rate=rate)
         ctx.result = self.module

@@ -40,7 +40,9 @@ from typing import Any
 from petriflow.agents.comm.agent import CommAgent, Peer, vertex_id
 from petriflow.agents.comm.framework import History, addresses, dhcp_pools, dpp, grid_position, grid_size
 from petriflow.agents.comm.radio import RadioChannel, pick_threshold, threshold_sweep
+from petriflow.agents.mobile.maze import MAZE
 
+from petriflow.capabilities import Bodies, Physics, Positions, provides
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 from petriflow.runtime.resources import LIVENESS, Liveness
 
@@ -61,6 +63,7 @@ class Characterise(InstantAction):
     """Process 1: make the agent's state; a robot's dpp (eq. 2) and start on the grid (eq. 3)."""
 
     agent_state = CommAgent
+    settings = MAZE  # the maze the metrics score the maps against, checked when the world loads
 
     params = {
         "kind": Param(str, "robot", "robot, monitor or central", choices=("robot", "monitor", "central")),
@@ -178,7 +181,7 @@ def _plan(ctx: ActionContext, state: CommAgent, links: dict[str, Any]) -> None:
     peers = [peer for peer in state.peers.values() if live.alive(peer.name)]  # the others: no beacon
     world = ctx.world
     positions = None
-    if peers and world is not None and hasattr(world, "position"):
+    if peers and provides(world, Positions):  # a static agent may run without a world
         positions = {state.name: world.position(state.name)}
         positions.update((peer.name, world.position(peer.name)) for peer in peers)
     heard = set()
@@ -243,6 +246,7 @@ class Explore(Action):
     needs_world = True
     agent_state = CommAgent
     resources = {"live": LIVENESS}
+    uses = (Physics, Bodies, Positions)
 
     def setup(self, world: Any) -> None:
         self.links: dict[str, Any] = {}  # channel place -> the model carrying it (see _plan)
@@ -291,7 +295,7 @@ class Explore(Action):
         """A robot that waits is woken once, at the world step where counting its wait
         down step by step (as :meth:`poll` would) reaches zero, instead of being polled
         at every step: the same step, the same remainder, for a fraction of the cost."""
-        step = getattr(ctx.world, "dt", None)
+        step = ctx.world.dt
         if not step:
             return
         tick = round(ctx.now / step)

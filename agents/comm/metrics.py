@@ -18,18 +18,17 @@ from __future__ import annotations
 
 from typing import Any
 
-from petriflow.agents.mobile.maze import from_meta
+from petriflow.agents.mobile.maze import MAZE, from_meta
 
 __all__ = ["register", "truth", "holdings"]
 
 
 def truth(record: Any) -> set[int]:
-    """Vertex ids of the maze's topological map (from the world's ``meta.maze``)."""
-    world = record.world
-    meta = getattr(world, "meta", {}) or {}
-    if "maze" not in meta:
+    """Vertex ids of the maze's topological map (the world's ``meta.maze``, :data:`MAZE`)."""
+    settings = record.section(MAZE)
+    if not settings["rows"]:
         raise ValueError("the world has no meta.maze: comm metrics need the maze's ground truth")
-    maze = from_meta(meta["maze"])
+    maze = from_meta(settings)
     return {r * maze.cols + c for r, c in maze.vertices()}
 
 

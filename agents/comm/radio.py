@@ -39,6 +39,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
+from petriflow.capabilities import Positions, provides
 from petriflow.runtime.channels import ChannelModel, Message
 from petriflow.runtime.radio import LogDistance, WallCounter
 
@@ -76,6 +77,7 @@ class RadioChannel(ChannelModel):
     def __post_init__(self) -> None:
         self.world: Any = None
         self._walls: Any = None
+        self._placed: Positions | None = None  # the bound world, when it places the agents
         self.path = LogDistance(self.tx_power_dbm, 0.0, self.exponent, min_distance=0.05)
 
     @property
@@ -101,6 +103,7 @@ class RadioChannel(ChannelModel):
         not move, so each pair of places, to the centimetre, is ray-tested once)."""
         self.world = world
         self._walls = WallCounter(world, z=self.antenna_z)
+        self._placed = world if provides(world, Positions) else None
 
     def rssi(self, distance: float, walls: int = 0) -> float:
         """Received signal strength (dBm) at ``distance`` m through ``walls`` walls."""
@@ -133,8 +136,8 @@ class RadioChannel(ChannelModel):
         agents' ``(x, y)`` now, when the caller has read them already (one read per
         agent for a whole plan instead of two per pair).
         """
-        world = self.world
-        if self._walls is not None and world is not None and hasattr(world, "position"):
+        world = self._placed
+        if self._walls is not None and world is not None:
             if positions is not None and a in positions and b in positions:
                 pa, pb = positions[a], positions[b]
             else:

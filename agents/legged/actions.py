@@ -37,8 +37,10 @@ from petriflow.agents.legged.control import LeggedRobot, NotLeggedError
 from petriflow.agents.legged.gait import GaitError, gait_for
 from petriflow.agents.legged.righting import BACK_TILT, brace_point, lying_on, righting_motion
 
+from petriflow.capabilities import Bodies, Physics
 from petriflow.errors import NetFormatError
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Status
+from petriflow.runtime.stopwatch import timed
 
 __all__ = ["Brace", "StandUp", "Turn", "Walk"]
 
@@ -79,9 +81,10 @@ class _LeggedAction(Action):
 
     needs_world = True
     requires = frozenset({"world", "robot"})
+    uses = (Physics, Bodies)
 
     def setup(self, world: Any) -> None:
-        if world is None or not hasattr(world, "p"):
+        if world is None:
             raise ActionFailure(f"{type(self).__name__} needs a pybullet world (run with --world)")
         self.world = world
         self.robots: dict[str, LeggedRobot] = {}
@@ -204,6 +207,7 @@ class Walk(_LeggedAction):
             route.append(("face", self.params["heading"]))
         return route
 
+    @timed("control")
     def poll(self, ctx: ActionContext) -> Status:
         robot = self.robot
         self._track_yaw()
@@ -449,6 +453,7 @@ class StandUp(_LeggedAction):
         self.attempts += 1
         self.steps = list(righting_motion(robot.design, side))
 
+    @timed("control")
     def poll(self, ctx: ActionContext) -> Status:
         if self.wait > 0:
             self.wait -= self.dt

@@ -7,7 +7,10 @@ neighbouring cells and walls all round. :func:`generate` carves a perfect maze
 opens ``loops`` of the remaining inner walls, so there are cycles as in a real
 building. :meth:`Maze.world` is its pybullet world description (thin wall boxes, the
 robots), with the maze itself in ``meta.maze`` so metrics can compute the ground
-truth from the world alone (:func:`from_meta`).
+truth from the world alone (:func:`from_meta`). That section of a world file is
+declared (:data:`MAZE`, read and checked with the file's lines when the world loads,
+by a run whose actions declare it; its metrics read it from ``record.settings``), as
+is a tiled world's ``meta.tiles`` (:data:`TILES`).
 
 The **topological map** of a maze has a vertex at every cell that is not the middle
 of a straight corridor: a dead end, a corner, a junction (:meth:`Maze.vertices`); its
@@ -18,6 +21,8 @@ Examples:
     >>> len(maze.cells()), maze.is_connected()
     (16, True)
     >>> from_meta(maze.meta()).walls() == maze.walls()
+    True
+    >>> from_meta(MAZE.read(maze.meta())).walls() == maze.walls()
     True
     >>> vertex_count = len(maze.vertices()); 2 <= vertex_count <= 16
     True
@@ -31,7 +36,28 @@ from typing import Any
 
 import networkx as nx
 
-__all__ = ["DIRECTIONS", "Cell", "Maze", "from_meta", "generate"]
+from petriflow.runtime.settings import Section, Setting
+
+__all__ = ["DIRECTIONS", "MAZE", "TILES", "Cell", "Maze", "from_meta", "generate"]
+
+_WALLS = Setting(str, doc="'1' (a wall) or '0' (an opening) per neighbouring pair of cells")
+
+#: A maze world's ``meta.maze`` (:meth:`Maze.meta` writes it); ``rows: 0``: no maze.
+MAZE = Section("maze", {
+    "rows": Setting(int, 0, "rows of cells (0: the world has no maze)", low=0),
+    "cols": Setting(int, 0, "cells per row", low=0),
+    "cell": Setting(float, 1.0, "side of a cell (m)", low=1e-9),
+    "origin": Setting(list, [0.0, 0.0], "world x, y of the south-west corner", items=Setting(float)),
+    "east": Setting(list, [], "per row, the walls east of its cells but the last", items=_WALLS),
+    "north": Setting(list, [], "per row but the last, the walls north of its cells", items=_WALLS),
+}, doc="the maze of a maze world: its ground truth")
+
+#: A world tiled with copies of one maze (``meta.tiles``): how many, and the rows
+#: from one copy to the next.
+TILES = Section("tiles", {
+    "count": Setting(int, 1, "copies of the maze (their cell ids differ)", low=1),
+    "pitch_rows": Setting(int, 0, "rows of cells from one copy to the next", low=0),
+}, doc="copies of a maze in one world")
 
 Cell = tuple[int, int]
 #: Neighbour offsets (row, col) by direction name; north is +y.

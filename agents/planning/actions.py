@@ -59,7 +59,9 @@ from petriflow.agents.planning.maps import (
     robot_label,
 )
 from petriflow.agents.planning.tracking import check_track
+from petriflow.capabilities import Poses, Positions, provides
 from petriflow.runtime.action import Action, ActionContext, InstantAction, Param, Port, Status
+from petriflow.runtime.stopwatch import UNTIMED, Timing
 
 __all__ = ["PlanPath", "TrackPath", "plan_world_path", "scene_frame", "find_scene"]
 
@@ -143,7 +145,8 @@ def scene_frame(scene: Any, shape: Sequence[int], cell: int, metres_per_pixel: f
 
 def plan_world_path(label_map: np.ndarray, frame: GridFrame, robot: str | int, goal: Sequence[float],
                     start: Sequence[float] | None = None, radius: float = 0.1, variant: str = "optimal",
-                    cut_corners: bool = False, snap: float | None = None) -> dict[str, Any]:
+                    cut_corners: bool = False, snap: float | None = None,
+                    stopwatch: Timing = UNTIMED) -> dict[str, Any]:
     """Plan ``robot``'s path on a label map, in world coordinates.
 
     Args:
@@ -190,7 +193,8 @@ def plan_world_path(label_map: np.ndarray, frame: GridFrame, robot: str | int, g
                                 f"grown by the robot radius, or off the map) and no free cell is within "
                                 f"{reach * frame.metres_per_cell:g} m")
         cells[what] = (cell, free)
-    plan = astar(grid, cells["start"][1], cells["goal"][1], variant=variant, cut_corners=cut_corners)
+    with stopwatch.measure("search", keep=True):
+        plan = astar(grid, cells["start"][1], cells["goal"][1], variant=variant, cut_corners=cut_corners)
     path: list[list[float]] = []
     if plan.found:
         points = frame.cell_to_world(plan.cells)
@@ -270,8 +274,9 @@ class PlanPath(InstantAction):
                 if start is not None:
                     break
         began = time.perf_counter()
-        result = plan_world_path(label_map, frame, robot, goal, start, params["radius"], params["variant"],
-                                 params["cut_corners"], params["snap"])
+        with ctx.stopwatch.measure("planning", keep=True):
+            result = plan_world_path(label_map, frame, robot, goal, start, params["radius"], params["variant"],
+                                     params["cut_corners"], params["snap"], stopwatch=ctx.stopwatch)
         took = time.perf_counter() - began
         del result["seconds"]  # wall-clock: only on request
         if params["report_ms"]:
@@ -310,10 +315,13 @@ class TrackPath(InstantAction):
                 if pose is not None:
                     return _point(pose, "pose")
         world = ctx.world
-        for method in ("pose", "position"):
-            if world is not None and hasattr(world, method) and robot is not None:
+        # a world is optional (tokens may carry the pose): its pose, else its position, if it has them
+        reads = [world.pose] if provides(world, Poses) else []
+        reads += [world.position] if provides(world, Positions) else []
+        if robot is not None:
+            for read in reads:
                 try:
-                    found = getattr(world, method)(robot)
+                    found = read(robot)
                 except Exception as exc:  # a world that does not know the body
                     raise PlanningError(f"cannot read the pose of {robot!r}: {exc}") from None
                 if found is not None:
@@ -331,8 +339,9 @@ class TrackPath(InstantAction):
         if path is None or len(path) == 0:
             raise PlanningError("no path: no input token has a path")
         position = self._position(ctx, robot)
-        decision = check_track(path, position, step=params["step"], radius=params["radius"],
-                               reach=params["reach"])
+        with ctx.stopwatch.measure("planning"):
+            decision = check_track(path, position, step=params["step"], radius=params["radius"],
+                                   reach=params["reach"])
         return {
             "robot": robot, "decision": decision.kind.value, "distance": round(decision.distance, 6),
             "point": None if decision.point is None else [round(v, 6) for v in decision.point],

@@ -43,32 +43,13 @@ import math
 from typing import Any
 
 from petriflow.agents.slam.agent import Air, Base, Central, Robot, Wireless, frame, merge_seen
-from petriflow.agents.slam.corridors import HALF_WIDTH, to_map
+from petriflow.agents.slam.corridors import SLAM, to_map
 from petriflow.agents.slam.history import choose, exchange_role, read_node, update
 from petriflow.capabilities import Bodies, Physics, Poses
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
-from petriflow.runtime.settings import Section, Setting
 
 __all__ = ["GUARDS", "AIR", "SLAM", "Boot", "Explore", "Install", "Finish", "Scan", "SwitchOff", "Send", "Receive",
            "CentralBoot", "Serve", "Dispatch"]
-
-_POINT = Setting(list, doc="x, y (m)", items=Setting(float))
-
-#: A corridor world's ``meta.slam`` (:func:`petriflow.agents.slam.corridors.world_description`
-#: writes it): the map frame, the corridors' ground truth the metrics score the built
-#: map against, the centralised system's nodes.
-SLAM = Section("slam", {
-    "origin": Setting((list, type(None)), None, "world x, y of the map's origin (default: the RA's start)",
-                      items=Setting(float)),
-    "size": Setting((list, type(None)), None, "the world's extent x, y (m)", items=Setting(float)),
-    "half_width": Setting(float, HALF_WIDTH, "half a corridor's width (m)", low=0),
-    "vertices": Setting(dict, {}, "the ground-truth graph's vertices: id -> map x, y (m)"),
-    "edges": Setting(list, [], "the ground-truth graph's corridors: [vertex, vertex]"),
-    "nodes": Setting(list, [], "the centralised system's pre-installed nodes (world x, y)", items=_POINT),
-    "starts": Setting(list, [], "the RAs' starts in the map frame (a generated maze)", items=_POINT),
-    "maze_seed": Setting((int, type(None)), None, "the seed of a generated maze"),
-    "paper": Setting(dict, {}, "the vertices as published, for comparison (the Fig. 6 world)"),
-}, doc="a corridor world: the map frame and the ground truth")
 
 #: The resource type of the beacons.
 AIR = "slam.air"
@@ -77,11 +58,6 @@ PLACE = "the shared air place (frames travel through it)"
 
 def _radio(ctx: ActionContext, air_place: str) -> Any:
     return ctx.link(air_place)[0]
-
-
-def _meta(ctx: ActionContext) -> dict[str, Any]:
-    # the actions that do not declare SLAM yet (the second wave migrates them: ctx.settings)
-    return (getattr(ctx.world, "meta", None) or {}).get("slam", {})
 
 
 def _publish(ctx: ActionContext, state: Robot | Wireless) -> None:
@@ -309,6 +285,7 @@ class Install(Action):
     agent_state = Robot
     needs_world = False
     resources = {"air": AIR}
+    uses = (Physics, Bodies)  # the WA's box is put down where the RA stands
     params = {
         "index": Param(int, 1, "the installation number", low=1),
         "wa": Param(str, doc="the WA (its agent, and its box in the world)"),
@@ -622,13 +599,14 @@ class CentralBoot(InstantAction):
     """Make the central unit's state; count the pre-installed nodes it works through."""
 
     agent_state = Central
+    settings = SLAM
     params = {"match": Param(float, 1.0, "two positions nearer than this (m) are one vertex", low=0.01)}
 
     def run(self, ctx: ActionContext) -> None:
         state = Central(ctx.agent or "central", radius=self.params["match"])
         ctx.state = state
         state.touch("outbox", "alert", "plan")
-        nodes = _meta(ctx).get("nodes", [])
+        nodes = ctx.settings["nodes"]
         ctx.emit("slam.nodes", count=len(nodes))
 
 

@@ -32,8 +32,11 @@ from typing import Any
 
 import numpy as np
 
+from petriflow.runtime.settings import Section, Setting
+
 __all__ = [
     "HALF_WIDTH",
+    "SLAM",
     "draw",
     "fig6_world",
     "free_space",
@@ -48,6 +51,24 @@ __all__ = [
 #: Half the corridors' width (m): 1.2 m corridors fit Fig. 6's closest parallel
 #: corridors (1.7 m between centre lines) with a wall between them.
 HALF_WIDTH = 0.6
+
+_POINT = Setting(list, doc="x, y (m)", items=Setting(float))
+
+#: A corridor world's ``meta.slam`` (:func:`petriflow.agents.slam.corridors.world_description`
+#: writes it): the map frame, the corridors' ground truth the metrics score the built
+#: map against, the centralised system's nodes.
+SLAM = Section("slam", {
+    "origin": Setting((list, type(None)), None, "world x, y of the map's origin (default: the RA's start)",
+                      items=Setting(float)),
+    "size": Setting((list, type(None)), None, "the world's extent x, y (m)", items=Setting(float)),
+    "half_width": Setting(float, HALF_WIDTH, "half a corridor's width (m)", low=0),
+    "vertices": Setting(dict, {}, "the ground-truth graph's vertices: id -> map x, y (m)"),
+    "edges": Setting(list, [], "the ground-truth graph's corridors: [vertex, vertex]"),
+    "nodes": Setting(list, [], "the centralised system's pre-installed nodes (world x, y)", items=_POINT),
+    "starts": Setting(list, [], "the RAs' starts in the map frame (a generated maze)", items=_POINT),
+    "maze_seed": Setting((int, type(None)), None, "the seed of a generated maze"),
+    "paper": Setting(dict, {}, "the vertices as published, for comparison (the Fig. 6 world)"),
+}, doc="a corridor world: the map frame and the ground truth")
 #: Height of the walls (m); the distance sensors look at 0.1 m.
 WALL_HEIGHT = 0.5
 RA_URDF = "petriflow.agents:robots/diffdrive.urdf"
@@ -210,7 +231,7 @@ def draw(description: dict[str, Any], path: str | Path, *, built: dict[str, Any]
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    meta = description["meta"]["slam"]
+    meta = SLAM.read((description.get("meta") or {}).get("slam"))
     origin = tuple(meta["origin"])
     panels = 2 if built is not None else 1
     figure, axes = plt.subplots(1, panels, figsize=(6.4 * panels, 6.4), squeeze=False)

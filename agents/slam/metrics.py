@@ -32,6 +32,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from petriflow.agents.slam.corridors import SLAM
+
 __all__ = ["built_map", "map_quality", "parse_map", "register", "truth", "union"]
 
 
@@ -41,8 +43,8 @@ def _custom(record: Any, name: str) -> list[Any]:
 
 def truth(record: Any) -> tuple[dict[int, tuple[float, float]], set[tuple[int, int]]]:
     """The world's ground truth: ``({id: (x, y)}, {(a, b)})`` in the map frame."""
-    meta = (getattr(record.world, "meta", None) or {}).get("slam")
-    if not meta:
+    meta = record.section(SLAM)
+    if not meta["vertices"]:
         raise ValueError("the world has no meta.slam: seed 001's metrics need its corridor graph")
     vertices = {int(v): (float(p[0]), float(p[1])) for v, p in meta["vertices"].items()}
     return vertices, {(min(a, b), max(a, b)) for a, b in meta["edges"]}

@@ -34,8 +34,11 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from petriflow.agents.slam.corridors import SLAM
+from petriflow.capabilities import Described, Positions, provides
 from petriflow.runtime.channels import ChannelModel, Message
 from petriflow.runtime.radio import LogDistance
+from petriflow.runtime.settings import read_settings
 
 __all__ = ["CENTRAL", "ESP8266", "TX_AT_1M"]
 
@@ -62,10 +65,17 @@ class ESP8266(ChannelModel):
         self._reach = self._path.range(self.threshold_dbm - self.fade_db)
         self.world: Any = None
         self.loss_reason = ""
+        self._placed: Positions | None = None
+        self._nodes: list[tuple[float, ...]] = []
 
     def bind(self, world: Any) -> None:
-        """The run's world: where the agents are."""
+        """The run's world: where the agents are (when it places them), and the nodes of
+        its ``meta.slam`` (:data:`~petriflow.agents.slam.corridors.SLAM`, checked)."""
         self.world = world
+        self._placed = world if provides(world, Positions) else None
+        if provides(world, Described):
+            slam = read_settings(world.meta, {SLAM.name: SLAM}, path=world.path)[SLAM.name]
+            self._nodes = [tuple(point) for point in slam["nodes"]]
 
     # The link budget ----------------------------------------------------------------
     def rssi(self, distance: float) -> float:
@@ -94,8 +104,8 @@ class ESP8266(ChannelModel):
 
     # Positions ------------------------------------------------------------------------
     def position(self, name: str) -> tuple[float, float] | None:
-        world = self.world
-        if world is None or not hasattr(world, "position"):
+        world = self._placed
+        if world is None:
             return None
         try:
             return world.position(name)
@@ -103,8 +113,7 @@ class ESP8266(ChannelModel):
             return None
 
     def nodes(self) -> list[tuple[float, float]]:
-        meta = getattr(self.world, "meta", None) or {}
-        return [tuple(p) for p in meta.get("slam", {}).get("nodes", [])]
+        return list(self._nodes)
 
     def link(self, a: str, b: str) -> tuple[float, bool] | None:
         """``(RSSI, through the backbone)`` of a frame between agents ``a`` and ``b``, or

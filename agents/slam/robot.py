@@ -84,7 +84,7 @@ class Body:
         self.travelled = 0.0
         self.sensor_range = sensor_range
         self.sensor_z = sensor_z
-        names = set(ignore or []) | set(getattr(world, "agents", {}))
+        names = set(ignore or []) | set(world.agents)
         self.ignore = sorted({world.body(n) for n in names if _has_body(world, n)})
         # the body is placed where the kinematics say: it must not be pushed by contacts
         # (two RAs wait at the start; the floor)
@@ -138,7 +138,7 @@ class Body:
 
 
 def _has_body(world: Any, name: str) -> bool:
-    return name in getattr(world, "agents", {}) or name in getattr(world, "bodies", {})
+    return name in world.agents or name in world.bodies
 
 
 @dataclass(frozen=True)

@@ -36,11 +36,14 @@ from typing import Any, ClassVar
 
 from petriflow.agents.legged.actions import Walk
 from petriflow.agents.smart import messages
+from petriflow.agents.smart.arena import SMART
 from petriflow.agents.smart.decision import LABELS, assess, draw_obstacle, robot_id
 from petriflow.vision.capture import Capture as _VisionCapture
 
+from petriflow.capabilities import Bodies, Cameras, Physics, Poses
 from petriflow.errors import NetFormatError
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, Param, Port, Status
+from petriflow.runtime.stopwatch import timed
 
 __all__ = [
     "Avoid",
@@ -91,10 +94,6 @@ def _cells(x: float, y: float, params: Mapping[str, Any]) -> tuple[int, int]:
         raise ActionFailure(str(exc)) from None
 
 
-def _world(ctx: ActionContext, action: Action) -> Any:
-    return ctx.world if ctx.world is not None else getattr(action, "world", None)
-
-
 class Capture(_VisionCapture):
     """``vision.capture`` of the dressed arena (white floor, marker hats): the
     ``smart.arena`` resource, which the run makes once before the first firing."""
@@ -134,6 +133,8 @@ class Dispatch(Action):
         "origin": Param(list, list(_CELLS["origin"]), "world [x, y] of command cell (0, 0)"),
     }
     needs_world = False
+    uses = (Cameras, Bodies, Physics)
+    settings = SMART
 
     def setup(self, world: Any) -> None:
         self.world = world
@@ -146,9 +147,9 @@ class Dispatch(Action):
         scene = _scene_of(ctx)
         if scene is None:
             raise ActionFailure("smart.dispatch: no scene in the input tokens")
-        world = _world(ctx, self)
+        world = ctx.world if ctx.world is not None else self.world
         camera = _field(scene, "camera")
-        if camera is None and world is not None and len(getattr(world, "cameras", {})) == 1:
+        if camera is None and len(world.cameras) == 1:
             camera = next(iter(world.cameras.values()))
         size = _field(scene, "size")
         if camera is not None and size is not None and (camera.width, camera.height) != tuple(size):
@@ -165,7 +166,7 @@ class Dispatch(Action):
         from petriflow.agents.legged.righting import brace_point, lying_on
         from petriflow.agents.smart.arena import colour_robots
 
-        body = colour_robots(world).get(params["fallen"]) if world is not None else None
+        body = colour_robots(world, ctx.settings).get(params["fallen"])
         if body is None:
             raise ActionFailure(f"smart.dispatch: no robot wears {params['fallen']!r} (world meta.smart.markers)")
         from petriflow.agents.legged.control import LeggedRobot
@@ -310,6 +311,7 @@ class Follow(Walk):
         "scene": Port("place holding the camera's latest scene (read for vision tracking)"),
         "orders": Port("place holding the decision maker's standing orders (read: hold, re-plan)"),
     }
+    settings = SMART
 
     def setup(self, world: Any) -> None:
         super().setup(world)
@@ -358,7 +360,7 @@ class Follow(Walk):
         if colour is None:
             from petriflow.agents.smart.arena import robot_colours
 
-            colour = robot_colours(self.world).get(self.robot.name)
+            colour = robot_colours(self.world, ctx.settings).get(self.robot.name)
         self.colour = colour
         gait_step = self.gait.stride
         self.step = self.params["step"] or gait_step
@@ -424,8 +426,9 @@ class Follow(Walk):
         position = self._pose_seen(ctx)
         if position is None:
             return
-        decision = check_track(self.path, position, step=self.step, radius=self.params["radius"],
-                               reach=self.reach)
+        with ctx.stopwatch.measure("planning"):
+            decision = check_track(self.path, position, step=self.step, radius=self.params["radius"],
+                                   reach=self.reach)
         record = {"t": round(ctx.now, 4), "decision": decision.kind.value, "dc": round(decision.distance, 4),
                   "position": [round(v, 4) for v in position]}
         if decision.point is not None:
@@ -453,6 +456,7 @@ class Follow(Walk):
         orders = ctx.latest("orders")
         return orders.get(self.colour) if isinstance(orders, Mapping) else None
 
+    @timed("control")
     def poll(self, ctx: ActionContext) -> Status:
         if self._holding is not None:
             order = self._orders(ctx)
@@ -559,9 +563,10 @@ class Push(Action):
     }
     needs_world = True
     requires = frozenset({"world", "robot"})
+    uses = (Physics, Bodies, Poses)
 
     def setup(self, world: Any) -> None:
-        if world is None or not hasattr(world, "p"):
+        if world is None:
             raise ActionFailure("smart.push needs a pybullet world")
         self.world = world
 

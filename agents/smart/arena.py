@@ -46,12 +46,23 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
-from petriflow.errors import NetFormatError
+from petriflow.capabilities import Bodies, Described, Physics, provides
+from petriflow.runtime.settings import Section, Setting, read_settings
 
-__all__ = ["Arena", "arena_resource", "colour_robots", "dress", "hat_offset", "load_arena", "robot_colours",
-           "unrendered_ground"]
+__all__ = ["SMART", "Arena", "arena_resource", "arena_settings", "colour_robots", "dress", "hat_offset", "load_arena",
+           "robot_colours", "unrendered_ground"]
+
+#: The world file's ``meta.smart``: the floor the camera sees and the robots' hats.
+SMART = Section("smart", {
+    "floor": Setting((str, type(None)), None, "white (an unrendered ground), painted (the plane painted"
+                     " white) or none (the floor as loaded)", choices=("white", "painted", None)),
+    "markers": Setting(list, [], "one marker hat per robot", items=Setting(dict, doc="a robot's hat", fields={
+        "robot": Setting(str, doc="the robot's body name"),
+        "colour": Setting(str, doc="the hat's colour (vision.segment's labels)"),
+    })),
+}, doc="the SMART arena: the floor and the robots' marker hats")
 
 
 @dataclass
@@ -69,28 +80,22 @@ class Arena:
     floor: str | None = None
 
 
-def _spec(world: Any) -> dict[str, Any]:
-    meta = getattr(world, "meta", None) or {}
-    spec = meta.get("smart") or {}
-    if not isinstance(spec, dict):
-        raise NetFormatError(f"meta.smart is a mapping, got {spec!r}", path=getattr(world, "path", None))
-    return spec
+def arena_settings(world: Described) -> dict[str, Any]:
+    """The world's ``meta.smart`` (:data:`SMART`) read and checked, defaults filled in:
+    what a run gives its actions as ``ctx.settings`` (errors at the world file's line)."""
+    return read_settings(world.meta, {SMART.name: SMART}, path=world.path)[SMART.name]
 
 
-def robot_colours(world: Any) -> dict[str, str]:
-    """``{robot body name: colour}`` declared under the world's ``meta.smart.markers``."""
-    colours: dict[str, str] = {}
-    for entry in _spec(world).get("markers") or []:
-        if not isinstance(entry, dict) or "robot" not in entry or "colour" not in entry:
-            raise NetFormatError(f"a marker is {{robot: NAME, colour: COLOUR}}, got {entry!r}",
-                                 path=getattr(world, "path", None))
-        colours[str(entry["robot"])] = str(entry["colour"])
-    return colours
+def robot_colours(world: Described, settings: Mapping[str, Any] | None = None) -> dict[str, str]:
+    """``{robot body name: colour}`` declared under the world's ``meta.smart.markers``
+    (``settings``: the section already read, as ``ctx.settings``)."""
+    settings = arena_settings(world) if settings is None else settings
+    return {entry["robot"]: entry["colour"] for entry in settings["markers"]}
 
 
-def colour_robots(world: Any) -> dict[str, str]:
+def colour_robots(world: Described, settings: Mapping[str, Any] | None = None) -> dict[str, str]:
     """``{colour: robot body name}``, the inverse of :func:`robot_colours`."""
-    return {colour: robot for robot, colour in robot_colours(world).items()}
+    return {colour: robot for robot, colour in robot_colours(world, settings).items()}
 
 
 def hat_offset(world: Any, body: int) -> tuple[float, float, float]:
@@ -134,29 +139,26 @@ def unrendered_ground(world: Any) -> int:
     return body
 
 
-def dress(world: Any) -> Arena:
+def dress(world: Any, settings: Mapping[str, Any] | None = None) -> Arena:
     """Whiten the floor and put a marker hat on every robot named in the world's
-    ``meta.smart``, once per world: a world already dressed (its hats are found in the
-    pybullet scene, where each records itself) is not dressed again, and the same
+    ``meta.smart`` (``settings``: that section already read, as a run's resource has
+    it), once per world: a world already dressed (its hats are found in the pybullet
+    scene, where each records itself) is not dressed again, and the same
     :class:`Arena` is described again."""
     from petriflow.vision.markers import attach_markers, markers_on, white_floor
 
-    spec = _spec(world)
-    colours = robot_colours(world)
+    settings = arena_settings(world) if settings is None else settings
+    colours = robot_colours(world, settings)
+    floor = settings["floor"]
     worn = {robot: markers_on(world, world.body(robot)) for robot in colours}
     if colours and all(worn.values()):
-        return Arena({robot: hats[0] for robot, hats in worn.items()}, dict(colours), spec.get("floor"))
+        return Arena({robot: hats[0] for robot, hats in worn.items()}, dict(colours), floor)
     arena = Arena()
-    floor = spec.get("floor")
-    if floor is not None:
-        if floor == "white":
-            unrendered_ground(world)
-        elif floor == "painted":
-            white_floor(world)
-        else:
-            raise NetFormatError(f"meta.smart.floor: 'white' or 'painted', got {floor!r}",
-                                 path=getattr(world, "path", None))
-        arena.floor = floor
+    if floor == "white":
+        unrendered_ground(world)
+    elif floor == "painted":
+        white_floor(world)
+    arena.floor = floor
     for robot, colour in colours.items():
         body = world.body(robot)
         arena.hats[robot] = attach_markers(world, body, colour=colour, offset=hat_offset(world, body))
@@ -165,12 +167,13 @@ def dress(world: Any) -> Arena:
 
 
 def arena_resource(context: Any) -> Arena | None:
-    """The ``smart.arena`` resource: the run's world dressed once (``None`` without a
-    pybullet world)."""
+    """The ``smart.arena`` resource: the run's world dressed once by its checked
+    ``meta.smart`` (``None`` when the world is not a physics scene with bodies:
+    nothing to dress)."""
     world = context.world
-    if world is None or not hasattr(world, "p"):
+    if not provides(world, Physics, Bodies):
         return None
-    return dress(world)
+    return dress(world, context.settings[SMART.name])
 
 
 def load_arena(path: str | Path, gui: bool = False, camera_size: tuple[int, int] | None = None) -> Any:

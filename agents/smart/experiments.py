@@ -97,7 +97,8 @@ def run_net(name: str, net: Path, world: Path, out: Path, *, until: float, seed:
     warm_up()  # numba compiles (or loads) A* once per process: not part of a planning time
     trace = out / f"{name}.jsonl"
     with Timers() as timers:
-        outcome = run_files(net, world=world_path, seed=seed, until=until, trace=trace, keep_events=True)
+        outcome = run_files(net, world=world_path, seed=seed, until=until, trace=trace, keep_events=True,
+                            stopwatch=timers)
     data = yaml.safe_load(world_path.read_text(encoding="utf-8"))
     return Run(name, outcome, outcome.events, timers, data, [str(trace)])
 

@@ -23,6 +23,8 @@ import math
 from typing import Any
 
 from petriflow.agents.swarm.agent import SIDES, Scout
+from petriflow.agents.mobile.maze import MAZE, TILES
+from petriflow.capabilities import KinematicDrive, Poses, RayTests
 from petriflow.runtime.action import Action, ActionContext, ActionFailure, InstantAction, Param, Status
 
 __all__ = ["GUARDS", "Wake", "Explore", "Share", "Sent", "Home"]
@@ -32,6 +34,8 @@ class Wake(InstantAction):
     """The robot starts: its state, its home cell (where it stands)."""
 
     agent_state = Scout
+    uses = (Poses,)
+    settings = MAZE  # the maze the metrics count the cells of, checked when the world loads
     params = {
         "air": Param(str, doc="the robot's radio place (its address is its radio's)", places=""),
         "cols": Param(int, 1, "cells per maze row", low=1),
@@ -60,6 +64,7 @@ class _Mover(Action):
 
     needs_world = False
     agent_state = Scout
+    uses = (Poses, KinematicDrive)
     params = {
         "speed": Param(float, 0.5, "cruise speed (m/s)", low=1e-9),
         "turn_rate": Param(float, 2.0, "turn rate on the spot (rad/s)", low=1e-9),
@@ -112,6 +117,8 @@ class _Mover(Action):
 class Explore(_Mover):
     """One cell of exploration (see the module)."""
 
+    settings = TILES  # a tiled world's copies of the maze (the metrics count their cells)
+    uses = (Poses, KinematicDrive, RayTests)
     params = dict(_Mover.params, reach=Param(int, 4, "the robot maps the cells at most this many rows and columns"
                                              " from its start (through known cells at most 4 x as far)", low=1),
                   sensor_z=Param(float, 0.1, "height of the distance rays (m)"))

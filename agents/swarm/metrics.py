@@ -18,15 +18,17 @@ from __future__ import annotations
 
 from typing import Any
 
+from petriflow.agents.mobile.maze import MAZE, TILES
+
 __all__ = ["register", "coverage", "bytes_total", "time_s", "home"]
 
 
 def _cells(record: Any) -> int:
-    meta = getattr(record.world, "meta", {}) or {}
-    if "maze" not in meta:
+    maze = record.section(MAZE)
+    if not maze["rows"]:
         raise ValueError("the world has no meta.maze: swarm metrics need the maze")
-    tiles = int((meta.get("tiles") or {}).get("count", 1))  # copies of the maze (their cell ids differ)
-    return int(meta["maze"]["rows"]) * int(meta["maze"]["cols"]) * tiles
+    tiles = record.section(TILES)["count"]  # copies of the maze (their cell ids differ)
+    return maze["rows"] * maze["cols"] * tiles
 
 
 def _custom(record: Any, name: str):

@@ -31,6 +31,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
+from petriflow.capabilities import PoseArrays, provides
 from petriflow.runtime.channels import Message
 from petriflow.runtime.media import Medium, MediumPort
 from petriflow.runtime.radio import LogDistance, RadioIndex
@@ -105,7 +106,7 @@ class SwarmRadio(Medium):
         # the robots the world moves kinematically, by agent (row of the world's poses)
         self.rows: dict[str, int] = {}
         self.agents: list[str] = []
-        if world is not None and getattr(world, "mode", None) == "kinematic":
+        if provides(world, PoseArrays) and world.mode == "kinematic":
             for agent in world.agents:
                 if world.is_kinematic(agent):
                     self.rows[agent] = world.row(agent)

@@ -44,6 +44,7 @@ from typing import Any, Callable, ClassVar, Generator, Mapping, TypeVar
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
 from petriflow.outcome import Outcome
 from petriflow.runtime.services import AgentStates, ChannelLookup, RunServices
+from petriflow.runtime.stopwatch import UNTIMED, Timing
 
 __all__ = [
     "Status",
@@ -425,6 +426,13 @@ class ActionContext:
                 no view.
         """
         return self._channels(place).view(place, self.agent)
+
+    @property
+    def stopwatch(self) -> Timing:
+        """What the action reports its work's wall-clock time to
+        (``with ctx.stopwatch.measure("vision"): ...``; :mod:`petriflow.runtime.stopwatch`):
+        the run's stopwatch, or one that measures nothing."""
+        return UNTIMED if self.services is None else self.services.stopwatch
 
     def running(self, agent: str | None) -> bool:
         """Whether ``agent`` runs now: not killed, not waiting to join (what a radio

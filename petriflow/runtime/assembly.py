@@ -34,6 +34,8 @@ from petriflow.runtime.clock import Clock, RealtimeClock, SimulatedClock
 from petriflow.runtime.control import Control
 from petriflow.runtime.config import RunConfig
 from petriflow.runtime.scheduler import Scheduler
+from petriflow.runtime.stopwatch import UNTIMED, Timing
+from petriflow.runtime.services import RemoteGoals
 from petriflow.runtime.validation import CheckedRun, validate
 
 __all__ = ["open_run", "CheckedRun", "validate"]
@@ -42,7 +44,8 @@ __all__ = ["open_run", "CheckedRun", "validate"]
 @contextmanager
 def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunConfig | None = None, *,
              seed: int | None = None, world: Any = None, gui: bool = False, realtime: bool = False,
-             clock: Clock | None = None, control: Control | None = None) -> Iterator[Scheduler]:
+             clock: Clock | None = None, stopwatch: Timing | None = None,
+             remote: RemoteGoals | None = None, control: Control | None = None) -> Iterator[Scheduler]:
     """A run put together: yields its :class:`~petriflow.runtime.scheduler.Scheduler`.
 
     Args:
@@ -54,6 +57,10 @@ def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunC
         gui: open pybullet's GUI for a world built here.
         realtime: pace the run to the wall clock (a :class:`RealtimeClock`).
         clock: the clock (overrides ``realtime``).
+        stopwatch: where the run's wall-clock time goes, by category (the world's
+            steps, the actions' work: :mod:`~petriflow.runtime.stopwatch`); ``None``:
+            nobody times it.
+        remote: where the goals of remote transitions go (a run with a ``bridge:``).
         control: the run's control queue, if it is steered
             (:class:`~petriflow.runtime.control.Control`).
     """
@@ -68,8 +75,9 @@ def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunC
     elif world is not None:
         settings = None  # read from the world given (its meta), by the scheduler
     try:
+        clock = clock or (RealtimeClock(stopwatch) if realtime else SimulatedClock(stopwatch))
         scheduler = Scheduler(run.net, world=world, config=run.config, seed=seed, binding=run.binding,
-                              clock=clock or (RealtimeClock() if realtime else SimulatedClock()), settings=settings,
+                              clock=clock, settings=settings, stopwatch=stopwatch or UNTIMED, remote=remote,
                               control=control)
         with scheduler:
             yield scheduler

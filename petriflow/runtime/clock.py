@@ -5,7 +5,8 @@ between (a run with no world jumps straight there). :class:`SimulatedClock` does
 that; :class:`RealtimeClock` also sleeps so that simulated time never runs ahead of
 the wall clock, as SimPy's ``RealtimeEnvironment`` does. A run takes its clock when it
 is made (``Scheduler(..., clock=RealtimeClock())``); nothing else in the run knows
-which one it has.
+which one it has. A clock made with a stopwatch (:mod:`~petriflow.runtime.stopwatch`)
+reports each world step to it as ``physics``.
 
 Examples:
     >>> from petriflow.runtime.kernel import Kernel
@@ -21,6 +22,7 @@ import time as wallclock
 from typing import Any, Callable, Protocol
 
 from petriflow.runtime.kernel import Kernel
+from petriflow.runtime.stopwatch import Timing
 
 __all__ = ["Clock", "SimulatedClock", "RealtimeClock"]
 
@@ -39,12 +41,16 @@ class Clock(Protocol):
 class SimulatedClock:
     """As fast as the machine goes: simulated time is decoupled from the wall clock.
 
+    Args:
+        stopwatch: where each world step's wall-clock time goes (``physics``).
+
     Attributes:
         interrupt: called after each world step; ``True`` stops the advance at that tick
             (someone steering the run wants it to stop there, :mod:`~.control`).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, stopwatch: Timing | None = None) -> None:
+        self.stopwatch = stopwatch
         self.interrupt: Callable[[], bool] | None = None
 
     def start(self) -> None:
@@ -55,8 +61,13 @@ class SimulatedClock:
             kernel.tick = max(kernel.tick, tick)
             return
         interrupt = self.interrupt
+        stopwatch = self.stopwatch
         while kernel.tick < tick:
-            world.step()
+            if stopwatch is None:
+                world.step()
+            else:
+                with stopwatch.measure("physics"):
+                    world.step()
             kernel.tick += 1
             if interrupt is not None and interrupt():
                 return
@@ -67,6 +78,7 @@ class RealtimeClock:
     time divided by ``factor`` (a run that is slower than that just runs behind).
 
     Args:
+        stopwatch: where each world step's wall-clock time goes (``physics``).
         factor: simulated seconds per wall-clock second (2: twice as fast as real time).
         now: the simulated time the clock starts from (a run paced from the middle on).
 
@@ -74,12 +86,13 @@ class RealtimeClock:
         interrupt: called after each tick; ``True`` stops the advance at that tick.
     """
 
-    def __init__(self, factor: float = 1.0, now: float = 0.0) -> None:
+    def __init__(self, stopwatch: Timing | None = None, factor: float = 1.0, now: float = 0.0) -> None:
         if not factor > 0:
             raise ValueError(f"a real-time factor is > 0, got {factor!r}")
         self.factor = factor
         self._from = now
         self._start = wallclock.perf_counter()
+        self.stopwatch = stopwatch
         self.interrupt: Callable[[], bool] | None = None
 
     def start(self) -> None:
@@ -93,7 +106,10 @@ class RealtimeClock:
 
     def advance(self, kernel: Kernel, world: Any, tick: int) -> None:
         while kernel.tick < tick:
-            if world is not None:
+            if world is not None and self.stopwatch is not None:
+                with self.stopwatch.measure("physics"):
+                    world.step()
+            elif world is not None:
                 world.step()
             kernel.tick += 1
             ahead = (kernel.now - self._from) / self.factor - (wallclock.perf_counter() - self._start)

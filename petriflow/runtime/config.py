@@ -20,6 +20,8 @@ or the net's own ``run:`` mapping) or built in code::
     bind:               # actions for a net's transitions without editing its file
       register: core.wait                                    # by id, or by label
       "check ticket": {action: core.wait, params: {seconds: 60}}
+    bridge:             # subnets whose agents run elsewhere (docs/bridge.md)
+      {transport: zenoh, connect: tcp/127.0.0.1:7447, agents: {red: red}}
 
 Examples:
     >>> config = RunConfig.from_dict({"seed": 3, "faults": [{"kill": "r1", "at": 5}]})
@@ -37,6 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from petriflow.bridge.spec import BridgeSpec
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.outcome import Name
@@ -46,7 +49,7 @@ from petriflow.runtime.metrics import MetricRef, parse_refs
 
 __all__ = ["RunConfig", "Fault", "FaultKind", "load_config", "plain_data"]
 
-_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall", "metrics", "bind", "breakpoints"}
+_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall", "metrics", "bind", "bridge", "breakpoints"}
 
 #: Default of :attr:`RunConfig.stall`: simulated seconds a run may step tick by tick
 #: with actions running and no firing starting or ending before it is stopped.
@@ -94,6 +97,10 @@ class FaultKind(Name):
     """Messages between the two agents are lost from ``at`` until ``until``."""
     RESTORE_LINK = "restore_link"
     """In traces only: a dropped link works again (at its ``until``)."""
+    LOST = "lost"
+    """In traces only: a remote agent stopped answering (its running actions failed)."""
+    BACK = "back"
+    """In traces only: a lost remote agent announced itself again (a late joiner)."""
 
 
 _FAULT_KINDS = (FaultKind.KILL.value, FaultKind.JOIN.value, FaultKind.DROP_LINK.value)
@@ -161,6 +168,7 @@ class RunConfig:
     bind: dict[str, tuple[str, dict[str, Any]]] = field(default_factory=dict)
     #: ``{transition: name in bind}`` of the transitions :meth:`bound` bound last.
     bound_by: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
+    bridge: BridgeSpec | None = None
     #: breakpoints of a steered run (:mod:`petriflow.runtime.control`'s language):
     #: ``transition NAME``, ``place NAME >= N``, ``lost``, ``failed``.
     breakpoints: list[str] = field(default_factory=list)
@@ -213,6 +221,7 @@ class RunConfig:
         bindings = _bindings(data.get("bind"), bind_fail)
         lines.update({f"bind/{name}": getattr(binds, "key_lines", {}).get(name) for name in bindings})
         lines["actions"] = getattr(data, "key_lines", {}).get("actions")
+        lines["bridge"] = getattr(data, "key_lines", {}).get("bridge")
         lines["metrics"] = getattr(data, "key_lines", {}).get("metrics")
         lines = {key: at or getattr(data, "key_lines", {}).get(key.split("/")[0]) or line
                  for key, at in lines.items()}
@@ -220,9 +229,11 @@ class RunConfig:
         metrics = [] if data.get("metrics") is None else parse_refs(data["metrics"], fail)
         breakpoints = _breakpoints(data.get("breakpoints"), lambda message: fail(message, key="breakpoints"))
         lines["breakpoints"] = getattr(data, "key_lines", {}).get("breakpoints") or line
+        bridge = None if data.get("bridge") is None else BridgeSpec.from_dict(plain_data(data["bridge"]), fail)
         config = cls(seed, None if until is None else float(until), float(dt), world,
                      {str(k): dict(v) for k, v in channels.items()}, faults, path, located,
-                     None if stall is None else float(stall), lines, metrics, bindings, breakpoints=breakpoints)
+                     None if stall is None else float(stall), lines, metrics, bindings, bridge=bridge,
+                     breakpoints=breakpoints)
         try:
             config.channel_models()  # fail early on a bad model
         except NetFormatError as exc:
@@ -323,7 +334,8 @@ class RunConfig:
         return {name: build_channel(name, spec, registry=registry) for name, spec in self.channels.items()}
 
     def check(self, net: Net) -> None:
-        """Check that faults name agents and channels name channels of ``net``.
+        """Check that faults name agents, channels name channels and the bridge names
+        subnets of ``net``.
 
         Raises:
             NetFormatError: naming the configuration file and the unknown name.
@@ -343,6 +355,12 @@ class RunConfig:
                 raise NetFormatError(f"breakpoint {spec!r}: net {net.id!r} has no {point.kind} {point.name!r}"
                                      f"{did_you_mean(point.name, list(names))}", path=self.path,
                                      line=self.lines.get("breakpoints"))
+        if self.bridge is not None:
+            names = {*net.subnets, *agents}
+            for subnet in self.bridge.agents:
+                if subnet not in names:
+                    raise NetFormatError(f"bridge: agents: {subnet!r} is no subnet of net {net.id!r}"
+                                         f"{did_you_mean(subnet, names)}", path=self.path, line=self.lines.get("bridge"))
         used = {p.channel for p in net.places.values() if p.channel}
         for name in self.channels:
             if name not in used:
@@ -364,6 +382,8 @@ class RunConfig:
                 "channels": self.channels, "faults": faults, "actions": list(self.actions), "stall": self.stall}
         if self.metrics:
             data["metrics"] = [{m.name: {"metric": m.metric, **m.params}} for m in self.metrics]
+        if self.bridge is not None:
+            data["bridge"] = self.bridge.to_dict()
         if self.bind:
             data["bind"] = {name: {"action": action, "params": dict(params)}
                             for name, (action, params) in self.bind.items()}

@@ -101,6 +101,18 @@ class Faults:
             if fault.until is not None:
                 self.kernel.schedule(self.kernel.ticks_at(fault.until), FaultEvent(self.restore, fault))
 
+    def lose(self, agent: str, why: str = "") -> None:
+        """``agent`` stopped answering (a remote agent silent too long): it no longer
+        runs, as if killed, until :meth:`rejoin`; the caller ends its running actions."""
+        self.stopped.add(agent)
+        self.recorder.emit("fault", None, agent, fault=FaultKind.LOST.value, **({"why": why} if why else {}))
+
+    def rejoin(self, agent: str) -> None:
+        """A lost ``agent`` is back: it runs again, as a late joiner does."""
+        self.stopped.discard(agent)
+        self.recorder.emit("fault", None, agent, fault=FaultKind.BACK.value)
+        self.on_started(agent)
+
     def restore(self, fault: Fault) -> None:
         """The link ``fault`` dropped works again."""
         self.down.discard(frozenset(fault.link))

@@ -103,6 +103,23 @@ class RunRecord:
         scheduler). A metric reads a scenario's settings here, not in ``world.meta``."""
         return {} if self.scheduler is None else self.scheduler.settings
 
+    def section(self, section: Any) -> dict[str, Any]:
+        """The values of the declared settings ``section`` (a
+        :class:`~petriflow.runtime.settings.Section`) for this run: as the run read them
+        (:attr:`settings`), else read now from the record's world file (a record made by
+        hand from a run's outcome and its world), else its defaults.
+
+        Raises:
+            NetFormatError: the world's settings do not check (``file:line``).
+        """
+        if section.name in self.settings:
+            return dict(self.settings[section.name])
+        from petriflow.capabilities import Described, provides
+
+        if not provides(self.world, Described):
+            return section.read(None)
+        return section.read((self.world.meta or {}).get(section.name), path=self.world.path)
+
     @property
     def tokens(self) -> dict[str, list[Any]]:
         """``{place: [data, ...]}`` at the end."""

@@ -89,7 +89,8 @@ from petriflow.runtime.recorder import EventHandler, Recorder
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.resources import Liveness, ResourceContext, Resources
 from petriflow.runtime.result import RunResult
-from petriflow.runtime.services import RunServices
+from petriflow.runtime.services import RemoteGoals, RunServices
+from petriflow.runtime.stopwatch import UNTIMED, Timing
 from petriflow.runtime.tokens import TokenStore
 from petriflow.runtime.trace import EventKind
 from petriflow.runtime.validation import UNKNOWN, settings_of, validate
@@ -123,6 +124,9 @@ class Scheduler:
         settings: the world file's settings the actions read, checked
             (:class:`~petriflow.runtime.validation.CheckedRun`); default: read from the
             world's ``meta`` (:func:`~petriflow.runtime.validation.settings_of`).
+        stopwatch: what the actions report their work's wall-clock time to
+            (``ctx.stopwatch``; :mod:`~petriflow.runtime.stopwatch`); give the clock
+            the same one to time the world's steps.
         control: the run's control queue, when it is steered (a live page, a resumed
             steered run): :class:`~petriflow.runtime.control.Control`.
 
@@ -136,6 +140,7 @@ class Scheduler:
     def __init__(self, net: Net, *, world: Any = None, config: RunConfig | dict | None = None, seed: int | None = None,
                  registry: Registry | None = None, path: str | None = None, binding: Binding | None = None,
                  clock: Clock | None = None, settings: Mapping[str, Mapping[str, Any]] | None = None,
+                 stopwatch: Timing = UNTIMED, remote: RemoteGoals | None = None,
                  control: Control | None = None) -> None:
         self.net = net
         self.world = world
@@ -168,7 +173,7 @@ class Scheduler:
         self.resources = Resources(self.registry, ResourceContext(world, Liveness(faults.alive, index.agents), config,
                                                                   self.settings))
         services = RunServices(agents=agents, tokens=tokens, channels=self.channels, resources=self.resources,
-                               liveness=faults, settings=self.settings)
+                               liveness=faults, settings=self.settings, stopwatch=stopwatch, remote=remote)
         self.firer = Firer(net, index, kernel, tokens, enabled, recorder=recorder, agents=agents,
                            channels=self.channels, services=services, world=world, seed=seed, running=running)
         self.runner = self.firer.runner
@@ -253,6 +258,21 @@ class Scheduler:
         self.enabled_set.mark(transitions)
         self.runner.drive(self.runner.cancel(transitions))
 
+    def agent_lost(self, agent: str, why: str = "") -> None:
+        """``agent`` (a remote one) stopped answering: its running actions end
+        ``failed`` (what they did is unknown, so the net's failure routes decide), its
+        transitions no longer fire until :meth:`agent_back`; what that enables fires now."""
+        self.faults.lose(agent, why)
+        transitions = self.index.of_agent.get(agent, [])
+        self.enabled_set.mark(transitions)
+        self.runner.drive(self.runner.cancel(transitions, Outcome.FAILED))
+        self.firer.fire_instant()  # a failure route, at the instant the loss is noticed
+
+    def agent_back(self, agent: str) -> None:
+        """A lost ``agent`` announced itself again: it runs again, as a late joiner."""
+        self.faults.rejoin(agent)
+        self.firer.fire_instant()
+
     def agent_started(self, agent: str) -> None:
         """``agent`` started (a late joiner): its transitions may fire."""
         self.enabled_set.mark(self.index.of_agent.get(agent, ()))
@@ -323,7 +343,8 @@ class Scheduler:
 
     def set_speed(self, factor: float) -> None:
         """Pace the run at ``factor`` times real time from now on (0: as fast as it goes)."""
-        self.clock = SimulatedClock() if factor == 0 else RealtimeClock(factor, self.now)
+        stopwatch = getattr(self.clock, "stopwatch", None)
+        self.clock = SimulatedClock(stopwatch) if factor == 0 else RealtimeClock(stopwatch, factor, self.now)
         if self.control is not None:
             self.clock.interrupt = self.control.interrupt
 

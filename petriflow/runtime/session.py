@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import time as wallclock
 import warnings
+from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -58,6 +59,7 @@ from petriflow.runtime.observers import Progress, run_observed
 from petriflow.runtime.outputs import check_outputs, make_folders
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.result import RunResult
+from petriflow.runtime.stopwatch import Timing
 from petriflow.runtime.summary import RunExtras, extras_for
 from petriflow.runtime.trace import read_trace
 from petriflow.runtime.validation import UNKNOWN, CheckedRun, check_run, validate
@@ -114,7 +116,16 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
         run_config.import_actions()
     pending = [] if import_actions else run_config.unimported_actions()
     try:
-        binding = bind(net, registry, path=str(files.path), unimported=pending)
+        if run_config.bridge is not None:  # remote subnets: checked against their agents when the run connects
+            from petriflow.bridge.remote import bind_remote
+            from petriflow.runtime.registry import default_registry
+
+            run_config.check(net)  # the subnets it names, at the configuration's line
+            binding = bind_remote(net, run_config.bridge, registry or default_registry,
+                                  lambda local: bind(local, registry, path=str(files.path), unimported=pending),
+                                  str(files.path))
+        else:
+            binding = bind(net, registry, path=str(files.path), unimported=pending)
     except NetFormatError as exc:
         raise run_config.blame(exc) from None
     run_config.check(net)
@@ -133,8 +144,13 @@ class Live:
 
 def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | None, trace: Path | None,
              xes: Path | None, realtime: bool, gui: bool, progress: bool | float, max_firings: int | None,
-             keep_events: bool = False, extras: RunExtras | None = None, live: Live | None = None) -> RunResult:
-    """Put the checked run together and run it with its observers (step 3 and 4)."""
+             keep_events: bool = False, extras: RunExtras | None = None,
+             stopwatch: Timing | None = None, wait_agents: float | None = None,
+             live: Live | None = None) -> RunResult:
+    """Put the checked run together and run it with its observers (step 3 and 4); a
+    configuration with a ``bridge:`` connects to its remote agents first
+    (:mod:`petriflow.bridge.orchestrator`; ``wait_agents``: seconds to wait for them);
+    ``live``: serve its page and controls (:mod:`petriflow.live`)."""
     extras = extras or RunExtras()
     keep = keep_events or extras.needs_events()
     # a steered run (served live, with breakpoints, or resumed from a steered journal)
@@ -157,7 +173,7 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
     try:
         return _observed(checked, inputs, journal=journal, trace=trace, xes=xes, realtime=realtime, gui=gui,
                          progress=progress, max_firings=max_firings, keep_events=keep_events, extras=extras,
-                         keep=keep, control=control, server=server)
+                         keep=keep, control=control, server=server, stopwatch=stopwatch, wait_agents=wait_agents)
     finally:
         if server is not None:
             server.stop()
@@ -165,8 +181,21 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
 
 def _observed(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | None, trace: Path | None,
               xes: Path | None, realtime: bool, gui: bool, progress: bool | float, max_firings: int | None,
-              keep_events: bool, extras: RunExtras, keep: bool, control: Control | None, server: Any) -> RunResult:
-    with open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime, control=control) as scheduler:
+              keep_events: bool, extras: RunExtras, keep: bool, control: Control | None, server: Any,
+              stopwatch: Timing | None, wait_agents: float | None) -> RunResult:
+    with ExitStack() as stack:
+        remote, clock, watch = None, None, None
+        spec = checked.config.bridge
+        if spec is not None:  # remote agents: connected and checked first, then in wall-clock time
+            from petriflow.bridge.orchestrator import connect_run
+
+            remote, clock, watch = connect_run(stack, checked, run=inputs.get("bridge_run"), wait=wait_agents,
+                                               journal=journal)
+        scheduler = stack.enter_context(open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime,
+                                                 clock=clock, remote=remote, stopwatch=stopwatch,
+                                                 control=control))
+        if remote is not None:
+            scheduler.on_instant(watch)
         if server is not None:
             server.watch(scheduler)
         if inputs.get("poses"):  # the world's body poses as trace events (petriflow.runtime.poses)
@@ -180,6 +209,10 @@ def _observed(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal |
                               until=inputs["until"], max_firings=max_firings)
         result.cpu = wallclock.process_time() - cpu
         extras.finish(scheduler, result, checked.config)
+        if remote is not None:  # what the bridge dropped, by reason (docs/bridge.md)
+            dropped = getattr(remote, "dispatcher", remote).dropped
+            result.metrics["bridge.dropped"] = sum(dropped.values())
+            result.metrics.update({f"bridge.dropped.{why}": count for why, count in sorted(dropped.items())})
     if not keep_events:
         result.events = []
     if journal is not None:
@@ -217,7 +250,9 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
               xes: str | Path | None = None, db: str | Path | None = None, realtime: bool = False,
               gui: bool = False, registry: Registry | None = None, progress: bool | float = False,
               max_firings: int | None = None, keep_events: bool = False, metrics: list[str] | None = None,
-              picture: str | Path | None = None, poses: float | None = None, live: Live | None = None) -> RunResult:
+              picture: str | Path | None = None, poses: float | None = None,
+              stopwatch: Timing | None = None, wait_agents: float | None = None,
+              live: Live | None = None) -> RunResult:
     """Run the net in ``net_path`` (what ``petriflow run`` does).
 
     The run configuration is ``config``, else the one the net names, else
@@ -230,6 +265,10 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     record the world's body poses as ``pose`` events every so many simulated seconds
     (:mod:`petriflow.runtime.poses`; what ``petriflow view`` draws the world from).
     ``live``: serve the run's live page and controls (:class:`Live`, :mod:`petriflow.live`).
+    ``stopwatch``: where the run's wall-clock time goes, by category (the world's
+    steps as ``physics``, what the actions measure: :mod:`petriflow.runtime.stopwatch`).
+    ``wait_agents``: seconds to wait for a bridged run's remote agents (default: the
+    configuration's ``bridge: wait``).
 
     Raises:
         NetFormatError: a file is missing or malformed, an action is unknown...
@@ -241,6 +280,10 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     _warn_unbound(checked.net, net_path)
     inputs = journal_inputs(files, seed=seed, until=until)
     inputs["max_firings"] = max_firings
+    if files.config.bridge is not None:  # the run's name in its goal ids: a resume re-attaches by it
+        from petriflow.bridge.orchestrator import new_run_name
+
+        inputs["bridge_run"] = new_run_name()
     if poses is not None:  # journaled, so a resumed run samples them too
         inputs["poses"] = _pose_interval(poses)
     inputs["outputs"] = {name: None if path is None else str(Path(path).resolve())
@@ -258,7 +301,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     try:
         return _execute(checked, inputs, journal=journal, trace=None if trace is None else Path(trace),
                         xes=None if xes is None else Path(xes), realtime=realtime, gui=gui, progress=progress,
-                        max_firings=max_firings, keep_events=keep_events, extras=extras, live=live)
+                        max_firings=max_firings, keep_events=keep_events, extras=extras, stopwatch=stopwatch,
+                        wait_agents=wait_agents, live=live)
     except BaseException:
         if journal is not None and journal.journaled == 0:  # it never started: leave no journal behind
             journal.close()

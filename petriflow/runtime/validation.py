@@ -108,7 +108,16 @@ def validate(net: Net, config: RunConfig, *, binding: Binding | None = None, reg
         return binding
     if binding is None:
         try:
-            binding = bind(net, registry, path=path)
+            if config.bridge is not None:  # the remote subnets' transitions: goals to their agents
+                from petriflow.bridge.remote import bind_remote
+
+                config.check(net)  # the subnets it names, at the configuration's line
+                from petriflow.runtime.registry import default_registry
+
+                binding = bind_remote(net, config.bridge, registry or default_registry,
+                                      lambda local: bind(local, registry, path=path), path)
+            else:
+                binding = bind(net, registry, path=path)
         except NetFormatError as exc:
             raise config.blame(exc) from None
     config.check(net)

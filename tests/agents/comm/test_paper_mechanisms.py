@@ -121,10 +121,11 @@ def test_the_builder_takes_the_speed_from_the_paper_and_a_breakdown_as_a_paramet
 
 def _record(events):
     from petriflow.agents.comm.nets import world
+    from petriflow.runtime.metrics import RunRecord
 
     maze = world()["meta"]["maze"]
-    return SimpleNamespace(events=events, world=SimpleNamespace(meta={"maze": maze}),
-                           result=SimpleNamespace(time=events[-1].time))
+    return RunRecord(events=events, world=SimpleNamespace(meta={"maze": maze}, path=None),
+                     result=SimpleNamespace(time=events[-1].time))
 
 
 def test_a_broken_down_robot_is_not_counted_as_a_working_agent():

@@ -103,9 +103,13 @@ class _Place:
     def __init__(self, positions):
         self.positions = positions
         self.meta = {"slam": {"nodes": [[0.0, 0.0], [20.0, 0.0]]}}
+        self.path = None  # a world described in code (capabilities.Described)
 
     def position(self, name):
         return self.positions.get(name)
+
+    def distance(self, a, b):  # with position: what capabilities.Positions names
+        return math.dist(self.positions[a], self.positions[b])
 
 
 def test_the_channel_delivers_near_loses_far_and_reaches_the_central_unit_by_the_nodes():

@@ -82,8 +82,8 @@ def test_hats_follow_a_walking_robot_without_a_per_step_sync(arena):
 
 
 @pytest.mark.parametrize("meta, match", [
-    ({"smart": {"floor": "blue"}}, "floor"),
-    ({"smart": {"markers": [{"robot": "robot3l"}]}}, "a marker is"),
+    ({"smart": {"floor": "blue"}}, "setting 'floor' must be one of"),
+    ({"smart": {"markers": [{"robot": "robot3l"}]}}, r"'meta.smart.markers\[0\]': missing setting 'colour'"),
     ({"smart": [1]}, "meta.smart is a mapping"),
 ])
 def test_malformed_arena_data_is_an_error(meta, match):
@@ -96,8 +96,8 @@ def test_malformed_arena_data_is_an_error(meta, match):
 
 
 def test_bad_arena_data_stops_the_run_before_it_starts():
-    """smart.capture uses the smart.arena resource, which the run makes before the first
-    firing: a malformed meta.smart is bad input, one error naming the field."""
+    """smart.capture uses the smart.arena resource, which declares meta.smart: a
+    malformed meta.smart is bad input, one error naming the setting, before the run."""
     net = loads_net("""
 petriflow: 1
 places: [{id: a, tokens: 1}, b, bad]
@@ -105,7 +105,7 @@ transitions: [{id: t, action: smart.capture, in: [a], out: [b], outcomes: {faile
 """)
     world = World({"meta": {"smart": {"floor": "blue"}}, "cameras": [{"id": "top", "width": 32, "height": 24}]})
     try:
-        with pytest.raises(PetriflowError, match="resource smart.arena: meta.smart.floor: 'white' or 'painted'"):
+        with pytest.raises(PetriflowError, match="'meta.smart': setting 'floor' must be one of"):
             fire_one(net, "t", world=world)
     finally:
         world.close()

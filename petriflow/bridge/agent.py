@@ -1,0 +1,347 @@
+"""The robot's side of the bridge: ``petriflow agent`` serves registry actions to a run.
+
+An :class:`AgentServer` connects to the router or broker under one or more agent
+names, announces the actions of its registry with their parameters, and executes the
+goals sent to those names with the very :class:`~petriflow.runtime.action.Action`
+classes (and ``@action`` functions) a local run uses, in wall-clock time: ``start``
+when the goal comes, ``poll`` at every step of its own world (``--world``, a pybullet
+stand-in for the hardware) or when the action asked (``wake_at``), ``cancel`` when
+the run cancels the goal. Its context has the goal's transition, agent, parameters,
+input tokens and seed (so ``ctx.rng`` draws as in a local run), its world, and the
+world file's settings the action declares (``ctx.settings``); it has no other run
+services (an action that reads another agent's state or a port runs locally).
+
+Goals are de-duplicated by id: a goal sent again (the run re-sends after a broker
+restart) is answered from what the server holds of that id (``accepted`` while it
+runs, the same ``result`` once it ended) and never executed twice. ``log`` gets one
+JSON line per goal executed, for the operator (and the tests) to count executions.
+
+``speed`` runs the agent's clock faster than the wall clock (2: twice as fast), for
+demonstrations and tests; a robot runs at 1.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import queue
+import threading
+import time
+import uuid
+from dataclasses import dataclass
+from typing import Any, Callable, TextIO
+
+from petriflow.bridge import protocol
+from petriflow.bridge.protocol import Refused
+from petriflow.bridge.transport import Transport, agent_of, from_agent, to_agent
+from petriflow.errors import NetFormatError
+from petriflow.runtime.action import REQUIRED, Action, ActionContext, Status, first_data, type_names
+from petriflow.runtime.registry import Registry, UnknownActionError, default_registry
+from petriflow.runtime.services import RunServices
+from petriflow.runtime.settings import read_settings
+
+__all__ = ["AgentServer", "announcement"]
+
+log = logging.getLogger("petriflow.bridge.agent")
+#: Ended goals remembered per server (to answer a goal sent again); the oldest are forgotten.
+REMEMBERED = 100_000
+
+
+def announcement(registry: Registry) -> dict[str, dict[str, Any]]:
+    """``{action: {parameter: {"type": ..., "default": ...}}}`` of every action of
+    ``registry`` (a required parameter has no ``default``).
+
+    Examples:
+        >>> announcement(default_registry)["core.wait"]["seconds"]["type"]
+        'float'
+    """
+    actions: dict[str, dict[str, Any]] = {}
+    for name in registry.names():
+        try:
+            cls = registry.resolve(name)
+        except Exception:  # an action whose module does not import is not served
+            continue
+        declared = {}
+        for pname, param in getattr(cls, "params", {}).items():
+            entry: dict[str, Any] = {"type": type_names(param.type)}
+            if param.default is not REQUIRED:
+                entry["default"] = protocol.to_data(param.default)
+            declared[pname] = entry
+        actions[name] = declared
+    return actions
+
+
+@dataclass
+class _Running:
+    """A goal being executed."""
+
+    goal: protocol.Goal
+    action: Action
+    ctx: ActionContext
+    ends_at: float | None = None  # an action that only waits: when it ends
+    cancelling: bool = False
+
+
+class AgentServer:
+    """Executes goals for ``names`` (see the module).
+
+    Args:
+        names: the agent names served.
+        transport: an open transport.
+        registry: where actions are found (default: the run registry).
+        world: the world actions run in (``None``: none).
+        speed: agent seconds per wall-clock second.
+        heartbeat: seconds between heartbeats (an announcement every four).
+        log_file: where to write one JSON line per goal executed.
+        now: the wall clock.
+    """
+
+    def __init__(self, names: list[str], transport: Transport, *, registry: Registry | None = None,
+                 world: Any = None, speed: float = 1.0, heartbeat: float = 0.5, log_file: TextIO | None = None,
+                 now: Callable[[], float] = time.perf_counter) -> None:
+        self.names = list(dict.fromkeys(names))
+        self.transport = transport
+        self.registry = registry or default_registry
+        self.world = world
+        self.speed = speed
+        self.heartbeat = heartbeat
+        self.log_file = log_file
+        self.wall = now
+        self.instance = uuid.uuid4().hex[:12]
+        self.actions = announcement(self.registry)
+        self.inbox: queue.SimpleQueue[tuple[str, bytes]] = queue.SimpleQueue()
+        self.running: dict[str, _Running] = {}
+        self.ended: dict[str, protocol.Message] = {}
+        self.instances: dict[tuple[str, str, str], Action] = {}
+        self.executed = 0
+        self.dropped = 0
+        self._stop = threading.Event()
+        self._start = now()
+        self._dt = float(getattr(world, "dt", None) or 0.01)
+        for name in self.names:
+            transport.subscribe(to_agent(name), self._receive)
+
+    @property
+    def now(self) -> float:
+        """The agent's time: wall-clock seconds since it started, times :attr:`speed`."""
+        return (self.wall() - self._start) * self.speed
+
+    def _receive(self, topic: str, payload: bytes) -> None:
+        self.inbox.put((topic, payload))
+
+    def _send(self, agent: str, message: protocol.Message) -> None:
+        self.transport.publish(from_agent(agent), protocol.encode(message))
+
+    def announce(self) -> None:
+        """Announce every name served."""
+        for name in self.names:
+            self._send(name, protocol.Announce(name, self.actions, self.instance))
+
+    def stop(self) -> None:
+        """Make :meth:`serve` return (from another thread or a signal handler)."""
+        self._stop.set()
+        self.inbox.put(("", b""))
+
+    def serve(self, until: Callable[[], bool] | None = None) -> None:
+        """Serve goals until :meth:`stop` (or ``until()`` is true); running goals are
+        cancelled and every action torn down at the end."""
+        self.announce()
+        beats = 0
+        next_beat = self.wall() + self.heartbeat
+        next_step = self.wall()
+        try:
+            while not self._stop.is_set() and not (until is not None and until()):
+                wall = self.wall()
+                if wall >= next_beat:
+                    beats += 1
+                    next_beat = wall + self.heartbeat
+                    self._beat(announce=beats % 4 == 0)
+                if wall >= next_step:
+                    next_step += self._dt / self.speed
+                    if next_step < wall:
+                        next_step = wall  # behind: never try to catch up a burst of steps
+                    if self.world is not None and self.running:
+                        self.world.step()
+                    self._poll_all()
+                wait = max(0.0, min(next_beat, next_step if self.running else next_beat) - self.wall())
+                try:
+                    topic, payload = self.inbox.get(timeout=wait)
+                except queue.Empty:
+                    continue
+                if topic:
+                    self.handle(agent_of(topic), payload)
+                while True:  # what else came in meanwhile
+                    try:
+                        topic, payload = self.inbox.get_nowait()
+                    except queue.Empty:
+                        break
+                    if topic:
+                        self.handle(agent_of(topic), payload)
+        finally:
+            for goal_id in list(self.running):
+                self._finish_cancel(goal_id, force=True)
+            for action in self.instances.values():
+                try:
+                    action.teardown()
+                except Exception as exc:
+                    log.warning("teardown failed: %s", exc)
+
+    def _beat(self, announce: bool) -> None:
+        if announce:
+            self.announce()
+        for name in self.names:
+            running = [g for g, r in self.running.items() if r.goal.agent == name]
+            self._send(name, protocol.Heartbeat(name, running, self.instance))
+
+    # one message -----------------------------------------------------------------------------
+    def handle(self, agent: str, payload: bytes) -> None:
+        """One message for ``agent`` (a name served): checked, then acted on."""
+        try:
+            message = protocol.decode(payload)
+        except Refused as exc:
+            self.dropped += 1
+            log.warning("dropped a message for %s: %s", agent, exc)
+            return
+        if isinstance(message, protocol.Heartbeat):
+            return
+        if not isinstance(message, (protocol.Goal, protocol.Cancel)) or message.agent != agent:
+            self.dropped += 1
+            log.warning("dropped a %s for %s", message.kind.value, agent)
+            return
+        if isinstance(message, protocol.Cancel):
+            self.cancel(message)
+            return
+        done = self.ended.get(message.id)
+        if done is not None:  # sent again: the same answer, never a second execution
+            self._send(agent, done)
+        elif message.id in self.running:
+            self._send(agent, protocol.Accepted(message.id, agent))
+        else:
+            self.execute(message)
+
+    def cancel(self, message: protocol.Cancel) -> None:
+        """Stop a running goal (its action's ``cancel`` until it is done); acknowledge."""
+        running = self.running.get(message.id)
+        if running is None:
+            done = self.ended.get(message.id)
+            if isinstance(done, protocol.Result):  # it had ended: the run learns how
+                self._send(message.agent, done)
+            else:
+                self._send(message.agent, protocol.Cancelled(message.id, message.agent))
+            return
+        running.cancelling = True
+        self._finish_cancel(message.id)
+
+    def _finish_cancel(self, goal_id: str, force: bool = False) -> None:
+        running = self.running[goal_id]
+        running.ctx.now = self.now
+        try:
+            done = running.ends_at is not None or running.action.cancel(running.ctx)
+        except Exception as exc:
+            log.warning("cancel of %s raised %s", goal_id, exc)
+            done = True
+        if done or force:
+            del self.running[goal_id]
+            self._remember(goal_id, protocol.Cancelled(goal_id, running.goal.agent))
+
+    def _remember(self, goal_id: str, answer: protocol.Message) -> None:
+        self.ended[goal_id] = answer
+        if len(self.ended) > REMEMBERED:
+            del self.ended[next(iter(self.ended))]
+        self._send(answer.agent, answer)
+
+    def execute(self, goal: protocol.Goal) -> None:
+        """Start executing ``goal``: reject it if its action or parameters do not check."""
+        try:
+            cls = self.registry.resolve(goal.action)
+            params = cls.check_params(goal.params, goal.transition or goal.action)
+        except (UnknownActionError, NetFormatError) as exc:
+            self._remember(goal.id, protocol.Rejected(goal.id, goal.agent, str(exc)))
+            return
+        key = (goal.agent, goal.transition, json.dumps(protocol.to_data(params), sort_keys=True))
+        action = self.instances.get(key)
+        setup_error = None
+        if action is None:
+            action = self.instances[key] = cls(params)
+            try:
+                action.setup(self.world)
+            except Exception as exc:
+                setup_error = f"setup: {type(exc).__name__}: {exc}"
+        section = getattr(cls, "settings", None)
+        try:  # the world file's settings the action declares, as a local run reads them
+            settings = {} if section is None else read_settings(getattr(self.world, "meta", None),
+                                                                 {section.name: section})
+        except NetFormatError as exc:
+            self._remember(goal.id, protocol.Rejected(goal.id, goal.agent, f"the world's settings: {exc}"))
+            return
+        now = self.now
+        ctx = ActionContext(goal.transition or goal.action, goal.agent, params, dict(goal.inputs), self.world,
+                            goal.seed or goal.id, now, now, services=RunServices(settings=settings), action=cls)
+        self.executed += 1
+        if self.log_file is not None:
+            self.log_file.write(json.dumps({"goal": goal.id, "agent": goal.agent, "action": goal.action,
+                                            "transition": goal.transition, "at": round(now, 6)}) + "\n")
+            self.log_file.flush()
+        self._send(goal.agent, protocol.Accepted(goal.id, goal.agent))
+        if setup_error is not None:
+            self._end(goal, ctx, Status.FAILED, setup_error)
+            return
+        running = self.running[goal.id] = _Running(goal, action, ctx)
+        try:
+            seconds = action.delay()
+        except Exception:
+            seconds = None
+        if seconds is not None:
+            running.ends_at = now + seconds
+            self._poll(running)
+            return
+        try:
+            action.start(ctx)
+        except Exception as exc:
+            del self.running[goal.id]
+            self._end(goal, ctx, Status.FAILED, f"{type(exc).__name__}: {exc}")
+            return
+        wake = action.wake_at
+        if action.needs_world or wake is None or wake <= now:
+            self._poll(running)
+
+    def _poll_all(self) -> None:
+        for running in list(self.running.values()):
+            if running.cancelling:
+                self._finish_cancel(running.goal.id)
+                continue
+            action = running.action
+            if running.ends_at is None and not action.needs_world and action.wake_at is not None \
+                    and action.wake_at > self.now:
+                continue
+            self._poll(running)
+
+    def _poll(self, running: _Running) -> None:
+        ctx = running.ctx
+        ctx.now = now = self.now
+        if running.ends_at is not None:
+            if now + 1e-9 < running.ends_at:
+                return
+            ctx.result = first_data(ctx.inputs)
+            status = Status.OK
+        else:
+            try:
+                status = running.action.poll(ctx)
+            except Exception as exc:
+                ctx.reason = f"{type(exc).__name__}: {exc}"
+                status = Status.FAILED
+        if status is Status.RUNNING:
+            return
+        del self.running[running.goal.id]
+        self._end(running.goal, ctx, status if status in (Status.OK, Status.FAILED) else Status.FAILED,
+                  ctx.reason or ("" if status in (Status.OK, Status.FAILED) else f"poll() returned {status!r}"))
+
+    def _end(self, goal: protocol.Goal, ctx: ActionContext, status: Status, reason: str = "") -> None:
+        if status is Status.OK:
+            data = ctx.result
+            if ctx.per_place and isinstance(data, dict):
+                data = None
+            answer = protocol.Result(goal.id, goal.agent, "ok", protocol.to_data(data))
+        else:
+            answer = protocol.Result(goal.id, goal.agent, "failed", None, reason or ctx.reason or "failed")
+        self._remember(goal.id, answer)

@@ -1,0 +1,361 @@
+"""The orchestrator's side of the bridge: goals out, answers in, agents watched.
+
+A :class:`Dispatcher` holds one transport connection for a run. The run's thread
+sends goals and cancels and reads their state (:meth:`Dispatcher.goal`); the
+transport's thread delivers what agents send, which is decoded, checked against what
+this run sent and counted when dropped (:attr:`Dispatcher.dropped`, by
+:class:`~petriflow.bridge.protocol.Drop`); a heartbeat thread tells the agents the run
+is alive and sends again, with the same id, every goal an agent is not known to hold
+(lost in a broker restart: the agent answers from what it remembers of that id, and
+never runs it twice).
+
+An agent is *lost* when nothing came from it for ``heartbeat_timeout`` seconds; it is
+back when it announces itself again. :meth:`Dispatcher.watch` says which agents were
+lost or came back since it was last asked, so the run changes its own state only in
+its own thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+import uuid
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from petriflow.bridge import protocol
+from petriflow.bridge.protocol import Drop, Refused
+from petriflow.bridge.spec import BridgeSpec
+from petriflow.bridge.transport import Transport, agent_of, from_agent, open_transport, to_agent
+
+__all__ = ["Dispatcher", "GoalState", "AgentSeen", "Phase"]
+
+log = logging.getLogger("petriflow.bridge")
+#: Drops logged per reason (the rest are only counted).
+LOGGED_DROPS = 5
+
+
+class Phase:
+    """Where a goal is (plain strings: they are compared, logged and recorded)."""
+
+    SENT = "sent"
+    ACCEPTED = "accepted"
+    REJECTED = "rejected"
+    OK = "ok"
+    FAILED = "failed"
+    CANCELLED = "cancelled"
+    ENDED = (REJECTED, OK, FAILED, CANCELLED)
+
+
+@dataclass
+class GoalState:
+    """One goal this run sent, and what came back.
+
+    Attributes:
+        goal: the goal.
+        phase: a :class:`Phase`.
+        sent: wall-clock time (``time.perf_counter``) it was first sent.
+        answered: wall-clock time of its result (``None`` before).
+        resent: how many times it was sent again.
+        data: the result's output token data.
+        reason: why it failed or was rejected.
+        cancel_sent: wall-clock time a cancel was sent (``None``: none).
+        feedback: the last feedback's data.
+    """
+
+    goal: protocol.Goal
+    phase: str = Phase.SENT
+    sent: float = 0.0
+    last_sent: float = 0.0
+    answered: float | None = None
+    resent: int = 0
+    data: Any = None
+    reason: str = ""
+    cancel_sent: float | None = None
+    feedback: Any = None
+    #: On resume, the simulated time the journal shows it ended at (its ending is taken
+    #: then, as journaled: :mod:`petriflow.bridge.resume`); ``None``: a live goal.
+    at: float | None = None
+
+    @property
+    def ended(self) -> bool:
+        """Whether the goal ended (a result, a rejection or a cancel's acknowledgement)."""
+        return self.phase in Phase.ENDED
+
+    @property
+    def round_trip(self) -> float | None:
+        """Seconds from the goal sent to its end received."""
+        return None if self.answered is None else self.answered - self.sent
+
+
+@dataclass
+class AgentSeen:
+    """What the run knows of one agent."""
+
+    name: str
+    actions: dict[str, dict[str, Any]] = field(default_factory=dict)
+    instance: str = ""
+    last: float = 0.0
+    running: set[str] = field(default_factory=set)
+    announced: bool = False
+
+
+class Dispatcher:
+    """The run's connection to its remote agents (see the module).
+
+    Args:
+        spec: the configuration's ``bridge:`` section.
+        transport: an open transport (default: opened from ``spec``).
+        run: this run's name in goal ids (default: a new random one).
+        now: the wall clock (seconds).
+    """
+
+    def __init__(self, spec: BridgeSpec, transport: Transport | None = None, *, run: str | None = None,
+                 now: Callable[[], float] = time.perf_counter) -> None:
+        self.spec = spec
+        self.run = run or uuid.uuid4().hex[:12]
+        self.now = now
+        self.names = set(spec.agents.values())
+        self.agents: dict[str, AgentSeen] = {name: AgentSeen(name) for name in self.names}
+        self.goals: dict[str, GoalState] = {}
+        self.dropped: Counter[str] = Counter()
+        self._lock = threading.Lock()
+        self._announced = threading.Condition(self._lock)
+        self._ended = threading.Condition(self._lock)
+        self._lost: set[str] = set()
+        self._stop = threading.Event()
+        self.transport = transport or open_transport(spec.transport, spec.endpoint(), "orchestrator")
+        self.transport.subscribe(from_agent("*"), self.receive)
+        self._beat = threading.Thread(target=self._heartbeats, name="petriflow-bridge-heartbeat", daemon=True)
+        self._beat.start()
+
+    # what the transport's thread calls ------------------------------------------------
+    def drop(self, reason: Drop, detail: str) -> None:
+        """Count (and log the first few of) a message dropped for ``reason``."""
+        with self._lock:
+            self.dropped[reason.value] += 1
+            count = self.dropped[reason.value]
+        if count <= LOGGED_DROPS:
+            log.warning("bridge: dropped a message (%s): %s", reason.value, detail[:200])
+
+    def receive(self, topic: str, payload: bytes) -> None:
+        """One message from an agent (the transport's handler): checked, then applied."""
+        sender = agent_of(topic)
+        if sender not in self.names:
+            self.drop(Drop.UNKNOWN_AGENT, f"from {sender[:64]!r}, which the run's bridge does not list")
+            return
+        try:
+            message = protocol.decode(payload)
+        except Refused as exc:
+            self.drop(exc.drop, f"from {sender!r}: {exc}")
+            return
+        if getattr(message, "agent", sender) != sender:
+            self.drop(Drop.WRONG_AGENT, f"{message.kind.value} on {sender!r}'s topic names agent"
+                                        f" {getattr(message, 'agent', '')!r}")
+            return
+        if isinstance(message, (protocol.Goal, protocol.Cancel)):
+            self.drop(Drop.MALFORMED, f"an agent sent a {message.kind.value}")
+            return
+        now = self.now()
+        with self._lock:
+            seen = self.agents[sender]
+            seen.last = now
+            if isinstance(message, protocol.Announce):
+                if seen.instance and message.instance != seen.instance:
+                    self._restarted(seen, now)
+                seen.actions, seen.instance, seen.announced = message.actions, message.instance, True
+                self._announced.notify_all()
+                return
+            if isinstance(message, protocol.Heartbeat):
+                seen.running = set(message.running)
+                return
+            state = self.goals.get(message.id)
+        if state is None:
+            self.drop(Drop.UNKNOWN_GOAL, f"{message.kind.value} from {sender!r} for goal {message.id[:80]!r},"
+                                         " which this run never sent")
+            return
+        if state.goal.agent != sender:
+            self.drop(Drop.WRONG_AGENT, f"{message.kind.value} from {sender!r} for a goal sent to"
+                                        f" {state.goal.agent!r}")
+            return
+        self._apply(state, message, now)
+
+    def _restarted(self, seen: AgentSeen, now: float) -> None:
+        """``seen`` announced itself as a new process: the goals its old one held died
+        with it (they fail; sending them again would run them a second time). Holds
+        the lock."""
+        for state in self.goals.values():
+            if state.goal.agent == seen.name and not state.ended:
+                state.phase, state.answered = Phase.FAILED, now
+                state.reason = "the agent restarted while the goal ran (its outcome is unknown)"
+        self._ended.notify_all()
+
+    def _apply(self, state: GoalState, message: protocol.Message, now: float) -> None:
+        with self._lock:
+            if state.ended:
+                replayed = True
+            else:
+                replayed = False
+                if isinstance(message, protocol.Accepted):
+                    state.phase = Phase.ACCEPTED
+                elif isinstance(message, protocol.Feedback):
+                    state.feedback = message.data
+                elif isinstance(message, protocol.Rejected):
+                    state.phase, state.reason, state.answered = Phase.REJECTED, message.reason, now
+                elif isinstance(message, protocol.Result):
+                    state.phase = Phase.OK if message.outcome == "ok" else Phase.FAILED
+                    state.data, state.reason, state.answered = message.data, message.reason, now
+                elif isinstance(message, protocol.Cancelled):
+                    state.phase, state.answered = Phase.CANCELLED, now
+                if state.ended:
+                    self._ended.notify_all()
+        # an answer to a goal sent again is expected twice; otherwise an ended goal's answer is a replay
+        if replayed and state.resent == 0 and not isinstance(message, (protocol.Accepted, protocol.Feedback)):
+            self.drop(Drop.REPLAYED, f"{message.kind.value} for goal {state.goal.id!r}, which had ended")
+
+    # what the run's thread calls --------------------------------------------------------
+    def wait_for(self, seconds: float) -> list[str]:
+        """Wait up to ``seconds`` for every agent to announce itself; the names of those
+        that did not, sorted."""
+        deadline = self.now() + seconds
+        with self._lock:
+            while True:
+                missing = sorted(name for name, seen in self.agents.items() if not seen.announced)
+                left = deadline - self.now()
+                if not missing or left <= 0:
+                    return missing
+                self._announced.wait(min(left, 0.1))
+
+    def announced(self, agent: str) -> dict[str, dict[str, Any]] | None:
+        """``{action: {parameter: declaration}}`` ``agent`` announced (``None``: it did not)."""
+        with self._lock:
+            seen = self.agents.get(agent)
+            return dict(seen.actions) if seen is not None and seen.announced else None
+
+    def send(self, goal: protocol.Goal) -> GoalState:
+        """Send ``goal`` (again, if a goal of its id was sent: its state is kept)."""
+        now = self.now()
+        with self._lock:
+            state = self.goals.get(goal.id)
+            if state is None:
+                state = self.goals[goal.id] = GoalState(goal, sent=now)
+            state.last_sent = now
+        self.transport.publish(to_agent(goal.agent), protocol.encode(goal))
+        return state
+
+    def goal(self, goal_id: str) -> GoalState | None:
+        """The state of the goal ``goal_id``."""
+        with self._lock:
+            return self.goals.get(goal_id)
+
+    def wait_goal(self, goal_id: str, seconds: float) -> GoalState | None:
+        """The goal's state once it ended, or after ``seconds`` (``None``: never sent)."""
+        deadline = self.now() + seconds
+        with self._lock:
+            while True:
+                state = self.goals.get(goal_id)
+                left = deadline - self.now()
+                if state is None or state.ended or left <= 0:
+                    return state
+                self._ended.wait(left)
+
+    def cancel(self, goal_id: str) -> None:
+        """Ask the agent to stop the goal (again after a heartbeat until acknowledged)."""
+        with self._lock:
+            state = self.goals.get(goal_id)
+            if state is None or state.ended:
+                return
+            state.cancel_sent = self.now()
+            goal = state.goal
+        self.transport.publish(to_agent(goal.agent), protocol.encode(protocol.Cancel(goal.id, goal.agent)))
+
+    def forget(self, goal_id: str) -> None:
+        """The run is done with this goal (it ended, was cancelled, or its agent lost)."""
+        with self._lock:
+            state = self.goals.get(goal_id)
+            if state is not None and not state.ended:
+                state.phase = Phase.CANCELLED
+
+    def is_lost(self, agent: str) -> bool:
+        """Whether ``agent`` was lost (as :meth:`watch` last found)."""
+        return agent in self._lost
+
+    def watch(self) -> tuple[list[str], list[str]]:
+        """``(lost, back)``: the agents lost and those back since the last call (an agent
+        is lost when silent for ``heartbeat_timeout``, back when it announced itself
+        since)."""
+        now, timeout = self.now(), self.spec.heartbeat_timeout
+        lost, back = [], []
+        with self._lock:
+            for name, seen in sorted(self.agents.items()):
+                silent = not seen.announced or now - seen.last > timeout
+                if silent and name not in self._lost and seen.announced:
+                    self._lost.add(name)
+                    seen.announced = False  # back only when it announces itself again
+                    lost.append(name)
+                elif not silent and name in self._lost:
+                    self._lost.discard(name)
+                    back.append(name)
+        return lost, back
+
+    def mark_lost(self, agent: str) -> None:
+        """Hold ``agent`` lost (the run had lost it before a resume) until it announces itself."""
+        with self._lock:
+            self._lost.add(agent)
+            self.agents[agent].announced = False
+
+    def silence(self, agent: str) -> float:
+        """Seconds since ``agent`` was last heard from."""
+        with self._lock:
+            return self.now() - self.agents[agent].last
+
+    # the heartbeat thread -----------------------------------------------------------------
+    def _heartbeats(self) -> None:
+        beat = protocol.encode(protocol.Heartbeat(""))
+        period = self.spec.heartbeat
+        while not self._stop.wait(period):
+            try:
+                for name in sorted(self.names):
+                    self.transport.publish(to_agent(name), beat)
+                self.send_again()
+            except Exception as exc:  # a transport error must not end the heartbeats
+                log.warning("bridge: heartbeat failed: %s", exc)
+
+    def send_again(self) -> None:
+        """Send again each goal its agent does not hold (not in its last heartbeat) and
+        each cancel not acknowledged, once a heartbeat has passed since the last send."""
+        now, period = self.now(), self.spec.heartbeat
+        goals, cancels = [], []
+        with self._lock:
+            for state in self.goals.values():
+                if state.ended:
+                    continue
+                seen = self.agents[state.goal.agent]
+                if state.cancel_sent is not None:
+                    if now - state.cancel_sent > period:
+                        state.cancel_sent = now
+                        cancels.append(state.goal)
+                elif state.goal.id not in seen.running and now - state.last_sent > 2 * period and \
+                        seen.last > state.last_sent:
+                    state.last_sent = now
+                    state.resent += 1
+                    goals.append(state.goal)
+        for goal in goals:
+            self.transport.publish(to_agent(goal.agent), protocol.encode(goal))
+        for goal in cancels:
+            self.transport.publish(to_agent(goal.agent), protocol.encode(protocol.Cancel(goal.id, goal.agent)))
+
+    def close(self) -> None:
+        """Stop the heartbeats and disconnect."""
+        self._stop.set()
+        self._beat.join(timeout=5)
+        self.transport.close()
+
+    def __enter__(self) -> "Dispatcher":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+

@@ -1,0 +1,325 @@
+"""The remote-action protocol: versioned messages between a run and its agents.
+
+A run (the *orchestrator*) and the processes that execute its actions (*agents*: a
+``petriflow agent``, or a robot speaking the protocol in any language) exchange small
+JSON objects over a publish/subscribe transport (:mod:`petriflow.bridge.transport`).
+Every message has ``v`` (the protocol version, :data:`VERSION`), ``type`` (a
+:class:`Kind`) and the fields its dataclass declares; docs/bridge.md is the
+language-neutral description.
+
+==============  ==============  ===================================================
+message         sent by         says
+==============  ==============  ===================================================
+``announce``    agent           its name, the actions it serves with their parameters
+``heartbeat``   both            alive; an agent's lists the goals it is running
+``goal``        orchestrator    run this action (an idempotent ``id``: run/firing/attempt)
+``accepted``    agent           the goal runs (also the answer to a goal sent again)
+``rejected``    agent           the goal cannot run (unknown action, bad parameters)
+``feedback``    agent           progress of a running goal (optional)
+``result``      agent           ``ok`` with the output token data, or ``failed``
+``cancel``      orchestrator    stop this goal
+``cancelled``   agent           the goal was stopped (the cancel's acknowledgement)
+==============  ==============  ===================================================
+
+Everything that comes from the network is data: :func:`decode` parses JSON (never
+code), refuses a message over :data:`MAX_MESSAGE` bytes before parsing it, and checks
+the version, the type and each field's type; what it refuses is a :class:`Refused`
+with the :class:`Drop` reason the receiver counts.
+
+Examples:
+    >>> goal = Goal(id="r1/3/1", agent="red", action="core.wait", params={"seconds": 1.0},
+    ...             transition="t", inputs={"i": [None]}, seed="1:3")
+    >>> data = encode(goal)
+    >>> decode(data) == goal
+    True
+    >>> decode(b'{"v": 1, "type": "result", "id": "x"}')
+    Traceback (most recent call last):
+    ...
+    petriflow.bridge.protocol.Refused: malformed: result: missing field 'agent'
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+from petriflow.errors import PetriflowError
+from petriflow.outcome import Name
+
+__all__ = ["VERSION", "MAX_MESSAGE", "Kind", "Drop", "Refused", "Announce", "Heartbeat", "Goal", "Accepted",
+           "Rejected", "Feedback", "Result", "Cancel", "Cancelled", "Message", "About", "encode", "decode", "goal_id",
+           "to_data"]
+
+#: The protocol version this code speaks (a message of another version is dropped).
+VERSION = 1
+#: The largest message accepted, in bytes (a larger one is dropped unread).
+MAX_MESSAGE = 1 << 20
+#: The deepest nesting of lists and mappings accepted in a message.
+MAX_DEPTH = 32
+
+
+class Kind(Name):
+    """The types of message."""
+
+    ANNOUNCE = "announce"
+    HEARTBEAT = "heartbeat"
+    GOAL = "goal"
+    ACCEPTED = "accepted"
+    REJECTED = "rejected"
+    FEEDBACK = "feedback"
+    RESULT = "result"
+    CANCEL = "cancel"
+    CANCELLED = "cancelled"
+
+
+class Drop(Name):
+    """Why a received message was dropped (each reason is counted)."""
+
+    OVERSIZED = "oversized"
+    """Longer than :data:`MAX_MESSAGE`."""
+    MALFORMED = "malformed"
+    """Not JSON, not an object, an unknown type, a missing or ill-typed field."""
+    VERSION = "version"
+    """Another protocol version."""
+    UNKNOWN_AGENT = "unknown_agent"
+    """From an agent name the run's configuration does not list."""
+    UNKNOWN_GOAL = "unknown_goal"
+    """About a goal this run never sent."""
+    REPLAYED = "replayed"
+    """About a goal already ended (a result or acknowledgement received twice)."""
+    WRONG_AGENT = "wrong_agent"
+    """About a goal sent to another agent."""
+
+
+class Refused(PetriflowError):
+    """A message :func:`decode` refuses; :attr:`drop` says why."""
+
+    def __init__(self, drop: Drop, detail: str) -> None:
+        super().__init__(f"{drop.value}: {detail}")
+        self.drop = drop
+
+
+@dataclass(frozen=True)
+class Message:
+    """Fields every message has (subclasses add theirs)."""
+
+    kind: ClassVar[Kind]
+
+
+@dataclass(frozen=True)
+class Announce(Message):
+    """An agent says who it is and what it serves.
+
+    Attributes:
+        agent: its name.
+        actions: ``{action: {parameter: {"type": TYPE, "default": VALUE}}}`` (a
+            parameter without ``default`` is required; ``type`` one of ``float``,
+            ``int``, ``str``, ``bool``, ``list``, ``dict``, ``any``).
+        instance: a name for the agent's process, new at every start (a restarted
+            agent is told from one that only lost some messages).
+    """
+
+    kind: ClassVar[Kind] = Kind.ANNOUNCE
+    agent: str
+    actions: dict[str, dict[str, Any]]
+    instance: str = ""
+
+
+@dataclass(frozen=True)
+class Heartbeat(Message):
+    """Alive. From an agent, ``running`` lists the goal ids it is executing; the
+    orchestrator's has ``agent`` ``""``."""
+
+    kind: ClassVar[Kind] = Kind.HEARTBEAT
+    agent: str
+    running: list[str] = field(default_factory=list)
+    instance: str = ""
+
+
+@dataclass(frozen=True)
+class Goal(Message):
+    """Run ``action`` with ``params`` on ``inputs`` (``{place: [token data]}``).
+
+    ``id`` is idempotent: the same goal sent again (after a reconnect) carries the same
+    id, and an agent that has it already answers as for the first one, never running
+    the action twice. ``seed`` seeds the firing's random generator as a local run would.
+    """
+
+    kind: ClassVar[Kind] = Kind.GOAL
+    id: str
+    agent: str
+    action: str
+    params: dict[str, Any]
+    transition: str = ""
+    inputs: dict[str, list[Any]] = field(default_factory=dict)
+    seed: str = ""
+
+
+@dataclass(frozen=True)
+class About(Message):
+    """A message about the goal ``id`` of ``agent`` (the answers, and a cancel)."""
+
+    id: str
+    agent: str
+
+
+@dataclass(frozen=True)
+class Rejected(About):
+    """The goal ``id`` cannot run, and why."""
+
+    kind: ClassVar[Kind] = Kind.REJECTED
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class Feedback(About):
+    """Progress of the goal ``id``."""
+
+    kind: ClassVar[Kind] = Kind.FEEDBACK
+    data: Any = None
+
+
+@dataclass(frozen=True)
+class Result(About):
+    """The goal ``id`` ended: ``outcome`` ``ok`` (``data``: the output tokens' data) or
+    ``failed`` (``reason``)."""
+
+    kind: ClassVar[Kind] = Kind.RESULT
+    outcome: str
+    data: Any = None
+    reason: str = ""
+
+
+def _bare(name: str, kind: Kind, doc: str) -> type[About]:
+    """A message about a goal with no field of its own."""
+    cls = type(name, (About,), {"__doc__": doc, "__module__": __name__, "__annotations__": {"kind": "ClassVar[Kind]"},
+                                "kind": kind})
+    return dataclass(frozen=True)(cls)
+
+
+Accepted = _bare("Accepted", Kind.ACCEPTED, "The goal ``id`` runs.")
+Cancel = _bare("Cancel", Kind.CANCEL, "Stop the goal ``id``.")
+Cancelled = _bare("Cancelled", Kind.CANCELLED, "The goal ``id`` stopped (acknowledges :class:`Cancel`).")
+
+_TYPES: dict[str, type[Message]] = {cls.kind.value: cls for cls in
+                                    (Announce, Heartbeat, Goal, Accepted, Rejected, Feedback, Result, Cancel,
+                                     Cancelled)}
+_OUTCOMES = ("ok", "failed")
+
+
+def goal_id(run: str, firing: int, attempt: int = 1) -> str:
+    """The idempotent id of a goal: ``run/firing/attempt``.
+
+    Examples:
+        >>> goal_id("4f2a", 12)
+        '4f2a/12/1'
+    """
+    return f"{run}/{firing}/{attempt}"
+
+
+def to_data(value: Any, depth: int = 0) -> Any:
+    """``value`` as JSON data: tuples and sets become lists, numpy values plain
+    numbers and lists, any other object its ``to_token()`` or its type's name.
+
+    Examples:
+        >>> to_data({"p": (1, 2), "s": {3}})
+        {'p': [1, 2], 's': [3]}
+    """
+    if depth > MAX_DEPTH:
+        raise ValueError(f"data nested deeper than {MAX_DEPTH}")
+    if value is None or isinstance(value, (bool, int, str)):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {str(k): to_data(v, depth + 1) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_data(v, depth + 1) for v in value]
+    if isinstance(value, (set, frozenset)):
+        return sorted((to_data(v, depth + 1) for v in value), key=repr)
+    if hasattr(value, "tolist"):  # numpy arrays and scalars
+        return to_data(value.tolist(), depth + 1)
+    if hasattr(value, "to_token"):
+        return to_data(value.to_token(), depth + 1)
+    return f"<{type(value).__name__}>"
+
+
+def encode(message: Message) -> bytes:
+    """``message`` as the bytes sent (compact JSON, ``v`` and ``type`` first).
+
+    Raises:
+        ValueError: the encoded message is longer than :data:`MAX_MESSAGE`.
+    """
+    body = {"v": VERSION, "type": message.kind.value}
+    for item in dataclasses.fields(message):
+        body[item.name] = to_data(getattr(message, item.name))
+    data = json.dumps(body, separators=(",", ":"), allow_nan=False).encode()
+    if len(data) > MAX_MESSAGE:
+        raise ValueError(f"a {message.kind.value} message of {len(data):,} bytes is over the limit of"
+                         f" {MAX_MESSAGE:,}")
+    return data
+
+
+def _depth(value: Any, depth: int = 0) -> int:
+    if depth > MAX_DEPTH:
+        return depth
+    if isinstance(value, dict):
+        return max((_depth(v, depth + 1) for v in value.values()), default=depth)
+    if isinstance(value, list):
+        return max((_depth(v, depth + 1) for v in value), default=depth)
+    return depth
+
+
+_FIELD_TYPES = {"str": str, "dict[str, Any]": dict, "dict[str, dict[str, Any]]": dict,
+                "dict[str, list[Any]]": dict, "list[str]": list}
+
+
+def decode(data: bytes | bytearray | memoryview | str) -> Message:
+    """The message in ``data``, checked (see the module).
+
+    Raises:
+        Refused: oversized, not JSON, another version, an unknown type, a missing,
+            unknown or ill-typed field.
+    """
+    if len(data) > MAX_MESSAGE:
+        raise Refused(Drop.OVERSIZED, f"{len(data):,} bytes (the limit is {MAX_MESSAGE:,})")
+    try:
+        body = json.loads(bytes(data) if not isinstance(data, str) else data)
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise Refused(Drop.MALFORMED, f"not JSON ({exc})") from None
+    if not isinstance(body, dict):
+        raise Refused(Drop.MALFORMED, "not a JSON object")
+    if body.get("v") != VERSION:
+        raise Refused(Drop.VERSION, f"version {body.get('v')!r} (this is version {VERSION})")
+    kind = body.get("type")
+    cls = _TYPES.get(kind) if isinstance(kind, str) else None
+    if cls is None:
+        raise Refused(Drop.MALFORMED, f"unknown type {kind!r}")
+    if _depth(body) > MAX_DEPTH:
+        raise Refused(Drop.MALFORMED, f"{kind}: nested deeper than {MAX_DEPTH}")
+    values: dict[str, Any] = {}
+    for item in dataclasses.fields(cls):
+        if item.name not in body:
+            if item.default is dataclasses.MISSING and item.default_factory is dataclasses.MISSING:
+                raise Refused(Drop.MALFORMED, f"{kind}: missing field {item.name!r}")
+            continue
+        value = body[item.name]
+        wanted = _FIELD_TYPES.get(str(item.type))
+        if wanted is not None and not isinstance(value, wanted):
+            raise Refused(Drop.MALFORMED, f"{kind}: field {item.name!r} is not a {wanted.__name__}")
+        values[item.name] = value
+    unknown = set(body) - {"v", "type"} - {item.name for item in dataclasses.fields(cls)}
+    if unknown:
+        raise Refused(Drop.MALFORMED, f"{kind}: unknown field {sorted(unknown)[0]!r}")
+    if cls is Result and values["outcome"] not in _OUTCOMES:
+        raise Refused(Drop.MALFORMED, f"result: outcome {values['outcome']!r} is neither ok nor failed")
+    if cls is Heartbeat and not all(isinstance(g, str) for g in values.get("running", [])):
+        raise Refused(Drop.MALFORMED, "heartbeat: running lists goal ids (strings)")
+    if cls is Goal and not all(isinstance(v, list) for v in values.get("inputs", {}).values()):
+        raise Refused(Drop.MALFORMED, "goal: inputs maps places to lists of token data")
+    if cls is Announce and not all(isinstance(v, dict) for v in values["actions"].values()):
+        raise Refused(Drop.MALFORMED, "announce: actions maps each action to its parameters")
+    return cls(**values)

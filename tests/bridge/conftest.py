@@ -1,0 +1,171 @@
+"""Brokers and routers on loopback for the bridge's tests, each stopped by its test.
+
+Every fixture that starts a process stops it and checks it is gone; ``mosquitto`` is
+the broker ``scripts/setup.sh`` installs, the Zenoh router a session of this process.
+"""
+
+from __future__ import annotations
+
+import getpass
+import os
+import shutil
+import socket
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from petriflow.bridge.transport import Endpoint, open_transport, wait_for_port
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def mosquitto_binary() -> str | None:
+    return shutil.which("mosquitto") or ("/usr/sbin/mosquitto" if Path("/usr/sbin/mosquitto").exists() else None)
+
+
+class Broker:
+    """A mosquitto on a free loopback port (small messages at once: TCP_NODELAY)."""
+
+    def __init__(self, folder: Path, passwords: Path | None = None) -> None:
+        binary = mosquitto_binary()
+        if binary is None:
+            pytest.skip("mosquitto is not installed (scripts/setup.sh installs it)")
+        self.binary, self.port = binary, free_port()
+        self.conf = folder / "mosquitto.conf"
+        access = "allow_anonymous true\n" if passwords is None else f"allow_anonymous false\npassword_file {passwords}\n"
+        # as root, mosquitto would become user 'mosquitto', who cannot read the test's files
+        self.conf.write_text(f"listener {self.port} 127.0.0.1\n{access}set_tcp_nodelay true\n"
+                             f"user {getpass.getuser()}\n")
+        self.process: subprocess.Popen | None = None
+        self.start()
+
+    @property
+    def connect(self) -> str:
+        return f"tcp/127.0.0.1:{self.port}"
+
+    def start(self) -> None:
+        self.process = subprocess.Popen([self.binary, "-c", str(self.conf)], stdout=subprocess.DEVNULL,
+                                        stderr=subprocess.DEVNULL)
+        wait_for_port(self.port)
+
+    def stop(self) -> None:
+        if self.process is not None:
+            self.process.terminate()
+            self.process.wait(timeout=10)
+            self.process = None
+
+
+class Router:
+    """A Zenoh router (a session of this process) on a free loopback port."""
+
+    def __init__(self) -> None:
+        pytest.importorskip("zenoh")
+        from petriflow.bridge.zenoh_transport import serve_router
+
+        self.port = free_port()
+        self.session = serve_router(Endpoint(self.connect))
+        wait_for_port(self.port)
+
+    @property
+    def connect(self) -> str:
+        return f"tcp/127.0.0.1:{self.port}"
+
+    def stop(self) -> None:
+        if self.session is not None:
+            self.session.close()
+            self.session = None
+
+
+def children() -> set[int]:
+    """The live processes whose parent is this one (from /proc; zombies count as gone)."""
+    found = set()
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == os.getpid() and fields[0] != "Z":
+            found.add(int(entry.name))
+    return found
+
+
+@pytest.fixture(autouse=True)
+def no_process_left():
+    """Every bridge test stops every process it started (the broker, agents, a run)."""
+    before = children()
+    yield
+    deadline = time.monotonic() + 10
+    while children() - before and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not children() - before, "a test left processes running"
+
+
+@pytest.fixture
+def broker(tmp_path):
+    pytest.importorskip("paho.mqtt")
+    made = Broker(tmp_path)
+    yield made
+    made.stop()
+    assert made.process is None
+
+
+@pytest.fixture
+def router():
+    made = Router()
+    yield made
+    made.stop()
+
+
+@pytest.fixture(params=["mqtt", "zenoh"])
+def middleware(request, tmp_path):
+    """``(transport name, the broker or router)`` for each transport."""
+    if request.param == "mqtt":
+        pytest.importorskip("paho.mqtt")
+        made = Broker(tmp_path)
+    else:
+        made = Router()
+    yield request.param, made
+    made.stop()
+
+
+class ServedAgent:
+    """An agent server in a thread of the test, with its own connection."""
+
+    def __init__(self, kind: str, connect: str, names: list[str], user: str | None = None,
+                 password: str | None = None, **options) -> None:
+        from petriflow.bridge.agent import AgentServer
+
+        self.transport = open_transport(kind, Endpoint(connect, user, password), "-".join(names))
+        self.server = AgentServer(names, self.transport, **options)
+        self.thread = threading.Thread(target=self.server.serve, daemon=True)
+        self.thread.start()
+
+    def stop(self) -> None:
+        self.server.stop()
+        self.thread.join(timeout=10)
+        self.transport.close()
+        assert not self.thread.is_alive()
+
+
+@pytest.fixture
+def serve():
+    """``serve(kind, connect, names, **options)``: an agent server in a thread, stopped after the test."""
+    started: list[ServedAgent] = []
+
+    def start(kind: str, connect: str, names: list[str], **options) -> ServedAgent:
+        agent = ServedAgent(kind, connect, names, **options)
+        started.append(agent)
+        return agent
+
+    yield start
+    for agent in started:
+        agent.stop()
