@@ -317,11 +317,14 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"petriflow: note: {args.db}: no journal (the run was stopped before it began);"
               f" running {args.net} from its beginning", file=sys.stderr)
         args.resume = False
+    from petriflow.live.command import live_of
+
+    live = live_of(args)  # --live: the run's page and controls served as it goes
     made_up_trace = run_view_start(args)  # --view: a trace (and poses) for the page
     try:
         if args.resume:
             outcome = resume(args.db, trace=args.trace, xes=args.xes, realtime=args.realtime,
-                             gui=args.gui, progress=_progress(args), picture=args.picture)
+                             gui=args.gui, progress=_progress(args), picture=args.picture, live=live)
         else:
             if args.net is None:
                 raise PetriflowError("give the net to run (or --resume --db RUN_DB)")
@@ -334,7 +337,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                                 realtime=args.realtime, gui=args.gui, progress=_progress(args),
                                 max_firings=args.max_firings, metrics=_metric_names(args.metrics),
                                 picture=args.picture, wait_agents=args.wait_agents,
-                                monitor=args.monitor)
+                                monitor=args.monitor, live=live)
     except BaseException:
         if made_up_trace is not None:  # the page's made-up trace, in a folder of its own
             shutil.rmtree(made_up_trace.parent, ignore_errors=True)
@@ -593,6 +596,9 @@ def build_parser() -> argparse.ArgumentParser:
     from petriflow.view.command import add_parser as add_view, add_run_options
 
     add_run_options(run)
+    from petriflow.live.command import add_run_options as add_live_options
+
+    add_live_options(run)
     run.add_argument("--json", action="store_true", help="print the summary as JSON")
     run.add_argument("--metrics", metavar="NAMES",
                      help="report these registered metrics at the end (comma-separated; 'none': no metric)"
@@ -656,6 +662,9 @@ def build_parser() -> argparse.ArgumentParser:
     add_reproduce_parser(sub)
     add_bridge(sub)
     add_view(sub)
+    from petriflow.live.command import add_parser as add_ctl
+
+    add_ctl(sub)
     return parser
 
 

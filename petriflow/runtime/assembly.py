@@ -31,6 +31,7 @@ from typing import Any, Iterator
 from petriflow.net import Net
 from petriflow.runtime.binding import Binding
 from petriflow.runtime.clock import Clock, RealtimeClock, SimulatedClock
+from petriflow.runtime.control import Control
 from petriflow.runtime.config import RunConfig
 from petriflow.runtime.scheduler import Scheduler
 from petriflow.runtime.services import RemoteGoals
@@ -44,7 +45,7 @@ __all__ = ["open_run", "CheckedRun", "validate"]
 def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunConfig | None = None, *,
              seed: int | None = None, world: Any = None, gui: bool = False, realtime: bool = False,
              clock: Clock | None = None, stopwatch: Timing | None = None,
-             remote: RemoteGoals | None = None) -> Iterator[Scheduler]:
+             remote: RemoteGoals | None = None, control: Control | None = None) -> Iterator[Scheduler]:
     """A run put together: yields its :class:`~petriflow.runtime.scheduler.Scheduler`.
 
     Args:
@@ -60,6 +61,8 @@ def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunC
             steps, the actions' work: :mod:`~petriflow.runtime.stopwatch`); ``None``:
             nobody times it.
         remote: where the goals of remote transitions go (a run with a ``bridge:``).
+        control: the run's control queue, if it is steered
+            (:class:`~petriflow.runtime.control.Control`).
     """
     if isinstance(run, Net):
         run = CheckedRun(run, binding, config or RunConfig())
@@ -74,7 +77,8 @@ def open_run(run: CheckedRun | Net, binding: Binding | None = None, config: RunC
     try:
         clock = clock or (RealtimeClock(stopwatch) if realtime else SimulatedClock(stopwatch))
         scheduler = Scheduler(run.net, world=world, config=run.config, seed=seed, binding=run.binding,
-                              clock=clock, settings=settings, stopwatch=stopwatch or UNTIMED, remote=remote)
+                              clock=clock, settings=settings, stopwatch=stopwatch or UNTIMED, remote=remote,
+                              control=control)
         with scheduler:
             yield scheduler
     finally:

@@ -19,7 +19,7 @@ Examples:
 from __future__ import annotations
 
 import time as wallclock
-from typing import Any, Protocol
+from typing import Any, Callable, Protocol
 
 from petriflow.runtime.kernel import Kernel
 from petriflow.runtime.stopwatch import Timing
@@ -34,7 +34,8 @@ class Clock(Protocol):
         """The run starts now (wall-clock reference)."""
 
     def advance(self, kernel: Kernel, world: Any, tick: int) -> None:
-        """Bring ``kernel.tick`` to ``tick``, stepping ``world`` once per tick."""
+        """Bring ``kernel.tick`` to ``tick``, stepping ``world`` once per tick (or stop
+        earlier, when its ``interrupt`` says so)."""
 
 
 class SimulatedClock:
@@ -42,10 +43,15 @@ class SimulatedClock:
 
     Args:
         stopwatch: where each world step's wall-clock time goes (``physics``).
+
+    Attributes:
+        interrupt: called after each world step; ``True`` stops the advance at that tick
+            (someone steering the run wants it to stop there, :mod:`~.control`).
     """
 
     def __init__(self, stopwatch: Timing | None = None) -> None:
         self.stopwatch = stopwatch
+        self.interrupt: Callable[[], bool] | None = None
 
     def start(self) -> None:
         pass
@@ -54,6 +60,7 @@ class SimulatedClock:
         if world is None:
             kernel.tick = max(kernel.tick, tick)
             return
+        interrupt = self.interrupt
         stopwatch = self.stopwatch
         while kernel.tick < tick:
             if stopwatch is None:
@@ -62,17 +69,39 @@ class SimulatedClock:
                 with stopwatch.measure("physics"):
                     world.step()
             kernel.tick += 1
+            if interrupt is not None and interrupt():
+                return
 
 
 class RealtimeClock:
     """Paced: after each tick, wait until the wall clock has caught up with simulated
-    time (a run that is slower than real time just runs behind)."""
+    time divided by ``factor`` (a run that is slower than that just runs behind).
 
-    def __init__(self, stopwatch: Timing | None = None) -> None:
+    Args:
+        stopwatch: where each world step's wall-clock time goes (``physics``).
+        factor: simulated seconds per wall-clock second (2: twice as fast as real time).
+        now: the simulated time the clock starts from (a run paced from the middle on).
+
+    Attributes:
+        interrupt: called after each tick; ``True`` stops the advance at that tick.
+    """
+
+    def __init__(self, stopwatch: Timing | None = None, factor: float = 1.0, now: float = 0.0) -> None:
+        if not factor > 0:
+            raise ValueError(f"a real-time factor is > 0, got {factor!r}")
+        self.factor = factor
+        self._from = now
         self._start = wallclock.perf_counter()
         self.stopwatch = stopwatch
+        self.interrupt: Callable[[], bool] | None = None
 
     def start(self) -> None:
+        self._start = wallclock.perf_counter()
+
+    def rebase(self, now: float) -> None:
+        """Pace from simulated time ``now`` as from this moment on (after a pause: the
+        run does not rush to catch up with the time it stood still)."""
+        self._from = now
         self._start = wallclock.perf_counter()
 
     def advance(self, kernel: Kernel, world: Any, tick: int) -> None:
@@ -83,6 +112,8 @@ class RealtimeClock:
             elif world is not None:
                 world.step()
             kernel.tick += 1
-            ahead = kernel.now - (wallclock.perf_counter() - self._start)
+            ahead = (kernel.now - self._from) / self.factor - (wallclock.perf_counter() - self._start)
             if ahead > 0:
                 wallclock.sleep(ahead)
+            if self.interrupt is not None and self.interrupt():
+                return

@@ -44,11 +44,12 @@ from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.net import Net
 from petriflow.outcome import Name
 from petriflow.runtime.channel_models import ChannelModel, build_channel
+from petriflow.runtime.control import BREAKPOINT_SYNTAX, ControlError, parse_breakpoint
 from petriflow.runtime.metrics import MetricRef, parse_refs
 
 __all__ = ["RunConfig", "Fault", "FaultKind", "load_config", "plain_data"]
 
-_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall", "metrics", "bind", "bridge"}
+_KEYS = {"seed", "until", "dt", "world", "channels", "faults", "actions", "stall", "metrics", "bind", "bridge", "breakpoints"}
 
 #: Default of :attr:`RunConfig.stall`: simulated seconds a run may step tick by tick
 #: with actions running and no firing starting or ending before it is stopped.
@@ -168,6 +169,9 @@ class RunConfig:
     #: ``{transition: name in bind}`` of the transitions :meth:`bound` bound last.
     bound_by: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
     bridge: BridgeSpec | None = None
+    #: breakpoints of a steered run (:mod:`petriflow.runtime.control`'s language):
+    #: ``transition NAME``, ``place NAME >= N``, ``lost``, ``failed``.
+    breakpoints: list[str] = field(default_factory=list)
 
     @classmethod
     def from_dict(cls, data: Any, path: str | None = None, *, base: str | None = None,
@@ -223,10 +227,13 @@ class RunConfig:
                  for key, at in lines.items()}
         world, located = _files(data, folder, fail)
         metrics = [] if data.get("metrics") is None else parse_refs(data["metrics"], fail)
+        breakpoints = _breakpoints(data.get("breakpoints"), lambda message: fail(message, key="breakpoints"))
+        lines["breakpoints"] = getattr(data, "key_lines", {}).get("breakpoints") or line
         bridge = None if data.get("bridge") is None else BridgeSpec.from_dict(plain_data(data["bridge"]), fail)
         config = cls(seed, None if until is None else float(until), float(dt), world,
                      {str(k): dict(v) for k, v in channels.items()}, faults, path, located,
-                     None if stall is None else float(stall), lines, metrics, bindings, bridge=bridge)
+                     None if stall is None else float(stall), lines, metrics, bindings, bridge=bridge,
+                     breakpoints=breakpoints)
         try:
             config.channel_models()  # fail early on a bad model
         except NetFormatError as exc:
@@ -341,6 +348,13 @@ class RunConfig:
                         f"fault {fault.kind} names unknown agent {agent!r}{did_you_mean(agent, agents)}",
                         path=self.path, line=self.lines.get(f"faults/{i}"),
                     )
+        for spec in self.breakpoints:
+            point = parse_breakpoint(spec)
+            names = net.transitions if point.kind == "transition" else net.places if point.kind == "place" else None
+            if names is not None and point.name not in names:
+                raise NetFormatError(f"breakpoint {spec!r}: net {net.id!r} has no {point.kind} {point.name!r}"
+                                     f"{did_you_mean(point.name, list(names))}", path=self.path,
+                                     line=self.lines.get("breakpoints"))
         if self.bridge is not None:
             names = {*net.subnets, *agents}
             for subnet in self.bridge.agents:
@@ -373,7 +387,25 @@ class RunConfig:
         if self.bind:
             data["bind"] = {name: {"action": action, "params": dict(params)}
                             for name, (action, params) in self.bind.items()}
+        if self.breakpoints:
+            data["breakpoints"] = list(self.breakpoints)
         return data
+
+
+def _breakpoints(given: Any, fail: Callable[[str], Any]) -> list[str]:
+    """A configuration's ``breakpoints``: a list of breakpoints, each checked for its
+    syntax (the names are checked against the net by :meth:`RunConfig.check`)."""
+    if given is None:
+        return []
+    if not isinstance(given, list):
+        fail(f"breakpoints is a list ({BREAKPOINT_SYNTAX}), got {given!r}")
+    out = []
+    for entry in given:
+        try:
+            out.append(parse_breakpoint(entry).text)
+        except ControlError as exc:
+            fail(str(exc))
+    return out
 
 
 def _bindings(given: Any, fail: Callable[..., Any]) -> dict[str, tuple[str, dict[str, Any]]]:

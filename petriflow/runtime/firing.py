@@ -95,6 +95,10 @@ class Firer:
         self.count = 0
         self.progress = 0
         self.limit: int | None = None
+        #: the run's control queue (:class:`~petriflow.runtime.control.Control`), if it
+        #: is steered: every firing is admitted by it first (where pause, step and
+        #: breakpoints hold the run, for simulated and dispatched actions alike)
+        self.control: Any = None
         self.now_count = 0  # firings at the current instant (the Zeno check's)
         self._looping: list[str] = []  # near the limit: what fires (to name a cycle)
         self._rng = random.Random(f"{seed}:conflicts")
@@ -106,12 +110,16 @@ class Firer:
         agenda, dirty, changed, refresh, fire = enabled.agenda, enabled.dirty, enabled.changed, enabled.refresh, \
             self.fire
         watch = limits.FIRINGS_PER_INSTANT - 64
+        control = self.control
         while limit is None or self.count < limit:
             if dirty or changed:
                 refresh()
             if not agenda.count:
                 return
             t = agenda.take(draw)
+            if control is not None and not control.admit(t):  # an intervention took its tokens
+                dirty.add(t)
+                continue
             fire(t)
             self.now_count += 1
             if self.now_count > watch:

@@ -208,6 +208,16 @@ class Journal:
         return [Event.from_dict(json.loads(line))
                 for (line,) in self._db.execute("SELECT line FROM event ORDER BY seq")]
 
+    def controls(self) -> list[Event]:
+        """The journaled ``control`` events (a steered run's interventions and
+        breakpoint hits), in order: what a resumed run applies again."""
+        try:
+            rows = self._db.execute("SELECT line FROM event WHERE line LIKE '%\"kind\":\"control\"%' ORDER BY seq")
+            events = [Event.from_dict(parse_json(line)) for (line,) in rows]
+        except (*_DAMAGE, TypeError, KeyError) as exc:
+            raise JournalError(f"{self.path}: a damaged journal ({exc})") from None
+        return [e for e in events if e.kind == "control"]
+
     def _journaled_line(self, seq: int) -> str:
         offset = seq - self._chunk_start
         if not 0 <= offset < len(self._chunk):

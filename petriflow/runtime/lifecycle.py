@@ -64,7 +64,7 @@ class Firing(Scheduled):
     is cancelled; it keeps its ``inputs`` and ``started`` time."""
 
     __slots__ = ("runner", "number", "index", "action", "ctx", "deadline", "cancelling", "wake", "polled",
-                 "running", "inputs", "started", "nap")
+                 "running", "inputs", "started", "nap", "note")
     phase = POLL
 
     def __init__(self, runner: "ActionRunner", index: int, action: Action) -> None:
@@ -81,6 +81,7 @@ class Firing(Scheduled):
         self.polled = -1
         self.running = False
         self.nap = 0  # the sleep on its state it is in (0: awake)
+        self.note = ""  # why it was forced to end (an operator's intervention)
 
     def live(self, tick: int) -> bool:
         # an entry left by an earlier firing of this transition (a wake-up it no longer
@@ -168,6 +169,7 @@ class ActionRunner:
         firing = self._slot[t]  # a delay's record never has a deadline (no timeout)
         firing.number = number
         firing.ctx = firing.cancelling = None
+        firing.note = ""
         firing.inputs = inputs
         firing.started = now
         firing.running = True
@@ -191,6 +193,7 @@ class ActionRunner:
         firing = self._slot[t]  # its record begins firing `number` (the previous one has ended)
         firing.number, firing.ctx, firing.deadline = number, ctx, None if timeout is None else now + timeout
         firing.cancelling, firing.wake, firing.polled, firing.running = None, -1, -1, True
+        firing.note = ""
         self.running[t] = firing
         try:
             action.start(ctx)
@@ -218,6 +221,17 @@ class ActionRunner:
         for firing in firings:
             firing.cancelling = outcome
         return firings
+
+    def force(self, t: int, outcome: Outcome, note: str) -> Firing:
+        """End the running firing of ``t`` with ``outcome`` (someone steering the run
+        says so): its action's ``cancel()`` is called until it is done, as for a
+        cancellation, then the firing ends with ``outcome`` and ``note`` as its reason
+        (an ``ok`` one produces its plain outputs, with the data the action left)."""
+        firing = self.running[t]
+        firing.cancelling = outcome
+        firing.note = note
+        self.drive([firing])
+        return firing
 
     def drive(self, firings: list[Firing]) -> None:
         """Poll firings being cancelled at once (they may finish in this instant)."""
@@ -282,6 +296,8 @@ class ActionRunner:
         if not done:
             self._wake(firing, tick + 1)
             return
+        if firing.note and not ctx.reason:
+            ctx.reason = firing.note
         self._stop(firing)
         self.finish(firing.number, firing.index, ctx, outcome)
 

@@ -3,7 +3,8 @@
 A trace holds enough to rebuild the token game without running anything: the
 ``run`` event has the initial marking, ``start`` events the tokens consumed,
 ``cancel`` events the tokens withdrawn, ``end`` events the tokens produced, and
-``message`` events the tokens delivered through channels.
+``message`` events the tokens delivered through channels, and ``control`` events the
+tokens someone put in or took out while steering the run.
 """
 
 from __future__ import annotations
@@ -36,6 +37,11 @@ def markings(events: Iterable[Event]) -> Iterator[tuple[Event, Marking]]:
                 counts[place] = counts.get(place, 0) + n
         elif event.kind == "message" and data.get("fate") in ("delivered", "noticed"):
             counts[data["place"]] = counts.get(data["place"], 0) + 1
+        elif event.kind == "control":  # someone put tokens in or took them out
+            for place, n in (data.get("added") or {}).items():
+                counts[place] = counts.get(place, 0) + n
+            for place, n in (data.get("removed") or {}).items():
+                counts[place] = counts.get(place, 0) - n
         yield event, Marking({p: c for p, c in counts.items() if c > 0})
 
 
@@ -68,6 +74,10 @@ def describe(event: Event, labels: dict[str, str] | None = None) -> str:
         return f"run    {data.get('net')} seed {data.get('seed')}"
     if event.kind == "stop":
         return f"stop   {data.get('reason')} after {data.get('firings')} firings"
+    if event.kind == "control":
+        what = " ".join(str(data[k]) for k in ("spec", "place", "count", "firing", "outcome", "factor") if k in data)
+        by = f" by {data['by']}" if data.get("by") else ""
+        return f"ctl    {data.get('action')} {what}{by}".rstrip()
     return f"{event.kind:6} {event.transition or ''}{who} {data}"
 
 

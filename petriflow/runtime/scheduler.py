@@ -76,7 +76,8 @@ from petriflow.runtime.action import Action
 from petriflow.runtime.agents import Agents
 from petriflow.runtime.binding import Binding
 from petriflow.runtime.channels import Channels
-from petriflow.runtime.clock import Clock, SimulatedClock
+from petriflow.runtime.clock import Clock, RealtimeClock, SimulatedClock
+from petriflow.runtime.control import Control, ControlError
 from petriflow.runtime.config import RunConfig
 from petriflow.runtime.enabling import EnabledSet
 from petriflow.runtime.faults import Faults
@@ -126,6 +127,8 @@ class Scheduler:
         stopwatch: what the actions report their work's wall-clock time to
             (``ctx.stopwatch``; :mod:`~petriflow.runtime.stopwatch`); give the clock
             the same one to time the world's steps.
+        control: the run's control queue, when it is steered (a live page, a resumed
+            steered run): :class:`~petriflow.runtime.control.Control`.
 
     Raises:
         NetFormatError: an action, parameter, port or guard does not bind; a fault or
@@ -137,7 +140,8 @@ class Scheduler:
     def __init__(self, net: Net, *, world: Any = None, config: RunConfig | dict | None = None, seed: int | None = None,
                  registry: Registry | None = None, path: str | None = None, binding: Binding | None = None,
                  clock: Clock | None = None, settings: Mapping[str, Mapping[str, Any]] | None = None,
-                 stopwatch: Timing = UNTIMED, remote: RemoteGoals | None = None) -> None:
+                 stopwatch: Timing = UNTIMED, remote: RemoteGoals | None = None,
+                 control: Control | None = None) -> None:
         self.net = net
         self.world = world
         self.config = config = RunConfig.from_dict(config) if isinstance(config, dict) else config or RunConfig()
@@ -173,6 +177,11 @@ class Scheduler:
         self.firer = Firer(net, index, kernel, tokens, enabled, recorder=recorder, agents=agents,
                            channels=self.channels, services=services, world=world, seed=seed, running=running)
         self.runner = self.firer.runner
+        self.control = control
+        if control is not None:
+            self.firer.control = control
+            control.attach(self)
+            self.clock.interrupt = control.interrupt  # a pause stops the clock between instants too
         self._started = self._closed = self._opened = False  # _opened: the instant at tick 0 was processed
         self._watchers: list[Any] = []
         self._finished: RunResult | None = None
@@ -280,6 +289,99 @@ class Scheduler:
         self.tokens.replace(tokens)
         self.enabled_set.resync()
 
+    # Steering (what a Control changes, at its checkpoints) ------------------------------
+    def inject(self, place: str, count: int) -> dict[str, int]:
+        """Put ``count`` black tokens into ``place`` now (an operator's intervention:
+        call it through :class:`~petriflow.runtime.control.Control`, so it is recorded).
+
+        Raises:
+            ControlError: no such place.
+        """
+        index = self._place(place)
+        for _ in range(count):
+            self.tokens.add(index, None)
+        self.enabled_set.mark_place(index)
+        return {place: count}
+
+    def remove(self, place: str, count: int) -> dict[str, int]:
+        """Take ``count`` tokens (the oldest) out of ``place`` now.
+
+        Raises:
+            ControlError: no such place, or it holds fewer tokens.
+        """
+        index = self._place(place)
+        held = self.tokens.counts[index]
+        if held < count:
+            raise ControlError(f"place {place!r} holds {held} token{'s' * (held != 1)}, not {count}")
+        self.tokens.remove(index, count)
+        self.enabled_set.mark_place(index)
+        return {place: count}
+
+    def find_firing(self, firing: str) -> tuple[str, int]:
+        """``(transition, firing number)`` of the running firing ``firing`` names (its
+        number, or its transition's id).
+
+        Raises:
+            ControlError: no such firing is running.
+        """
+        order = self.runner.in_firing_order()
+        found = [f for f in order if str(f.number) == str(firing) or self.index.ids[f.index] == firing]
+        if not found:
+            running = ", ".join(f"{self.index.ids[f.index]} (firing {f.number})" for f in order)
+            raise ControlError(f"no running firing {firing!r} (running: {running or 'none'})")
+        return self.index.ids[found[0].index], found[0].number
+
+    def force(self, firing: str, outcome: Outcome, reason: str) -> tuple[str, int]:
+        """End a running firing (its number, or its transition's id) with ``outcome``:
+        its action is cancelled, then the outcome's arcs produce (an operator's
+        intervention: call it through :class:`~petriflow.runtime.control.Control`).
+
+        Raises:
+            ControlError: no such firing is running.
+        """
+        transition, number = self.find_firing(firing)
+        self.runner.force(self.index.position[transition], outcome, reason)
+        return transition, number
+
+    def set_speed(self, factor: float) -> None:
+        """Pace the run at ``factor`` times real time from now on (0: as fast as it goes)."""
+        stopwatch = getattr(self.clock, "stopwatch", None)
+        self.clock = SimulatedClock(stopwatch) if factor == 0 else RealtimeClock(stopwatch, factor, self.now)
+        if self.control is not None:
+            self.clock.interrupt = self.control.interrupt
+
+    def rebase_clock(self) -> None:
+        """The run stood still: a paced run goes on from now, without rushing to catch up."""
+        rebase = getattr(self.clock, "rebase", None)
+        if rebase is not None:
+            rebase(self.now)
+
+    def count(self, place: str) -> int:
+        """Tokens in ``place`` now."""
+        return self.tokens.counts[self._place(place)]
+
+    def can_fire(self, t: int) -> bool:
+        """Whether transition index ``t`` may fire now."""
+        return self.enabled_set.can_fire(t)
+
+    def transition_of(self, t: int) -> str:
+        """Transition index ``t``'s id."""
+        return self.index.ids[t]
+
+    def recorder_count(self) -> int:
+        """The number the next event will have."""
+        return self.recorder.count
+
+    def _place(self, place: str) -> int:
+        index = self.tokens.index.get(place) if isinstance(place, str) else None
+        if index is None:
+            from difflib import get_close_matches
+
+            close = get_close_matches(str(place), list(self.tokens.index), n=1)
+            raise ControlError(f"no place {place!r} in net {self.net.id!r}"
+                               f"{f' (did you mean {close[0]!r}?)' if close else ''}")
+        return index
+
     # Running ------------------------------------------------------------------------
     def start(self) -> None:
         """Record the run's start and set up every bound action (called by :meth:`run`
@@ -300,6 +402,8 @@ class Scheduler:
     def _advance(self, tick: int) -> None:
         self.clock.advance(self.kernel, self.world, tick)
         self.firer.new_instant()
+        if self.control is not None:
+            self.control.new_instant(self.kernel.now)
 
     def _instant(self, fire: bool = True) -> None:
         """Process the current tick: due polls and events, then the firings."""
@@ -353,11 +457,18 @@ class Scheduler:
         limit = None if until is None else kernel.ticks_at(until)
         try:
             self._instant()  # the first instant, or the rest of the one a limit stopped in
+            control = self.control
             while True:
+                if control is not None and control.between():  # tokens put in or taken out
+                    self._instant()  # what they enable fires now, before time moves on
+                    continue
                 stop = self._stop_reason(limit)
                 if stop is not None:
                     return stop
-                self._advance(kernel.peek())
+                tick = kernel.peek()
+                if control is not None:  # a resumed run stops where an intervention came between instants
+                    tick = control.cut(kernel.tick, tick, kernel.ticks_at)
+                self._advance(tick)
                 self._instant()
         except Unrouted as exc:
             return self._end(StopReason.FAILED, str(exc.failure))
@@ -445,6 +556,8 @@ class Scheduler:
         if problems:
             data["teardown_errors"] = problems
         self.emit(_STOP, None, None, **data)
+        if self.control is not None:
+            self.control.close()
         self._finished = RunResult(reason, round(self.now, 9), self.firings, self.marking(), self.recorder.count, error,
                                    self.tokens.tokens(), net=self.net, seed=self.seed)
         return self._finished

@@ -52,6 +52,7 @@ from petriflow.net import Net
 from petriflow.runtime.assembly import open_run
 from petriflow.runtime.binding import Binding, bind
 from petriflow.runtime.config import RunConfig, load_config
+from petriflow.runtime.control import Control
 from petriflow.runtime.journal import Journal
 from petriflow.runtime.loading import from_journal, journal_inputs, net_config, read_run, read_world
 from petriflow.runtime.observers import Progress, run_observed
@@ -131,15 +132,57 @@ def prepare(net_path: str | Path, *, config: str | Path | RunConfig | None = Non
     return Prepared(net, files.text, run_config, binding, files.world_path)
 
 
+@dataclass
+class Live:
+    """A run served live (``--live``, :mod:`petriflow.live`): where, whether it starts
+    paused, and whom to tell the page's address."""
+
+    address: str = "127.0.0.1:0"
+    paused: bool = False
+    announce: Any = None
+
+
 def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | None, trace: Path | None,
              xes: Path | None, realtime: bool, gui: bool, progress: bool | float, max_firings: int | None,
              keep_events: bool = False, extras: RunExtras | None = None,
-             stopwatch: Timing | None = None, wait_agents: float | None = None) -> RunResult:
+             stopwatch: Timing | None = None, wait_agents: float | None = None,
+             live: Live | None = None) -> RunResult:
     """Put the checked run together and run it with its observers (step 3 and 4); a
     configuration with a ``bridge:`` connects to its remote agents first
-    (:mod:`petriflow.bridge.orchestrator`; ``wait_agents``: seconds to wait for them)."""
+    (:mod:`petriflow.bridge.orchestrator`; ``wait_agents``: seconds to wait for them);
+    ``live``: serve its page and controls (:mod:`petriflow.live`)."""
     extras = extras or RunExtras()
     keep = keep_events or extras.needs_events()
+    # a steered run (served live, with breakpoints, or resumed from a steered journal)
+    # has a control queue; a resumed one applies the journaled interventions again
+    script = journal.controls() if journal is not None and journal.journaled else []
+    control = None
+    if live is not None or checked.config.breakpoints or script:
+        control = Control(breakpoints=checked.config.breakpoints, paused=live is not None and live.paused,
+                          interactive=live is not None, script=script)
+    server = None
+    if live is not None:
+        from petriflow.live.page import live_page
+        from petriflow.live.server import LiveServer, parse_address
+
+        host, port = parse_address(live.address)
+        server = LiveServer(control, live_page(checked.net), host, port)
+        url = server.start()
+        if live.announce is not None:
+            live.announce(url)
+    try:
+        return _observed(checked, inputs, journal=journal, trace=trace, xes=xes, realtime=realtime, gui=gui,
+                         progress=progress, max_firings=max_firings, keep_events=keep_events, extras=extras,
+                         keep=keep, control=control, server=server, stopwatch=stopwatch, wait_agents=wait_agents)
+    finally:
+        if server is not None:
+            server.stop()
+
+
+def _observed(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | None, trace: Path | None,
+              xes: Path | None, realtime: bool, gui: bool, progress: bool | float, max_firings: int | None,
+              keep_events: bool, extras: RunExtras, keep: bool, control: Control | None, server: Any,
+              stopwatch: Timing | None, wait_agents: float | None) -> RunResult:
     with ExitStack() as stack:
         remote, clock, watch = None, None, None
         spec = checked.config.bridge
@@ -149,9 +192,12 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
             remote, clock, watch = connect_run(stack, checked, run=inputs.get("bridge_run"), wait=wait_agents,
                                                journal=journal)
         scheduler = stack.enter_context(open_run(checked, seed=inputs["seed"], gui=gui, realtime=realtime,
-                                                 clock=clock, remote=remote, stopwatch=stopwatch))
+                                                 clock=clock, remote=remote, stopwatch=stopwatch,
+                                                 control=control))
         if remote is not None:
             scheduler.on_instant(watch)
+        if server is not None:
+            server.watch(scheduler)
         if inputs.get("poses"):  # the world's body poses as trace events (petriflow.runtime.poses)
             from petriflow.runtime.poses import PoseSampler
 
@@ -206,7 +252,7 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
               max_firings: int | None = None, keep_events: bool = False, metrics: list[str] | None = None,
               picture: str | Path | None = None, poses: float | None = None,
               stopwatch: Timing | None = None, wait_agents: float | None = None,
-              monitor: bool = False) -> RunResult:
+              monitor: bool = False, live: Live | None = None) -> RunResult:
     """Run the net in ``net_path`` (what ``petriflow run`` does).
 
     The run configuration is ``config``, else the one the net names, else
@@ -218,6 +264,7 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
     robots' trajectories at the end (see :mod:`petriflow.runtime.summary`). ``poses``:
     record the world's body poses as ``pose`` events every so many simulated seconds
     (:mod:`petriflow.runtime.poses`; what ``petriflow view`` draws the world from).
+    ``live``: serve the run's live page and controls (:class:`Live`, :mod:`petriflow.live`).
     ``stopwatch``: where the run's wall-clock time goes, by category (the world's
     steps as ``physics``, what the actions measure: :mod:`petriflow.runtime.stopwatch`).
     ``wait_agents``: seconds to wait for a bridged run's remote agents (default: the
@@ -265,7 +312,7 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
         return _execute(checked, inputs, journal=journal, trace=None if trace is None else Path(trace),
                         xes=None if xes is None else Path(xes), realtime=realtime, gui=gui, progress=progress,
                         max_firings=max_firings, keep_events=keep_events, extras=extras, stopwatch=stopwatch,
-                        wait_agents=wait_agents)
+                        wait_agents=wait_agents, live=live)
     except BaseException:
         if journal is not None and journal.journaled == 0:  # it never started: leave no journal behind
             journal.close()
@@ -279,7 +326,8 @@ def run_files(net_path: str | Path, *, world: str | Path | None = None, config: 
 
 def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path | None = None,
            realtime: bool = False, gui: bool = False, registry: Registry | None = None,
-           progress: bool | float = False, picture: str | Path | None = None) -> RunResult:
+           progress: bool | float = False, picture: str | Path | None = None,
+           live: Live | None = None) -> RunResult:
     """Continue the run journaled in ``db`` after a kill.
 
     The run is re-executed from its journaled inputs (the firing limit and the trace and
@@ -289,7 +337,9 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
     and ``xes`` write it elsewhere; ``picture`` draws the world's top view at the end,
     as :func:`run_files` does. A run whose end is journaled already (killed while it
     wrote its outputs) is re-executed all the same, with a warning, so that a resume
-    after a kill at any moment leaves the outputs of an uninterrupted run.
+    after a kill at any moment leaves the outputs of an uninterrupted run. A steered
+    run's interventions (its journaled ``control`` events) are applied again where they
+    were; ``live`` serves the resumed run live.
     """
     journal = Journal(db)
     try:
@@ -309,7 +359,8 @@ def resume(db: str | Path, *, trace: str | Path | None = None, xes: str | Path |
         return _execute(checked, inputs, journal=journal, trace=None if trace is None else Path(trace),
                         xes=None if xes is None else Path(xes), realtime=realtime, gui=gui, progress=progress,
                         max_firings=inputs.get("max_firings"),
-                        extras=extras_for(files.config, registry=checked.binding.registry, picture=picture))
+                        extras=extras_for(files.config, registry=checked.binding.registry, picture=picture),
+                        live=live)
     finally:
         journal.close()
 

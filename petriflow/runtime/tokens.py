@@ -302,6 +302,18 @@ class TokenStore:
             self.data[i] = deque([None] * before + [item])
         self._track(i, before)
 
+    def remove(self, i: int, count: int) -> None:
+        """Take ``count`` tokens (the oldest) out of place index ``i`` (it holds them)."""
+        before = self.counts[i]
+        self.counts[i] = before - count
+        queue = self.data[i]
+        if queue is not None:
+            for _ in range(count):
+                queue.popleft()
+            if not queue:
+                self.data[i] = None
+        self._track(i, before)
+
     def offered(self, row: int) -> dict[str, list[Any]]:
         """``{place: [data, ...]}`` of the tokens firing ``row`` would take now."""
         data, places = self.data, self.places

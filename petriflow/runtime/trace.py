@@ -52,6 +52,9 @@ class EventKind(Name):
     """Where the world's bodies are (optional sampling, :mod:`petriflow.runtime.poses`)."""
     STOP = "stop"
     """The run ends: why, firings, marking, what was still running."""
+    CONTROL = "control"
+    """Someone steered the run (:mod:`petriflow.runtime.control`): who, what, when, and
+    the tokens it ``added`` or ``removed``; or a breakpoint triggered (``hit``)."""
 
 
 #: The kinds of events a run records, as written in traces.
@@ -185,6 +188,7 @@ _NEEDS = {
     "cancel": {"withdrawn": _counts},
     "message": {"place": lambda v: isinstance(v, str), "fate": lambda v: isinstance(v, str)},
     "pose": {"poses": lambda v: isinstance(v, dict)},
+    "control": {"action": lambda v: isinstance(v, str), "point": lambda v: type(v) is int},
 }
 
 

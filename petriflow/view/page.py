@@ -51,16 +51,19 @@ def _inline_script(code: str) -> str:
     return "<script>\n" + code.replace("</script", "<\\/script") + "\n</script>"
 
 
-def render(*, title: str, body: str, data: Any, scripts: list[str], styles: list[str]) -> str:
+def render(*, title: str, body: str, data: Any, scripts: list[str], styles: list[str],
+           connect: bool = False) -> str:
     """The whole page: ``body`` (HTML), ``data`` as JSON in ``#pf-data``, the named
-    assets inlined (scripts in order, after the body)."""
+    assets inlined (scripts in order, after the body). ``connect``: the page may open
+    connections to the server it came from (a live page's WebSocket), and nowhere else."""
+    allowed = "; connect-src 'self'" if connect else ""
     style_text = "\n".join(asset(name) for name in styles)
     script_text = "\n".join(_inline_script(asset(name)) for name in scripts)
     return (
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
         "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
         "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; script-src 'unsafe-inline';"
-        " style-src 'unsafe-inline'; img-src data:\">\n"
+        f" style-src 'unsafe-inline'; img-src data:{allowed}\">\n"
         f"<title>{html.escape(title)}</title>\n<style>\n{style_text}\n</style>\n</head>\n<body>\n{body}\n"
         f"<script type=\"application/json\" id=\"pf-data\">{_script_json(data)}</script>\n"
         f"{script_text}\n</body>\n</html>\n"

@@ -182,6 +182,11 @@ def model(events: list[Any], places: list[str] | None = None) -> dict[str, Any]:
                     continue
             _message(out, i, i, event.agent, data.get("receiver"), fate, data.get("why"), data, agent, fates,
                      channels, place)
+        elif kind == "control":  # someone steering the run put tokens in or took them out
+            for p, n in (data.get("added") or {}).items():
+                add(p, n)
+            for p, n in (data.get("removed") or {}).items():
+                add(p, -n)
         elif kind == "pose":
             if isinstance(data.get("outlines"), list):
                 outlines = data["outlines"]
@@ -256,7 +261,9 @@ SCRIPTS = ["common.js", "trace.js", "replay.js", "panel-net.js", "panel-world.js
 _KEEP = {"run": {"marking", "agents", "net", "seed", "dt"}, "start": {"firing", "consumed"},
          "end": {"firing", "outcome", "produced", "reason"}, "cancel": {"withdrawn", "actions"},
          "message": {"place", "fate", "channel", "receiver", "why", "arrival", "in_flight", "size", "distance"},
-         "pose": {"poses", "outlines"}, "custom": {"name", "firing"}}
+         "pose": {"poses", "outlines"}, "custom": {"name", "firing"},
+         "control": {"action", "added", "removed", "by", "wall", "spec", "place", "count", "firing", "number",
+                     "outcome", "factor", "point", "tokens"}}
 
 #: The largest a run's page should be, in MB (``petriflow view --max-mb``).
 DEFAULT_MAX_MB = 20.0

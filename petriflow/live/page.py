@@ -1,0 +1,86 @@
+"""The live page: the net with its marking as the run goes, the firings running, the
+latest events, and the controls (pause, resume, step, breakpoints, tokens, forced
+outcomes, speed).
+
+The page is made once, before the run, from the net (no trace: the run's state comes
+over the WebSocket, :mod:`petriflow.live.server`). It reuses the run page's net panel
+(``panel-net.js``, the same picture as ``petriflow view``); a net too big to draw
+readably (the threshold ``export`` folds at, :func:`petriflow.fold.should_fold`) is
+shown as its list of places instead.
+"""
+
+from __future__ import annotations
+
+import html
+from typing import Any
+
+from petriflow.view.page import pack, render
+
+__all__ = ["live_page"]
+
+SCRIPTS = ["common.js", "panel-net.js", "live.js"]
+
+
+def live_page(net: Any) -> str:
+    """The HTML of the live page of a run of ``net``."""
+    from petriflow.fold import should_fold
+    from petriflow.view.run_page import net_picture
+
+    if should_fold(net):
+        svg, why = None, (f"the net has {len(net.places) + len(net.transitions)} nodes, more than a readable"
+                          " drawing holds (petriflow export --fold draws it by agent)")
+    else:
+        svg, why = net_picture(net)
+    agents = {s.id: (s.agent or s.id) for s in net.subnets.values()}
+    data = {
+        "kind": "live",
+        "name": net.id,
+        "svg": None if svg is None else pack(svg),
+        "svg_missing": why if svg is None else None,
+        "net_places": list(net.places),
+        "transition_info": {t.id: {"label": t.label or t.id, "action": t.action,
+                                   "agent": agents.get(t.subnet) if t.subnet else None}
+                            for t in net.transitions.values()},
+    }
+    title = f"{net.id}: live run"
+    return render(title=title, body=_BODY.replace("{title}", html.escape(title)), data=data, scripts=SCRIPTS,
+                  styles=["common.css", "run.css"], connect=True)
+
+
+_BODY = """
+<header>
+  <h1>{title}</h1>
+  <div id="summary"><span id="status">connecting…</span></div>
+</header>
+<section id="controls" class="bar">
+  <button id="c-pause" title="stop at the next firing">pause</button>
+  <button id="c-resume" title="go on">resume</button>
+  <button id="c-step" title="let this many firings happen, then pause">step</button>
+  <input id="c-step-n" type="number" min="1" value="1" size="3" aria-label="firings per step">
+  <label>speed <input id="c-speed" type="number" min="0" step="0.5" value="1" size="4"
+    title="times real time; 0: as fast as it goes"></label><button id="c-speed-set">set</button>
+  <span id="c-reply" role="status"></span>
+</section>
+<section class="bar" id="c-more">
+  <label>breakpoint <input id="c-break" size="24" placeholder="transition T | place P >= N | lost | failed"
+    list="c-break-hints"></label><button id="c-break-add">add</button>
+  <datalist id="c-break-hints"><option value="failed"><option value="lost"></datalist>
+  <span id="c-breaks"></span>
+  <label>place <input id="c-place" size="14" list="c-places"></label>
+  <datalist id="c-places"></datalist>
+  <input id="c-count" type="number" min="1" value="1" size="3" aria-label="tokens">
+  <button id="c-inject">inject</button><button id="c-remove">remove</button>
+  <label>firing <select id="c-firing"></select></label>
+  <select id="c-outcome"><option value="failed">failed</option><option value="ok">ok</option>
+    <option value="cancel">cancel</option></select>
+  <button id="c-force">force</button>
+</section>
+<main>
+  <section class="panel wide" id="p-net"><h2>Net <small>the marking now; running transitions lit with their action and
+    time; failed or cancelled firings marked; wheel: zoom, drag: pan, double click: all</small></h2>
+    <div id="net"></div></section>
+  <section class="panel" id="p-running"><h2>Running</h2><ol id="running"></ol></section>
+  <section class="panel" id="p-events"><h2>Latest events <small>newest first; the trace has them all</small></h2>
+    <div id="events-live"></div></section>
+</main>
+"""
