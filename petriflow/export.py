@@ -37,7 +37,7 @@ import subprocess
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from petriflow.dot import CLUSTER_COLOURS, FONT, attributes, html_text, quote, tokens_text
+from petriflow.dot import CLUSTER_COLOURS, FONT, arc_look, attributes, html_text, quote, tokens_text
 from petriflow.errors import DependencyNotInstalled, PetriflowError, UnknownElementError
 from petriflow.net import Net
 
@@ -216,7 +216,9 @@ def to_dot(
     Places are circles with their tokens inside (dots for 1 to 4, the number from 5)
     and their label (or id) under them; transitions are boxes with their label (or id)
     in bold and the bound action below it; silent transitions are thin black bars.
-    Arcs of weight above 1 carry the weight. Each agent subnet is a labelled cluster
+    Arcs of weight above 1 carry the weight beside them; output arcs reserved for a
+    failed, timed-out or cancelled action are dashed, coloured and named by the outcome
+    (:func:`arc_look`). Each agent subnet is a labelled cluster
     naming its agent. The layout runs left to right.
 
     Args:
@@ -322,9 +324,7 @@ def to_dot(
     out += node_lines(loose_places, loose_transitions, "  ")
 
     for arc in net.arcs:
-        attrs: dict[str, str] = {}
-        if arc.weight > 1:
-            attrs["label"] = quote(str(arc.weight))
+        attrs = arc_look(arc.outcome, arc.weight)
         if (arc.source, arc.target) in bold_arcs:
             colour = f'"{HIGHLIGHT_COLOUR}"'
             attrs.update({"color": colour, "fontcolor": colour, "penwidth": "2.8"})

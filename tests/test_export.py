@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 import petriflow.export as export
-from petriflow.dot import quote
+from petriflow.dot import OUTCOME_COLOURS, quote
 from petriflow.cli import main
 from petriflow.errors import DependencyNotInstalled, PetriflowError, UnknownElementError
 from petriflow.export import HIGHLIGHT_COLOUR, export_net, render, to_dot
@@ -101,10 +101,11 @@ def test_dot_has_one_labelled_cluster_per_subnet(inspection):
 
 
 def test_weights_above_one_are_edge_labels():
-    """Weights > 1 label their arc; weight-1 arcs carry no label."""
+    """Weights > 1 label their arc beside it (xlabel, not on the line); weight-1 arcs carry no label."""
     arcs = arc_statements(to_dot(weighted_net()))
-    assert 'label="3"' in arcs[("stock", "pack")]
-    assert 'label="2"' in arcs[("skip", "stock")]
+    assert 'xlabel="3"' in arcs[("stock", "pack")]
+    assert 'xlabel="2"' in arcs[("skip", "stock")]
+    assert not re.search(r"(?<![x])label=", arcs[("stock", "pack")])
     assert "label" not in arcs[("pack", "boxes")]
 
 
@@ -387,3 +388,38 @@ def test_a_wide_net_is_laid_out_top_to_bottom(tmp_path):
     assert "rankdir=TB" in (tmp_path / "chain.dot").read_text()
     export_net(chain, tmp_path / "lr.dot", rankdir="LR")
     assert "rankdir=LR" in (tmp_path / "lr.dot").read_text()
+
+
+def charging() -> Net:
+    net = Net("charging")
+    for place in ("empty", "full", "faulty"):
+        net.add_place(place, tokens=int(place == "empty"))
+    net.add_transition("charge", action="demo.charge")
+    net.add_arc("empty", "charge")
+    net.add_arc("charge", "full")
+    net.add_arc("charge", "faulty", outcome="failed")
+    return net
+
+
+def test_an_outcome_arc_is_dashed_coloured_and_named_and_an_ok_arc_is_plain():
+    arcs = arc_statements(to_dot(charging()))
+    failed = arcs[("charge", "faulty")]
+    assert "style=dashed" in failed and 'xlabel="failed"' in failed
+    assert OUTCOME_COLOURS["failed"] in failed
+    plain = arcs.get(("charge", "full"), "")
+    assert "dashed" not in plain and "label" not in plain
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz missing")
+def test_the_svg_shows_the_outcome_beside_its_dashed_arc(tmp_path):
+    out = tmp_path / "charging.svg"
+    export_net(charging(), out)
+    root = ET.fromstring(out.read_bytes())
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    edges = {e.find("s:title", ns).text: e for e in root.iter("{http://www.w3.org/2000/svg}g")
+             if e.get("class") == "edge"}
+    failed = edges["charge&#45;&gt;faulty"] if "charge&#45;&gt;faulty" in edges else edges["charge->faulty"]
+    assert failed.find("s:path", ns).get("stroke-dasharray")
+    assert [t.text for t in failed.iter("{http://www.w3.org/2000/svg}text")] == ["failed"]
+    plain = edges["charge->full"]
+    assert plain.find("s:path", ns).get("stroke-dasharray") is None
