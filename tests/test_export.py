@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import shutil
+import struct
 import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -423,3 +424,37 @@ def test_the_svg_shows_the_outcome_beside_its_dashed_arc(tmp_path):
     assert [t.text for t in failed.iter("{http://www.w3.org/2000/svg}text")] == ["failed"]
     plain = edges["charge->full"]
     assert plain.find("s:path", ns).get("stroke-dasharray") is None
+
+
+def chain(places: int) -> Net:
+    """A long line of places and transitions: wide drawn in full."""
+    net = Net("chain")
+    for k in range(places):
+        net.add_place(f"p{k}", tokens=int(k == 0))
+    for k in range(places - 1):
+        net.add_transition(f"t{k}")
+        net.add_arc(f"p{k}", f"t{k}")
+        net.add_arc(f"t{k}", f"p{k + 1}")
+    return net
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz missing")
+def test_a_big_net_drawn_in_full_is_scaled_to_the_bound_and_says_so(tmp_path, capsys):
+    from petriflow.fold import FOLD_ABOVE
+
+    net = chain(FOLD_ABOVE)   # 2 * FOLD_ABOVE - 1 nodes in one row: far wider than FULL_SIZE
+    out = tmp_path / "chain.png"
+    note = export_net(net, out, fold=False, rankdir="LR")
+    assert note and f"{2 * FOLD_ABOVE - 1} nodes" in note and "scaled down" in note
+    width, height = struct.unpack(">II", out.read_bytes()[16:24])
+    assert max(width, height) <= export.FULL_SIZE[0] * export.PNG_DPI + 1
+    yaml_file = tmp_path / "chain.yaml"
+    export_net(net, yaml_file)
+    assert main(["export", str(yaml_file), "-o", str(tmp_path / "again.png"), "--full", "--rankdir", "LR"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "too many to read drawn in full" in err
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz missing")
+def test_a_small_net_is_drawn_without_a_note(tmp_path):
+    assert export_net(charging(), tmp_path / "c.png") is None
