@@ -43,7 +43,7 @@ from typing import Mapping
 from petriflow.dot import CLUSTER_COLOURS, FONT, arc_look, attributes, html_text, quote, tokens_text
 from petriflow.net import Net
 
-__all__ = ["folded_dot", "should_fold", "FOLD_ABOVE", "FAN", "FAN_ARCS", "CROWD"]
+__all__ = ["folded_dot", "should_fold", "agent_net", "FOLD_ABOVE", "FAN", "FAN_ARCS", "CROWD"]
 
 #: ``export`` folds a picture without being asked when the net has more nodes than this
 #: and at least two agent subnets.
@@ -55,6 +55,50 @@ FAN = 4
 def should_fold(net: Net) -> bool:
     """Whether a picture of ``net`` is folded by default (see :data:`FOLD_ABOVE`)."""
     return len(net.places) + len(net.transitions) > FOLD_ABOVE and len(net.subnets) >= 2
+
+
+def agent_net(net: Net, subnet: str) -> Net:
+    """One agent's part of ``net`` as a net of its own, to draw it in full beside the
+    folded picture: the subnet's places and transitions, the places outside it that its
+    transitions take from or put into (outside the subnet's cluster), and the arcs between
+    them. Ids are those of ``net``, so a marking of ``net`` draws on it.
+
+    Examples:
+        >>> from petriflow.net import Net
+        >>> net = Net("team")
+        >>> _ = net.add_subnet("r1", agent="robot 1")
+        >>> _ = net.add_place("idle", tokens=1, subnet="r1"); _ = net.add_place("box")
+        >>> _ = net.add_transition("send", subnet="r1", action="radio.send")
+        >>> _ = net.add_arc("idle", "send"); _ = net.add_arc("send", "box", outcome="failed")
+        >>> part = agent_net(net, "r1")
+        >>> sorted(part.places), part.places["box"].subnet, part.arc("send", "box", "failed") is not None
+        (['box', 'idle'], None, True)
+    """
+    from dataclasses import fields
+
+    if subnet not in net.subnets:
+        from petriflow.errors import UnknownElementError
+
+        raise UnknownElementError("subnet", subnet, list(net.subnets))
+    spec = net.subnets[subnet]
+    part = Net(net.id, f"{spec.agent or spec.id}: {spec.label or spec.id}")
+    part.add_subnet(spec.id, label=spec.label, agent=spec.agent, state=spec.state)
+    places, transitions = net.nodes_of(subnet)
+    own = set(places) | set(transitions)
+    touched = [p for arc in net.arcs for p in (arc.source, arc.target)
+               if p in net.places and p not in own and ({arc.source, arc.target} & set(transitions))]
+    for place in [*places, *dict.fromkeys(touched)]:
+        p = net.places[place]
+        part.add_place(p.id, tokens=net.initial_marking[p.id], label=p.label,
+                       subnet=subnet if p.id in own else None, channel=p.channel)
+    for transition in transitions:
+        t = net.transitions[transition]
+        part.add_transition(t.id, **{f.name: getattr(t, f.name) for f in fields(t) if f.name not in ("id", "meta")})
+    for arc in net.arcs:
+        if arc.source in part.places or arc.source in part.transitions:
+            if arc.target in part.places or arc.target in part.transitions:
+                part.add_arc(arc.source, arc.target, weight=arc.weight, outcome=arc.outcome)
+    return part
 
 
 def _groups(net: Net) -> tuple[dict[str, str], set[str]]:
