@@ -146,13 +146,19 @@ def test_pause_button_holds_a_running_run(browser, live_run):
     assert marking == {"done": 3}
 
 
-def test_breakpoint_on_a_transition(browser, live_run):
-    """`transition fix` pauses the run before fix fires; the trace has no start of fix before the resume."""
+def paused_with_breakpoint(browser, live_run, spec: str):
+    """A run started paused, its page open, with the breakpoint ``spec`` added on the page."""
     run = live_run("--paused")
     open_live(browser, run)
-    fill(browser, "c-break", "transition fix")
+    fill(browser, "c-break", spec)
     click(browser, "c-break-add")
-    until(browser, "return window.pfLive.control.breakpoints.includes('transition fix')", "the breakpoint listed")
+    until(browser, f"return window.pfLive.control.breakpoints.includes({spec!r})", "the breakpoint listed")
+    return run
+
+
+def test_breakpoint_on_a_transition(browser, live_run):
+    """`transition fix` pauses the run before fix fires; the trace has no start of fix before the resume."""
+    run = paused_with_breakpoint(browser, live_run, "transition fix")
     fill(browser, "c-place", "spare")
     click(browser, "c-inject")
     until(browser, "return (window.pfLive.shownMarking().spare || 0) === 1", "the token injected")
@@ -172,11 +178,7 @@ def test_breakpoint_on_a_transition(browser, live_run):
 
 def test_breakpoint_on_a_place_count(browser, live_run):
     """`place done >= 2` pauses the run when done reaches 2, before any later firing."""
-    run = live_run("--paused")
-    open_live(browser, run)
-    fill(browser, "c-break", "place done >= 2")
-    click(browser, "c-break-add")
-    until(browser, "return window.pfLive.control.breakpoints.length === 1", "the breakpoint listed")
+    run = paused_with_breakpoint(browser, live_run, "place done >= 2")
     click(browser, "c-resume")
     until(browser, "return window.pfLive.state === 'paused' && (window.pfLive.shownMarking().done || 0) === 2",
           "paused at done = 2")
