@@ -93,7 +93,8 @@ def agent_net(net: Net, subnet: str) -> Net:
                        subnet=subnet if p.id in own else None, channel=p.channel)
     for transition in transitions:
         t = net.transitions[transition]
-        part.add_transition(t.id, **{f.name: getattr(t, f.name) for f in fields(t) if f.name not in ("id", "meta")})
+        copied = {f.name: getattr(t, f.name) for f in fields(t) if f.name not in ("id", "meta")}
+        part.add_transition(t.id, **copied)
     for arc in net.arcs:
         if arc.source in part.places or arc.source in part.transitions:
             if arc.target in part.places or arc.target in part.transitions:

@@ -450,7 +450,8 @@ def test_a_big_net_drawn_in_full_is_scaled_to_the_bound_and_says_so(tmp_path, ca
     assert max(width, height) <= export.FULL_SIZE[0] * export.PNG_DPI + 1
     yaml_file = tmp_path / "chain.yaml"
     export_net(net, yaml_file)
-    assert main(["export", str(yaml_file), "-o", str(tmp_path / "again.png"), "--full", "--rankdir", "LR"]) == 0
+    again = tmp_path / "again.png"
+    assert main(["export", str(yaml_file), "-o", str(again), "--full", "--rankdir", "LR"]) == 0
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "too many to read drawn in full" in err
 

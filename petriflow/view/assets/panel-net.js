@@ -102,7 +102,8 @@ PF.netPanel = function (view, svg) {
         const b = shape ? box2(shape) : { x: 0, y: 0, width: 0, height: 0 };
         const text = document.createElementNS(NS, "text");
         text.setAttribute("class", "pf-tokens");
-        text.setAttribute("x", String(b.x + b.width / 2)); text.setAttribute("y", String(b.y + b.height + 11));
+        text.setAttribute("x", String(b.x + b.width / 2));
+        text.setAttribute("y", String(b.y + b.height + 11));
         text.setAttribute("text-anchor", "middle");
         g.appendChild(text);
         g.dataset.agent = id;
