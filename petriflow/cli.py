@@ -281,14 +281,18 @@ def cmd_export(args: argparse.Namespace) -> int:
     options = {"marking": marking, "highlight": highlight, "caption": caption, "rankdir": args.rankdir,
                "size": size, "fold": args.fold}
     if not to_stdout:
-        export_net(net, args.output, format, **options)
+        note = export_net(net, args.output, format, **options)
+        if note:
+            print(f"petriflow: {note}", file=sys.stderr)
         print(f"wrote {args.output}")
         return EXIT_OK
     import tempfile
 
     with tempfile.TemporaryDirectory(prefix="petriflow-export-") as folder:
         made = os.path.join(folder, f"net.{format}")
-        export_net(net, made, format, **options)
+        note = export_net(net, made, format, **options)
+        if note:
+            print(f"petriflow: {note}", file=sys.stderr)
         with open(made, "rb") as data:
             sys.stdout.flush()
             shutil.copyfileobj(data, sys.stdout.buffer)
@@ -560,7 +564,9 @@ def build_parser() -> argparse.ArgumentParser:
     folding.add_argument("--fold", dest="fold", action="store_true", default=None,
                          help="pictures: one box per agent subnet, the places between agents as circles"
                               " (the default for team nets of over 150 nodes)")
-    folding.add_argument("--full", dest="fold", action="store_false", help="pictures: every node, however big")
+    folding.add_argument("--full", dest="fold", action="store_false",
+                         help="pictures: every node (a net of over 150 nodes is scaled down to fit"
+                              " 40 x 40 in, with a note)")
     export.add_argument("--marking", help="marking to draw, as JSON (default: initial)")
     export.add_argument("--highlight", metavar="IDS", help="comma-separated node ids to highlight")
     export.add_argument("--violation", action="store_true",

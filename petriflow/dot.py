@@ -19,7 +19,8 @@ import html
 import re
 from typing import Mapping
 
-__all__ = ["CLUSTER_COLOURS", "FONT", "attributes", "html_text", "quote", "tokens_text"]
+__all__ = ["CLUSTER_COLOURS", "FONT", "OUTCOME_COLOURS", "arc_look", "attributes", "html_text", "quote",
+           "tokens_text"]
 
 #: The font of every text in a drawing.
 FONT = "Helvetica"
@@ -32,6 +33,8 @@ CLUSTER_COLOURS = (
     ("#eef8f7", "#5fa8a0"),
     ("#fbeff2", "#c77b90"),
 )
+#: Colour of the output arcs reserved for each routed action outcome (see :func:`arc_look`).
+OUTCOME_COLOURS = {"failed": "#c0392b", "timeout": "#c77c02", "cancelled": "#7f7f7f"}
 _TOKEN = "\u25cf"  # a black circle: one token
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
@@ -77,3 +80,27 @@ def tokens_text(count: int) -> str:
     digits = len(str(count))
     size = {1: 10, 2: 10, 3: 9, 4: 8}.get(digits, 7)  # from 6 digits on it spills over the rim
     return f'<FONT POINT-SIZE="{size}"><B>{count}</B></FONT>'
+
+
+def arc_look(outcome: str | None, weight: int = 1) -> dict[str, str]:
+    """How an arc is drawn: an output arc reserved for an action outcome (``failed``,
+    ``timeout``, ``cancelled``) is dashed in the outcome's colour (:data:`OUTCOME_COLOURS`)
+    and named by it, so a failure route never looks like one more branch of an AND-split;
+    a weight above 1 is written beside the arc. Texts are ``xlabel``: Graphviz places them
+    beside the arc after the layout, not on top of it.
+
+    Examples:
+        >>> arc_look(None), arc_look(None, 2)
+        ({}, {'xlabel': '"2"'})
+        >>> arc_look("failed")["style"], arc_look("failed", 3)["xlabel"]
+        ('dashed', '"failed ×3"')
+    """
+    attrs: dict[str, str] = {}
+    text = "" if weight <= 1 else str(weight)
+    if outcome is not None and outcome != "ok":
+        colour = OUTCOME_COLOURS.get(outcome, "#7f7f7f")
+        text = outcome if weight <= 1 else f"{outcome} \u00d7{weight}"
+        attrs.update({"style": "dashed", "color": f'"{colour}"', "fontcolor": f'"{colour}"'})
+    if text:
+        attrs["xlabel"] = quote(text)
+    return attrs

@@ -37,13 +37,13 @@ import subprocess
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from petriflow.dot import CLUSTER_COLOURS, FONT, attributes, html_text, quote, tokens_text
+from petriflow.dot import CLUSTER_COLOURS, FONT, arc_look, attributes, html_text, quote, tokens_text
 from petriflow.errors import DependencyNotInstalled, PetriflowError, UnknownElementError
 from petriflow.net import Net
 
 __all__ = [
     "to_dot", "render", "export_net", "format_of", "EXPORT_FORMATS", "PICTURE_FORMATS", "DOT_EXECUTABLE",
-    "HIGHLIGHT_COLOUR", "RUNNING_COLOUR", "RANK_DIRECTIONS",
+    "HIGHLIGHT_COLOUR", "RUNNING_COLOUR", "RANK_DIRECTIONS", "FULL_SIZE",
 ]
 
 #: Every format :func:`export_net` writes.
@@ -56,6 +56,10 @@ DOT_EXECUTABLE = "dot"
 DOT_TIMEOUT_S = 60.0
 #: Resolution of PNG pictures (Graphviz's default of 96 is blurry for small labels).
 PNG_DPI = 150
+#: The largest a picture of every node of a big net may be, ``(width, height)`` in inches
+#: (6000 pixels a side in PNG): a net of more than :data:`~petriflow.fold.FOLD_ABOVE`
+#: nodes drawn in full is scaled down to fit, and :func:`export_net` says so.
+FULL_SIZE = (40.0, 40.0)
 
 _MISSING_DOT = "Graphviz 'dot' not found: run scripts/setup.sh or apt-get install graphviz"
 
@@ -216,7 +220,9 @@ def to_dot(
     Places are circles with their tokens inside (dots for 1 to 4, the number from 5)
     and their label (or id) under them; transitions are boxes with their label (or id)
     in bold and the bound action below it; silent transitions are thin black bars.
-    Arcs of weight above 1 carry the weight. Each agent subnet is a labelled cluster
+    Arcs of weight above 1 carry the weight beside them; output arcs reserved for a
+    failed, timed-out or cancelled action are dashed, coloured and named by the outcome
+    (:func:`arc_look`). Each agent subnet is a labelled cluster
     naming its agent. The layout runs left to right.
 
     Args:
@@ -322,9 +328,7 @@ def to_dot(
     out += node_lines(loose_places, loose_transitions, "  ")
 
     for arc in net.arcs:
-        attrs: dict[str, str] = {}
-        if arc.weight > 1:
-            attrs["label"] = quote(str(arc.weight))
+        attrs = arc_look(arc.outcome, arc.weight)
         if (arc.source, arc.target) in bold_arcs:
             colour = f'"{HIGHLIGHT_COLOUR}"'
             attrs.update({"color": colour, "fontcolor": colour, "penwidth": "2.8"})
@@ -455,10 +459,17 @@ def export_net(
     rankdir: str = "auto",
     size: tuple[float, float] | None = None,
     fold: bool | None = None,
-) -> None:
+) -> str | None:
     """Write ``net`` to ``path`` as ``pnml``, ``yaml``, ``dot``, ``svg`` or ``png``.
 
     Every format is written atomically, so a failure leaves an existing file as it was.
+    A picture of every node of a net too big to read (more than
+    :data:`~petriflow.fold.FOLD_ABOVE` nodes, not folded) is scaled down to fit
+    :data:`FULL_SIZE` (or ``size``, when smaller).
+
+    Returns:
+        ``None``, or a one-line note on what was drawn differently from what was asked
+        (a big net drawn in full and scaled down), for the caller to show.
 
     Args:
         net: the net.
@@ -503,8 +514,8 @@ def export_net(
             save_net(net, path, format)
         except OSError as exc:
             raise PetriflowError(f"{path}: cannot write: {getattr(exc, 'strerror', None) or exc}") from None
-        return
-    from petriflow.fold import folded_dot, should_fold
+        return None
+    from petriflow.fold import FOLD_ABOVE, folded_dot, should_fold
 
     if fold is None:
         fold = not highlight and not running and should_fold(net)
@@ -518,7 +529,16 @@ def export_net(
             _write(path, source.encode("utf-8"))
         else:
             render(source, path, format, size=size)
-        return
+        return None
+    nodes = len(net.places) + len(net.transitions)
+    note = None
+    if nodes > FOLD_ABOVE and format in PICTURE_FORMATS:
+        bound = FULL_SIZE if size is None else (min(size[0], FULL_SIZE[0]), min(size[1], FULL_SIZE[1]))
+        size = bound
+        pixels = f" ({bound[0] * PNG_DPI:.0f} x {bound[1] * PNG_DPI:.0f} px)" if format == "png" else ""
+        note = (f"{net.id}: {nodes} nodes are too many to read drawn in full; the picture is scaled down to"
+                f" at most {bound[0]:g} x {bound[1]:g} in{pixels}"
+                + ("; --fold draws one box per agent" if len(net.subnets) >= 2 else ""))
     options = {"highlight": highlight, "caption": caption, "running": running}
     source = to_dot(net, marking, rankdir="LR" if rankdir == "auto" else rankdir, **options)
     if rankdir == "auto":
@@ -529,3 +549,4 @@ def export_net(
         _write(path, source.encode("utf-8"))
     else:
         render(source, path, format, size=size)
+    return note

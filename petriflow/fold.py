@@ -6,7 +6,11 @@ box naming the agent, its label, how many places and transitions it holds and th
 in them; a place stays a circle when it joins more than one agent or the envelope (a
 mailbox other agents send into, a shared resource, the net's source and sink);
 transitions outside every subnet stay as they are. Arcs between the same two nodes are
-drawn once, with how many they stand for.
+drawn once, with how many they stand for beside them; the flow between agents is kept
+(a mailbox every agent sends into keeps its senders' arcs, or, in a net where that would
+be hundreds of arcs, one arc from a dashed "N agents" node that bundles them, see
+:func:`_arcs`), so no node loses its incoming arc. An arc that only stands for output arcs
+of a failed, timed-out or cancelled action is drawn dashed and named like them.
 
 :func:`folded_dot` makes the DOT text; ``petriflow export NET -o net.png --fold`` draws
 it, and :func:`should_fold` says when ``export`` folds without being asked (a net of more
@@ -36,10 +40,10 @@ import math
 from collections import Counter
 from typing import Mapping
 
-from petriflow.dot import CLUSTER_COLOURS, FONT, html_text, quote, tokens_text
+from petriflow.dot import CLUSTER_COLOURS, FONT, arc_look, attributes, html_text, quote, tokens_text
 from petriflow.net import Net
 
-__all__ = ["folded_dot", "should_fold", "FOLD_ABOVE"]
+__all__ = ["folded_dot", "should_fold", "agent_net", "FOLD_ABOVE", "FAN", "FAN_ARCS", "CROWD"]
 
 #: ``export`` folds a picture without being asked when the net has more nodes than this
 #: and at least two agent subnets.
@@ -51,6 +55,51 @@ FAN = 4
 def should_fold(net: Net) -> bool:
     """Whether a picture of ``net`` is folded by default (see :data:`FOLD_ABOVE`)."""
     return len(net.places) + len(net.transitions) > FOLD_ABOVE and len(net.subnets) >= 2
+
+
+def agent_net(net: Net, subnet: str) -> Net:
+    """One agent's part of ``net`` as a net of its own, to draw it in full beside the
+    folded picture: the subnet's places and transitions, the places outside it that its
+    transitions take from or put into (outside the subnet's cluster), and the arcs between
+    them. Ids are those of ``net``, so a marking of ``net`` draws on it.
+
+    Examples:
+        >>> from petriflow.net import Net
+        >>> net = Net("team")
+        >>> _ = net.add_subnet("r1", agent="robot 1")
+        >>> _ = net.add_place("idle", tokens=1, subnet="r1"); _ = net.add_place("box")
+        >>> _ = net.add_transition("send", subnet="r1", action="radio.send")
+        >>> _ = net.add_arc("idle", "send"); _ = net.add_arc("send", "box", outcome="failed")
+        >>> part = agent_net(net, "r1")
+        >>> sorted(part.places), part.places["box"].subnet, part.arc("send", "box", "failed") is not None
+        (['box', 'idle'], None, True)
+    """
+    from dataclasses import fields
+
+    if subnet not in net.subnets:
+        from petriflow.errors import UnknownElementError
+
+        raise UnknownElementError("subnet", subnet, list(net.subnets))
+    spec = net.subnets[subnet]
+    part = Net(net.id, f"{spec.agent or spec.id}: {spec.label or spec.id}")
+    part.add_subnet(spec.id, label=spec.label, agent=spec.agent, state=spec.state)
+    places, transitions = net.nodes_of(subnet)
+    own = set(places) | set(transitions)
+    touched = [p for arc in net.arcs for p in (arc.source, arc.target)
+               if p in net.places and p not in own and ({arc.source, arc.target} & set(transitions))]
+    for place in [*places, *dict.fromkeys(touched)]:
+        p = net.places[place]
+        part.add_place(p.id, tokens=net.initial_marking[p.id], label=p.label,
+                       subnet=subnet if p.id in own else None, channel=p.channel)
+    for transition in transitions:
+        t = net.transitions[transition]
+        copied = {f.name: getattr(t, f.name) for f in fields(t) if f.name not in ("id", "meta")}
+        part.add_transition(t.id, **copied)
+    for arc in net.arcs:
+        if arc.source in part.places or arc.source in part.transitions:
+            if arc.target in part.places or arc.target in part.transitions:
+                part.add_arc(arc.source, arc.target, weight=arc.weight, outcome=arc.outcome)
+    return part
 
 
 def _groups(net: Net) -> tuple[dict[str, str], set[str]]:
@@ -73,11 +122,27 @@ def _groups(net: Net) -> tuple[dict[str, str], set[str]]:
     return owner, kept
 
 
-def _arcs(net: Net, owner: dict[str, str]) -> tuple[Counter, dict[str, str]]:
-    """The folded arcs (``{(source, target): arcs folded into it}``) and the notes that
-    replace fans: a place that :data:`FAN` or more agents send into (or take from) gets
-    "from N agents" instead of N arcs, and an agent coupled to that many other agents
-    through their places gets "coupled to N agents" instead of arcs between boxes."""
+#: Fan arcs (an agent box to or from a place many agents share) drawn one by one in a
+#: folded picture, at most; the fans beyond go through one "the agents" node instead.
+FAN_ARCS = 60
+#: Id of the node that stands for many agents at once in a folded drawing.
+CROWD = "crowd:agents"
+
+
+def _arcs(net: Net, owner: dict[str, str]) -> tuple[Counter, set[tuple[str, str]], dict[str, str], int]:
+    """The folded arcs ``{(source, target): arcs folded into it}``, the pairs drawn as one
+    two-way arc, the notes of the fans, and how many agents the crowd node stands for
+    (0: none drawn).
+
+    Nothing loses its flow. A place that :data:`FAN` or more agents send into (or take
+    from) gets a note ("from N agents"); its fan is drawn as one arc per agent (an agent
+    that both sends and takes: one two-way arc) when all the fans together stay under
+    :data:`FAN_ARCS`; otherwise each fan is one arc from (or to) the :data:`CROWD` node,
+    labelled with how many agents it stands for. Two agent boxes
+    joined by an arc keep it, labelled with the count, except between two agents that are
+    bundled: an agent coupled to :data:`FAN` or more others, or to more than one agent
+    and one of them such a hub, gets one two-way arc to the crowd node, labelled with how
+    many agents it is coupled to, instead of an arc to each of them."""
     arcs: Counter[tuple[str, str]] = Counter()
     for arc in net.arcs:
         source, target = owner[arc.source], owner[arc.target]
@@ -85,13 +150,31 @@ def _arcs(net: Net, owner: dict[str, str]) -> tuple[Counter, dict[str, str]]:
             arcs[source, target] += 1
     agent = lambda node: node.startswith("agent:")  # noqa: E731
     notes: dict[str, list[str]] = {}
-    for node in {n for pair in arcs for n in pair if not agent(n)}:
-        for side, word in ((0, "from"), (1, "to")):
-            fan = [pair for pair in arcs if pair[1 - side] == node and agent(pair[side])]
-            if len(fan) >= FAN:
-                notes.setdefault(node, []).append(f"{word} {len(fan)} agents")
-                for pair in fan:
-                    del arcs[pair]
+    fans: dict[str, tuple[set[str], set[str]]] = {}
+    for node in sorted({n for pair in arcs for n in pair if not agent(n)}):
+        senders = {pair[0] for pair in arcs if pair[1] == node and agent(pair[0])}
+        takers = {pair[1] for pair in arcs if pair[0] == node and agent(pair[1])}
+        if len(senders) >= FAN:
+            notes.setdefault(node, []).append(f"from {len(senders)} agents")
+        if len(takers) >= FAN:
+            notes.setdefault(node, []).append(f"to {len(takers)} agents")
+        if len(senders) >= FAN or len(takers) >= FAN:
+            fans[node] = (senders if len(senders) >= FAN else set(), takers if len(takers) >= FAN else set())
+    both: set[tuple[str, str]] = set()
+    crowd: set[str] = set()
+    one_by_one = sum(len(senders | takers) for senders, takers in fans.values()) <= FAN_ARCS
+    for node, (senders, takers) in fans.items():
+        if one_by_one:
+            for box in senders & takers:
+                arcs[box, node] += arcs.pop((node, box))
+                both.add((box, node))
+            continue
+        for side, boxes in ((0, senders), (1, takers)):
+            if boxes:
+                for box in boxes:
+                    del arcs[(box, node) if side == 0 else (node, box)]
+                arcs[(CROWD, node) if side == 0 else (node, CROWD)] += len(boxes)
+                crowd |= boxes
     coupled: dict[str, set[str]] = {}
     for source, target in arcs:
         if agent(source) and agent(target):
@@ -100,10 +183,26 @@ def _arcs(net: Net, owner: dict[str, str]) -> tuple[Counter, dict[str, str]]:
     for node, others in coupled.items():
         if len(others) >= FAN:
             notes.setdefault(node, []).append(f"coupled to {len(others)} agents")
-    for pair in [p for p in arcs if agent(p[0]) and agent(p[1])]:
-        if len(coupled[pair[0]]) >= FAN or len(coupled[pair[1]]) >= FAN:
-            del arcs[pair]
-    return arcs, {node: ", ".join(words) for node, words in notes.items()}
+    bundled = {box for box, others in coupled.items()
+               if len(others) >= FAN or (len(others) > 1 and any(len(coupled[o]) >= FAN for o in others))}
+    for pair in [p for p in arcs if p[0] in bundled and p[1] in bundled]:
+        del arcs[pair]
+    for box in bundled:
+        arcs[box, CROWD] = len(coupled[box])
+        both.add((box, CROWD))
+        crowd.add(box)
+    return arcs, both, {node: ", ".join(words) for node, words in notes.items()}, len(crowd)
+
+
+def _outcomes(net: Net, owner: dict[str, str]) -> dict[tuple[str, str], str]:
+    """The folded arcs that only stand for output arcs of one routed outcome (``failed``,
+    ...): drawn like them (:func:`petriflow.dot.arc_look`)."""
+    seen: dict[tuple[str, str], set[str | None]] = {}
+    for arc in net.arcs:
+        pair = owner[arc.source], owner[arc.target]
+        if pair[0] != pair[1]:
+            seen.setdefault(pair, set()).add(arc.outcome)
+    return {pair: next(iter(kinds)) for pair, kinds in seen.items() if len(kinds) == 1 and None not in kinds}
 
 
 def _xlabel(name: str, note: str | None) -> str:
@@ -119,7 +218,7 @@ def _components(net: Net, owner: dict[str, str], arcs: Counter) -> int:
     import networkx as nx
 
     graph = nx.Graph()
-    graph.add_nodes_from(set(owner.values()))
+    graph.add_nodes_from(set(owner.values()) | {n for pair in arcs for n in pair})
     graph.add_edges_from(arcs)
     return nx.number_connected_components(graph)
 
@@ -129,7 +228,8 @@ def folded_dot(net: Net, marking: Mapping[str, int] | None = None, *, title: str
     """Graphviz DOT text of ``net`` folded (see the module)."""
     marking = net.initial_marking if marking is None else net.check_marking(marking)
     owner, kept = _groups(net)
-    arcs, notes = _arcs(net, owner)
+    arcs, both, notes, crowd = _arcs(net, owner)
+    outcomes = _outcomes(net, owner)
     title = (net.label or net.id) if title is None else title
     out = [f"digraph {quote(net.id)} {{"]
     label = f' label=<<B>{html_text(title)}</B><BR/><FONT POINT-SIZE="10">folded: one box per agent' \
@@ -168,8 +268,17 @@ def folded_dot(net: Net, marking: Mapping[str, int] | None = None, *, title: str
                     if t.id in notes else "")
             out.append(f'  {quote(t.id)} [shape=box, style="filled", fillcolor="#dfe6ee", height=0.3,'
                        f' label=<<B>{html_text(t.label or t.id)}</B>{note}>];')
+    if crowd:
+        out.append(f'  {quote(CROWD)} [shape=box, style="rounded,dashed", color="#555555", height=0.3,'
+                   f' label=<<I>{crowd} agents</I><BR/><FONT POINT-SIZE="8">(arcs of many agents,'
+                   f' bundled)</FONT>>];')
     for (source, target), count in arcs.items():
-        attrs = f' [label="{count}"]' if count > 1 else ""
-        out.append(f"  {quote(source)} -> {quote(target)}{attrs};")
+        attrs = {"xlabel": f'"{count}"'} if count > 1 else {}
+        if (source, target) in both:
+            attrs["dir"] = "both"
+        outcome = outcomes.get((source, target))
+        if outcome is not None:
+            attrs.update(arc_look(outcome, count))
+        out.append(f"  {quote(source)} -> {quote(target)}{' ' + attributes(attrs) if attrs else ''};")
     out.append("}")
     return "\n".join(out) + "\n"

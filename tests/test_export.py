@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import shutil
+import struct
 import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -11,7 +12,7 @@ from pathlib import Path
 import pytest
 
 import petriflow.export as export
-from petriflow.dot import quote
+from petriflow.dot import OUTCOME_COLOURS, quote
 from petriflow.cli import main
 from petriflow.errors import DependencyNotInstalled, PetriflowError, UnknownElementError
 from petriflow.export import HIGHLIGHT_COLOUR, export_net, render, to_dot
@@ -101,10 +102,11 @@ def test_dot_has_one_labelled_cluster_per_subnet(inspection):
 
 
 def test_weights_above_one_are_edge_labels():
-    """Weights > 1 label their arc; weight-1 arcs carry no label."""
+    """Weights > 1 label their arc beside it (xlabel, not on the line); weight-1 arcs carry no label."""
     arcs = arc_statements(to_dot(weighted_net()))
-    assert 'label="3"' in arcs[("stock", "pack")]
-    assert 'label="2"' in arcs[("skip", "stock")]
+    assert 'xlabel="3"' in arcs[("stock", "pack")]
+    assert 'xlabel="2"' in arcs[("skip", "stock")]
+    assert not re.search(r"(?<![x])label=", arcs[("stock", "pack")])
     assert "label" not in arcs[("pack", "boxes")]
 
 
@@ -387,3 +389,73 @@ def test_a_wide_net_is_laid_out_top_to_bottom(tmp_path):
     assert "rankdir=TB" in (tmp_path / "chain.dot").read_text()
     export_net(chain, tmp_path / "lr.dot", rankdir="LR")
     assert "rankdir=LR" in (tmp_path / "lr.dot").read_text()
+
+
+def charging() -> Net:
+    net = Net("charging")
+    for place in ("empty", "full", "faulty"):
+        net.add_place(place, tokens=int(place == "empty"))
+    net.add_transition("charge", action="demo.charge")
+    net.add_arc("empty", "charge")
+    net.add_arc("charge", "full")
+    net.add_arc("charge", "faulty", outcome="failed")
+    return net
+
+
+def test_an_outcome_arc_is_dashed_coloured_and_named_and_an_ok_arc_is_plain():
+    arcs = arc_statements(to_dot(charging()))
+    failed = arcs[("charge", "faulty")]
+    assert "style=dashed" in failed and 'xlabel="failed"' in failed
+    assert OUTCOME_COLOURS["failed"] in failed
+    plain = arcs.get(("charge", "full"), "")
+    assert "dashed" not in plain and "label" not in plain
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz missing")
+def test_the_svg_shows_the_outcome_beside_its_dashed_arc(tmp_path):
+    out = tmp_path / "charging.svg"
+    export_net(charging(), out)
+    root = ET.fromstring(out.read_bytes())
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    edges = {e.find("s:title", ns).text: e for e in root.iter("{http://www.w3.org/2000/svg}g")
+             if e.get("class") == "edge"}
+    failed = edges["charge&#45;&gt;faulty"] if "charge&#45;&gt;faulty" in edges else edges["charge->faulty"]
+    assert failed.find("s:path", ns).get("stroke-dasharray")
+    assert [t.text for t in failed.iter("{http://www.w3.org/2000/svg}text")] == ["failed"]
+    plain = edges["charge->full"]
+    assert plain.find("s:path", ns).get("stroke-dasharray") is None
+
+
+def chain(places: int) -> Net:
+    """A long line of places and transitions: wide drawn in full."""
+    net = Net("chain")
+    for k in range(places):
+        net.add_place(f"p{k}", tokens=int(k == 0))
+    for k in range(places - 1):
+        net.add_transition(f"t{k}")
+        net.add_arc(f"p{k}", f"t{k}")
+        net.add_arc(f"t{k}", f"p{k + 1}")
+    return net
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz missing")
+def test_a_big_net_drawn_in_full_is_scaled_to_the_bound_and_says_so(tmp_path, capsys):
+    from petriflow.fold import FOLD_ABOVE
+
+    net = chain(FOLD_ABOVE)   # 2 * FOLD_ABOVE - 1 nodes in one row: far wider than FULL_SIZE
+    out = tmp_path / "chain.png"
+    note = export_net(net, out, fold=False, rankdir="LR")
+    assert note and f"{2 * FOLD_ABOVE - 1} nodes" in note and "scaled down" in note
+    width, height = struct.unpack(">II", out.read_bytes()[16:24])
+    assert max(width, height) <= export.FULL_SIZE[0] * export.PNG_DPI + 1
+    yaml_file = tmp_path / "chain.yaml"
+    export_net(net, yaml_file)
+    again = tmp_path / "again.png"
+    assert main(["export", str(yaml_file), "-o", str(again), "--full", "--rankdir", "LR"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "too many to read drawn in full" in err
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz missing")
+def test_a_small_net_is_drawn_without_a_note(tmp_path):
+    assert export_net(charging(), tmp_path / "c.png") is None

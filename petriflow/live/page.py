@@ -6,7 +6,7 @@ The page is made once, before the run, from the net (no trace: the run's state c
 over the WebSocket, :mod:`petriflow.live.server`). It reuses the run page's net panel
 (``panel-net.js``, the same picture as ``petriflow view``); a net too big to draw
 readably (the threshold ``export`` folds at, :func:`petriflow.fold.should_fold`) is
-shown as its list of places instead.
+drawn folded, one box per agent, and a click on a box opens that agent's subnet.
 """
 
 from __future__ import annotations
@@ -23,20 +23,16 @@ SCRIPTS = ["common.js", "panel-net.js", "live.js"]
 
 def live_page(net: Any) -> str:
     """The HTML of the live page of a run of ``net``."""
-    from petriflow.fold import should_fold
-    from petriflow.view.run_page import net_picture
+    from petriflow.view.run_page import net_pictures
 
-    if should_fold(net):
-        svg, why = None, (f"the net has {len(net.places) + len(net.transitions)} nodes, more than a readable"
-                          " drawing holds (petriflow export --fold draws it by agent)")
-    else:
-        svg, why = net_picture(net)
+    svg, why, folded = net_pictures(net)
     agents = {s.id: (s.agent or s.id) for s in net.subnets.values()}
     data = {
         "kind": "live",
         "name": net.id,
         "svg": None if svg is None else pack(svg),
         "svg_missing": why if svg is None else None,
+        "folded": folded,
         "net_places": list(net.places),
         "transition_info": {t.id: {"label": t.label or t.id, "action": t.action,
                                    "agent": agents.get(t.subnet) if t.subnet else None}

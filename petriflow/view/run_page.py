@@ -24,16 +24,45 @@ from petriflow.runtime.trace import read_trace
 from petriflow.view.columns import encoded
 from petriflow.view.page import pack, pack_bytes, render
 
-__all__ = ["run_page", "net_picture", "model", "unpacked", "stored", "restored"]
+__all__ = ["run_page", "net_picture", "net_pictures", "model", "unpacked", "stored", "restored"]
 
 
 def net_picture(net: Any) -> tuple[str | None, str | None]:
     """``(svg, None)``: the net drawn with Graphviz without tokens, as inline SVG; or
     ``(None, why)`` when it cannot be drawn (Graphviz missing or failing)."""
-    from petriflow.export import render as render_dot
     from petriflow.export import to_dot
 
-    source = to_dot(net, {p: 0 for p in net.places}, title="")
+    return _svg(to_dot(net, {p: 0 for p in net.places}, title=""))
+
+
+def net_pictures(net: Any) -> tuple[str | None, str | None, dict[str, Any] | None]:
+    """The net panel's pictures: ``(svg, why, folded)`` as :func:`net_picture`, with
+    ``folded`` ``None``; or, for a net ``export`` folds (:func:`petriflow.fold.should_fold`),
+    the folded drawing as ``svg`` and ``folded`` = ``{"agent:SUBNET": {"places": [...],
+    "svg": packed SVG of the subnet drawn in full}}``, which the panel opens when its box
+    is clicked."""
+    from petriflow.export import to_dot
+    from petriflow.fold import agent_net, folded_dot, should_fold
+
+    if not should_fold(net):
+        svg, why = net_picture(net)
+        return svg, why, None
+    svg, why = _svg(folded_dot(net, {p: 0 for p in net.places}, title=""))
+    if svg is None:
+        return None, why, None
+    folded: dict[str, Any] = {}
+    for subnet in net.subnets:
+        part = agent_net(net, subnet)
+        inner, _ = _svg(to_dot(part, {p: 0 for p in part.places}, title=part.label or ""))
+        places, _ = net.nodes_of(subnet)
+        folded[f"agent:{subnet}"] = {"places": list(places), "svg": None if inner is None else pack(inner)}
+    return svg, None, folded
+
+
+def _svg(source: str) -> tuple[str | None, str | None]:
+    """DOT text drawn as inline SVG (comments left out), or ``(None, why)``."""
+    from petriflow.export import render as render_dot
+
     with tempfile.TemporaryDirectory(prefix="petriflow-view-") as folder:
         path = Path(folder) / "net.svg"
         try:
@@ -377,7 +406,7 @@ def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float 
     if not events:
         raise PetriflowError(f"{trace}: the trace holds no event")
     loaded = None
-    svg, why = None, "no net given (--net NET draws it)"
+    svg, why, folded = None, "no net given (--net NET draws it)", None
     if net is not None:
         from petriflow.io import load_net
 
@@ -386,10 +415,11 @@ def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float 
         if unknown:
             raise PetriflowError(f"{trace} was not recorded on {net}: it fires {', '.join(unknown[:3])},"
                                  " which the net does not have")
-        svg, why = net_picture(loaded)
+        svg, why, folded = net_pictures(loaded)
     first = events[0].data if events[0].kind == "run" else {}
     replay = model(events, list(loaded.places) if loaded is not None else None)
-    budget = max_mb * 1e6 - len(pack(svg or "")) - 200_000  # the page's own code and styles
+    pictures = len(pack(svg or "")) + sum(len(f["svg"] or "") for f in (folded or {}).values())
+    budget = max_mb * 1e6 - pictures - 200_000  # the page's own code and styles
     shortened, limit = 0, None
     for limit in (None, 1024, 256, 64):  # each event whole, else its bulky data left out, less and less
         kept, shortened = _shortened(events, limit)
@@ -412,6 +442,7 @@ def run_page(trace: str | Path, *, net: str | Path | None = None, max_mb: float 
         "shortened": {"events": shortened, "limit": limit, "max_mb": max_mb} if shortened else None,
         "svg": None if svg is None else pack(svg),
         "svg_missing": why if svg is None else None,
+        "folded": folded,
         "net_places": list(loaded.places) if loaded is not None else [],
         "transition_info": _transitions(loaded, events),
         "run_agents": [str(a) for a in first.get("agents") or []],

@@ -181,3 +181,45 @@ def test_sweep_page_draws_each_metric(browser, tmp_path):
     assert browser.find_element(By.ID, "t-count").text == "6 of 6 trials"
     screenshot(browser, tmp_path, "view-sweep")
     assert console_errors(browser) == []
+
+
+def test_a_big_team_net_is_drawn_folded_and_a_click_opens_one_agents_subnet(browser, tmp_path):
+    """Above the size ``export`` folds at, the net panel shows one box per agent (with the
+    tokens inside it); clicking a box shows that agent's subnet in full with the marking,
+    and "back" returns to the folded drawing."""
+    from petriflow.fold import should_fold
+    from petriflow.io import save_net
+    from petriflow.runtime.session import run_files
+    from tests.test_fold import team
+
+    net = team(12)
+    assert should_fold(net)
+    source = tmp_path / "team.yaml"
+    save_net(net, source, "yaml")
+    trace = tmp_path / "team.jsonl"
+    with pytest.warns(UserWarning, match="token game"):
+        run_files(source, trace=trace, max_firings=40)
+    events = read_trace(trace)
+    page = petriflow.view(trace, net=source, out=tmp_path / "team.html")
+    open_page(browser, page)
+    boxes = browser.find_elements(By.CSS_SELECTOR, "#net g.node[data-agent]")
+    assert len(boxes) == 12
+    assert not browser.find_elements(By.CSS_SELECTOR, '#net g.node[data-place="r1_idle"]')  # folded inside r1
+    move_slider(browser, len(events) - 1)
+    after = list(markings(events))[-1][1].to_dict()
+    r1 = browser.find_element(By.CSS_SELECTOR, '#net g.node[data-agent="agent:r1"]')
+    inside = sum(n for p, n in after.items() if p.startswith("r1_"))
+    assert int(r1.get_attribute("data-tokens")) == inside
+    screenshot(browser, tmp_path, "view-team-folded")
+    browser.execute_script("arguments[0].dispatchEvent(new MouseEvent('click', {bubbles: true}))", r1)
+    deadline = time.monotonic() + 10
+    while not browser.find_elements(By.CSS_SELECTOR, '#net g.node[data-place="r1_idle"]'):
+        assert time.monotonic() < deadline, "r1's subnet did not open"
+        time.sleep(0.05)
+    shown = browser.execute_script("return window.pfView.shownMarking()")
+    assert {p: n for p, n in shown.items() if p.startswith("r1_")} == \
+        {p: n for p, n in after.items() if p.startswith("r1_")}
+    screenshot(browser, tmp_path, "view-team-r1")
+    browser.find_element(By.ID, "net-back").click()
+    assert len(browser.find_elements(By.CSS_SELECTOR, "#net g.node[data-agent]")) == 12
+    assert console_errors(browser) == []

@@ -30,7 +30,30 @@ PF.netPanel = function (view, svg) {
       box.appendChild(table);
       return;
     }
-    box.innerHTML = svg;               // Graphviz's own SVG, as export writes it (no script in it)
+    show(svg, null);
+  }
+
+  /** Put a picture in the panel: the net (or its folded drawing) or, `agent` given, one
+   *  agent's subnet opened from the folded drawing, with a way back. */
+  function show(text, agent) {
+    const box = document.getElementById("net");
+    net.places.clear(); net.transitions.clear(); net.status = new Map(); net.shown = null; net.boxes = [];
+    box.innerHTML = text;               // Graphviz's own SVG, as export writes it (no script in it)
+    if (D.folded) {
+      const bar = document.createElement("div");
+      bar.className = "pf-fold-bar note";
+      if (agent) {
+        const back = document.createElement("button");
+        back.textContent = "back to all agents";
+        back.id = "net-back";
+        back.addEventListener("click", () => { show(svg, null); redraw(); });
+        bar.appendChild(back);
+        bar.appendChild(document.createTextNode(" " + agent.slice("agent:".length) + "'s subnet"));
+      } else {
+        bar.textContent = "folded: one box per agent; click a box to open its subnet";
+      }
+      box.insertBefore(bar, box.firstChild);
+    }
     const picture = box.querySelector("svg");
     picture.removeAttribute("width"); picture.removeAttribute("height");
     const NS = "http://www.w3.org/2000/svg";
@@ -74,10 +97,38 @@ PF.netPanel = function (view, svg) {
         g.appendChild(text);
         g.dataset.transition = id;
         net.transitions.set(id, { g, text });
+      } else if (!agent && D.folded && D.folded[id]) {
+        const shape = g.querySelector("polygon, path");
+        const b = shape ? box2(shape) : { x: 0, y: 0, width: 0, height: 0 };
+        const text = document.createElementNS(NS, "text");
+        text.setAttribute("class", "pf-tokens");
+        text.setAttribute("x", String(b.x + b.width / 2));
+        text.setAttribute("y", String(b.y + b.height + 11));
+        text.setAttribute("text-anchor", "middle");
+        g.appendChild(text);
+        g.dataset.agent = id;
+        g.style.cursor = "pointer";
+        net.boxes.push({ g, text, places: D.folded[id].places });
+        let down = null;
+        g.addEventListener("mousedown", e => { down = [e.clientX, e.clientY]; });
+        g.addEventListener("click", e => {   // a click, not the end of a drag
+          if (down && Math.hypot(e.clientX - down[0], e.clientY - down[1]) > 4) return;
+          open(id);
+        });
       }
     }
+    net.boxes = net.boxes.map(b => ({ ...b, places: b.places.filter(p => !net.places.has(p)) }));
     panZoom(box, picture);
   }
+
+  /** Open one agent's subnet (drawn in full) in place of the folded drawing. */
+  function open(id) {
+    const part = D.folded && D.folded[id];
+    if (!part || !part.svg) return;
+    PF.inflate(part.svg).then(text => { show(text, id); redraw(); });
+  }
+
+  function redraw() { if (net.last !== undefined) draw(net.last); }
 
   /** Wheel zooms around the pointer, dragging pans (the SVG's viewBox). */
   function panZoom(box, svg) {
@@ -113,8 +164,15 @@ PF.netPanel = function (view, svg) {
   }
 
   function draw(i) {
+    net.last = i;
     const counts = replay.markingAt(i), placeIndex = replay.placeIndex;
     const shown = net.shown;
+    for (const b of net.boxes || []) {
+      let n = 0;
+      for (const p of b.places) n += counts[placeIndex.get(p)] || 0;
+      b.text.textContent = n > 0 ? (n <= 3 ? "●".repeat(n) : String(n) + " tokens") : "";
+      b.g.dataset.tokens = String(n);
+    }
     for (const [p, node] of net.places) {
       const n = counts[placeIndex.get(p)];
       if (shown && shown[placeIndex.get(p)] === n) continue;
@@ -168,5 +226,5 @@ PF.netPanel = function (view, svg) {
   }
 
   setup();
-  return { draw, shown };
+  return { draw, shown, open };
 };
