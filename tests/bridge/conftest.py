@@ -83,6 +83,88 @@ class Router:
             self.session = None
 
 
+class Link:
+    """A TCP proxy on a free loopback port to ``port`` that the test can cut and restore: a
+    network partition between one client and the broker or router, with nobody killed.
+
+    Cut, it closes its listener and every connection through it (the client's reconnects
+    are refused); restored, it listens on the same port again.
+    """
+
+    def __init__(self, port: int) -> None:
+        self.target, self.port = port, free_port()
+        self.lock = threading.Lock()
+        self.sockets: list[socket.socket] = []
+        self.listener: socket.socket | None = None
+        self.threads: list[threading.Thread] = []
+        self.restore()
+
+    @property
+    def connect(self) -> str:
+        return f"tcp/127.0.0.1:{self.port}"
+
+    def restore(self) -> None:
+        listener = socket.socket()
+        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        listener.bind(("127.0.0.1", self.port))
+        listener.listen()
+        self.listener = listener
+        self._thread(self._accept, listener)
+
+    def cut(self) -> None:
+        with self.lock:
+            doomed, self.sockets = [self.listener, *self.sockets], []
+            self.listener = None
+        for sock in doomed:
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+            sock.close()
+
+    def stop(self) -> None:
+        self.cut()
+        for thread in self.threads:
+            thread.join(timeout=10)
+        assert not any(thread.is_alive() for thread in self.threads)
+
+    def _thread(self, target, *args) -> None:
+        thread = threading.Thread(target=target, args=args, daemon=True)
+        self.threads.append(thread)
+        thread.start()
+
+    def _accept(self, listener: socket.socket) -> None:
+        while True:
+            try:
+                client, _ = listener.accept()
+            except OSError:  # cut
+                return
+            server = socket.create_connection(("127.0.0.1", self.target))
+            for sock in (client, server):
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            with self.lock:
+                if self.listener is not listener:  # cut meanwhile
+                    client.close()
+                    server.close()
+                    return
+                self.sockets += [client, server]
+            self._thread(self._pipe, client, server)
+            self._thread(self._pipe, server, client)
+
+    @staticmethod
+    def _pipe(source: socket.socket, sink: socket.socket) -> None:
+        try:
+            while data := source.recv(65536):
+                sink.sendall(data)
+        except OSError:
+            pass
+        for sock in (source, sink):
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+
+
 def children() -> set[int]:
     """The live processes whose parent is this one (from /proc; zombies count as gone)."""
     found = set()
@@ -135,6 +217,20 @@ def middleware(request, tmp_path):
         made = Router()
     yield request.param, made
     made.stop()
+
+
+@pytest.fixture
+def link():
+    """``link(port)``: a :class:`Link` to ``port``, stopped after the test."""
+    made: list[Link] = []
+
+    def start(port: int) -> Link:
+        made.append(Link(port))
+        return made[-1]
+
+    yield start
+    for each in made:
+        each.stop()
 
 
 class ServedAgent:
