@@ -11,6 +11,7 @@ import os
 import shutil
 import socket
 import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -210,13 +211,38 @@ def router():
 @pytest.fixture(params=["mqtt", "zenoh"])
 def middleware(request, tmp_path):
     """``(transport name, the broker or router)`` for each transport."""
-    if request.param == "mqtt":
-        pytest.importorskip("paho.mqtt")
-        made = Broker(tmp_path)
-    else:
-        made = Router()
+    made = start_middleware(request.param, tmp_path)
     yield request.param, made
     made.stop()
+
+
+def start_middleware(kind: str, folder: Path) -> Broker | Router:
+    """A broker (``mqtt``) or a router (``zenoh``) on loopback; the caller stops it."""
+    if kind == "mqtt":
+        pytest.importorskip("paho.mqtt")
+        return Broker(folder)
+    return Router()
+
+
+#: Set in the test process started inside a network namespace of its own (:func:`own_network`).
+INSIDE = "PETRIFLOW_TEST_OWN_NETWORK"
+
+
+def own_network(request) -> bool:
+    """Run the calling test again in a network namespace of its own (``unshare -n``, loopback
+    up, everything it starts inside it) when this machine permits one; ``True`` when it did
+    (and passed there), so the caller returns; ``False`` inside it, or where no namespace is
+    permitted (the test then runs here, on the shared loopback)."""
+    if os.environ.get(INSIDE) or shutil.which("unshare") is None or shutil.which("ip") is None:
+        return False
+    if subprocess.run(["unshare", "-n", "ip", "link", "set", "lo", "up"], capture_output=True).returncode != 0:
+        return False
+    root = Path(__file__).resolve().parents[2]
+    inner = subprocess.run(["unshare", "-n", "sh", "-c", 'ip link set lo up && exec "$0" "$@"', sys.executable,
+                            "-m", "pytest", "-q", "-p", "no:randomly", "-m", "slow", request.node.nodeid],
+                           cwd=root, env={**os.environ, INSIDE: "1"}, capture_output=True, text=True, timeout=300)
+    assert inner.returncode == 0, inner.stdout[-3000:] + inner.stderr[-2000:]
+    return True
 
 
 @pytest.fixture
