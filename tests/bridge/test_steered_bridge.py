@@ -13,7 +13,7 @@ from tests.live.conftest import LiveRun
 from tests.live.test_steered_runs import ctl
 
 #: Ten goals in a row on the remote agent; the first, ``s0``, runs 1 s: the run is paused then.
-SLOW_FIRST = CHAIN.replace("{seconds: 0.3}}, in: [a]", "{seconds: 1.0}}, in: [a]")
+SLOW_FIRST = CHAIN.replace("{seconds: 0.3}, in: [a]", "{seconds: 1.0}, in: [a]")
 
 
 @pytest.mark.slow
