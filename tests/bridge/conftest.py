@@ -235,12 +235,12 @@ def own_network(request) -> bool:
     permitted (the test then runs here, on the shared loopback)."""
     if os.environ.get(INSIDE) or shutil.which("unshare") is None or shutil.which("ip") is None:
         return False
-    if subprocess.run(["unshare", "-n", "ip", "link", "set", "lo", "up"], capture_output=True).returncode != 0:
+    if subprocess.run(["unshare", "-n", "ip", "link", "set", "lo", "up"], capture_output=True, check=False).returncode != 0:
         return False
     root = Path(__file__).resolve().parents[2]
     inner = subprocess.run(["unshare", "-n", "sh", "-c", 'ip link set lo up && exec "$0" "$@"', sys.executable,
                             "-m", "pytest", "-q", "-p", "no:randomly", "-m", "slow", request.node.nodeid],
-                           cwd=root, env={**os.environ, INSIDE: "1"}, capture_output=True, text=True, timeout=300)
+                           cwd=root, env={**os.environ, INSIDE: "1"}, capture_output=True, text=True, timeout=300, check=False)
     assert inner.returncode == 0, inner.stdout[-3000:] + inner.stderr[-2000:]
     return True
 

@@ -33,27 +33,28 @@ def test_an_agent_cut_off_is_lost_then_rejoins_with_no_goal_run_twice(kind, requ
     request.addfinalizer(server.stop)
     serve, link = request.getfixturevalue("serve"), request.getfixturevalue("link")
     through = link(server.port)
-    agent = serve(kind, through.connect, ["robot1"], heartbeat=0.1, log_file=open(tmp_path / "agent.log", "w"))
-    net = write(tmp_path, kind, server.connect, net=RETRY.replace("{seconds: 30}", "{seconds: 2}"),
-                heartbeat=0.1, heartbeat_timeout=1.0)
-    cut = []
+    with open(tmp_path / "agent.log", "w") as log:
+        agent = serve(kind, through.connect, ["robot1"], heartbeat=0.1, log_file=log)
+        net = write(tmp_path, kind, server.connect, net=RETRY.replace("{seconds: 30}", "{seconds: 2}"),
+                    heartbeat=0.1, heartbeat_timeout=1.0)
+        cut = []
 
-    def partition():
-        deadline = time.monotonic() + 60
-        while not agent.server.executed:  # until go runs on the agent
-            if time.monotonic() > deadline:
-                return
-            time.sleep(0.01)
-        through.cut()
-        cut.append(time.monotonic())
-        time.sleep(3.0)  # lost by then, and go (2 s) over on the agent
-        through.restore()
+        def partition():
+            deadline = time.monotonic() + 60
+            while not agent.server.executed:  # until go runs on the agent
+                if time.monotonic() > deadline:
+                    return
+                time.sleep(0.01)
+            through.cut()
+            cut.append(time.monotonic())
+            time.sleep(3.0)  # lost by then, and go (2 s) over on the agent
+            through.restore()
 
-    cutter = threading.Thread(target=partition, daemon=True)
-    cutter.start()
-    result, failed_at = session_run(net, tmp_path, lambda event: None)
-    cutter.join(timeout=10)
-    assert cut, "go never reached the agent"
+        cutter = threading.Thread(target=partition, daemon=True)
+        cutter.start()
+        result, failed_at = session_run(net, tmp_path, lambda event: None)
+        cutter.join(timeout=10)
+        assert cut, "go never reached the agent"
     assert result.reason == "final" and result.tokens["o"] == ["retried"]
     assert failed_at - cut[0] < 1.0 + 1.0
     events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]

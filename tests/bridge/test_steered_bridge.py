@@ -24,25 +24,26 @@ def test_a_pause_stops_dispatching_while_the_remote_action_running_ends(middlewa
     before it dispatches anything, then dispatches the rest."""
     pytest.importorskip("websockets")
     kind, server = middleware
-    agent = serve(kind, server.connect, ["robot1"], heartbeat=0.1, log_file=open(tmp_path / "agent.log", "w"))
-    folder = tmp_path / "run"
-    folder.mkdir()
-    net = write(folder, kind, server.connect, net=SLOW_FIRST, heartbeat=0.1, heartbeat_timeout=5)
-    run = LiveRun(folder, net=net.read_text())
-    try:
-        deadline = time.monotonic() + 60
-        while agent.server.executed < 1:  # ``s0`` was sent and runs on the agent
-            assert time.monotonic() < deadline, "the first goal never reached the agent"
-            time.sleep(0.02)
-        assert ctl(capsys, run.url, "pause")[0] == 0
-        time.sleep(2.5)  # ``s0`` (1 s) ends on the agent meanwhile
-        assert agent.server.executed == 1 and not agent.server.running
-        assert "paused" in ctl(capsys, run.url, "status")[1]
-        assert ctl(capsys, run.url, "resume")[0] == 0
-        run.finish()
-        assert run.process.returncode == 0
-    finally:
-        run.stop()
+    with open(tmp_path / "agent.log", "w") as log:
+        agent = serve(kind, server.connect, ["robot1"], heartbeat=0.1, log_file=log)
+        folder = tmp_path / "run"
+        folder.mkdir()
+        net = write(folder, kind, server.connect, net=SLOW_FIRST, heartbeat=0.1, heartbeat_timeout=5)
+        run = LiveRun(folder, net=net.read_text())
+        try:
+            deadline = time.monotonic() + 60
+            while agent.server.executed < 1:  # ``s0`` was sent and runs on the agent
+                assert time.monotonic() < deadline, "the first goal never reached the agent"
+                time.sleep(0.02)
+            assert ctl(capsys, run.url, "pause")[0] == 0
+            time.sleep(2.5)  # ``s0`` (1 s) ends on the agent meanwhile
+            assert agent.server.executed == 1 and not agent.server.running
+            assert "paused" in ctl(capsys, run.url, "status")[1]
+            assert ctl(capsys, run.url, "resume")[0] == 0
+            run.finish()
+            assert run.process.returncode == 0
+        finally:
+            run.stop()
     events = [json.loads(line) for line in run.trace.read_text().splitlines()]
     controls = [i for i, e in enumerate(events) if e["kind"] == "control"]
     assert [events[i]["data"]["action"] for i in controls] == ["pause", "resume"]
