@@ -101,7 +101,7 @@ def test_the_readme_action_of_ones_own_runs_from_the_command_line(tmp_path):
 def test_every_net_readme_shows_loads():
     """Each YAML block of README.md that is a net (``petriflow: 1``) reads as one."""
     nets = [block for block in blocks(REPO / "README.md", "yaml") if "\npetriflow: 1\n" in "\n" + block]
-    assert len(nets) >= 2
+    assert nets  # the README shows at least one net
     for block in nets:
         assert loads_net(block).transitions
 
