@@ -11,6 +11,7 @@ import os
 import shutil
 import socket
 import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -83,6 +84,88 @@ class Router:
             self.session = None
 
 
+class Link:
+    """A TCP proxy on a free loopback port to ``port`` that the test can cut and restore: a
+    network partition between one client and the broker or router, with nobody killed.
+
+    Cut, it closes its listener and every connection through it (the client's reconnects
+    are refused); restored, it listens on the same port again.
+    """
+
+    def __init__(self, port: int) -> None:
+        self.target, self.port = port, free_port()
+        self.lock = threading.Lock()
+        self.sockets: list[socket.socket] = []
+        self.listener: socket.socket | None = None
+        self.threads: list[threading.Thread] = []
+        self.restore()
+
+    @property
+    def connect(self) -> str:
+        return f"tcp/127.0.0.1:{self.port}"
+
+    def restore(self) -> None:
+        listener = socket.socket()
+        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        listener.bind(("127.0.0.1", self.port))
+        listener.listen()
+        self.listener = listener
+        self._thread(self._accept, listener)
+
+    def cut(self) -> None:
+        with self.lock:
+            doomed, self.sockets = [self.listener, *self.sockets], []
+            self.listener = None
+        for sock in doomed:
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+            sock.close()
+
+    def stop(self) -> None:
+        self.cut()
+        for thread in self.threads:
+            thread.join(timeout=10)
+        assert not any(thread.is_alive() for thread in self.threads)
+
+    def _thread(self, target, *args) -> None:
+        thread = threading.Thread(target=target, args=args, daemon=True)
+        self.threads.append(thread)
+        thread.start()
+
+    def _accept(self, listener: socket.socket) -> None:
+        while True:
+            try:
+                client, _ = listener.accept()
+            except OSError:  # cut
+                return
+            server = socket.create_connection(("127.0.0.1", self.target))
+            for sock in (client, server):
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            with self.lock:
+                if self.listener is not listener:  # cut meanwhile
+                    client.close()
+                    server.close()
+                    return
+                self.sockets += [client, server]
+            self._thread(self._pipe, client, server)
+            self._thread(self._pipe, server, client)
+
+    @staticmethod
+    def _pipe(source: socket.socket, sink: socket.socket) -> None:
+        try:
+            while data := source.recv(65536):
+                sink.sendall(data)
+        except OSError:
+            pass
+        for sock in (source, sink):
+            try:
+                sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+
+
 def children() -> set[int]:
     """The live processes whose parent is this one (from /proc; zombies count as gone)."""
     found = set()
@@ -128,13 +211,52 @@ def router():
 @pytest.fixture(params=["mqtt", "zenoh"])
 def middleware(request, tmp_path):
     """``(transport name, the broker or router)`` for each transport."""
-    if request.param == "mqtt":
-        pytest.importorskip("paho.mqtt")
-        made = Broker(tmp_path)
-    else:
-        made = Router()
+    made = start_middleware(request.param, tmp_path)
     yield request.param, made
     made.stop()
+
+
+def start_middleware(kind: str, folder: Path) -> Broker | Router:
+    """A broker (``mqtt``) or a router (``zenoh``) on loopback; the caller stops it."""
+    if kind == "mqtt":
+        pytest.importorskip("paho.mqtt")
+        return Broker(folder)
+    return Router()
+
+
+#: Set in the test process started inside a network namespace of its own (:func:`own_network`).
+INSIDE = "PETRIFLOW_TEST_OWN_NETWORK"
+
+
+def own_network(request) -> bool:
+    """Run the calling test again in a network namespace of its own (``unshare -n``, loopback
+    up, everything it starts inside it) when this machine permits one; ``True`` when it did
+    (and passed there), so the caller returns; ``False`` inside it, or where no namespace is
+    permitted (the test then runs here, on the shared loopback)."""
+    if os.environ.get(INSIDE) or shutil.which("unshare") is None or shutil.which("ip") is None:
+        return False
+    if subprocess.run(["unshare", "-n", "ip", "link", "set", "lo", "up"], capture_output=True, check=False).returncode != 0:
+        return False
+    root = Path(__file__).resolve().parents[2]
+    inner = subprocess.run(["unshare", "-n", "sh", "-c", 'ip link set lo up && exec "$0" "$@"', sys.executable,
+                            "-m", "pytest", "-q", "-p", "no:randomly", "-m", "slow", request.node.nodeid],
+                           cwd=root, env={**os.environ, INSIDE: "1"}, capture_output=True, text=True, timeout=300, check=False)
+    assert inner.returncode == 0, inner.stdout[-3000:] + inner.stderr[-2000:]
+    return True
+
+
+@pytest.fixture
+def link():
+    """``link(port)``: a :class:`Link` to ``port``, stopped after the test."""
+    made: list[Link] = []
+
+    def start(port: int) -> Link:
+        made.append(Link(port))
+        return made[-1]
+
+    yield start
+    for each in made:
+        each.stop()
 
 
 class ServedAgent:
