@@ -36,10 +36,10 @@ from typing import Any
 
 from petriflow.agents.slam.corridors import SLAM
 
-from petriflow.capabilities import Described, Positions, provides
+from petriflow.capabilities import Positions, provides
 from petriflow.runtime.channels import ChannelModel, Message
 from petriflow.runtime.radio import LogDistance, fade_loss, power_for_range
-from petriflow.runtime.settings import read_settings
+from petriflow.runtime.settings import world_section
 
 __all__ = ["CENTRAL", "ESP8266", "Esp8266Link", "TX_AT_1M"]
 
@@ -87,9 +87,7 @@ class ESP8266(Esp8266Link, ChannelModel):
         its ``meta.slam`` (:data:`~petriflow.agents.slam.corridors.SLAM`, checked)."""
         self.world = world
         self._placed = world if provides(world, Positions) else None
-        if provides(world, Described):
-            slam = read_settings(world.meta, {SLAM.name: SLAM}, path=world.path)[SLAM.name]
-            self._nodes = [tuple(point) for point in slam["nodes"]]
+        self._nodes = [tuple(point) for point in world_section(world, SLAM)["nodes"]]
 
     # The link budget ----------------------------------------------------------------
     def rssi(self, distance: float) -> float:

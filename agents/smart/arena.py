@@ -49,7 +49,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from petriflow.capabilities import Bodies, Described, Physics, provides
-from petriflow.runtime.settings import Section, Setting, read_settings
+from petriflow.runtime.settings import Section, Setting, world_section
 
 __all__ = ["SMART", "Arena", "arena_resource", "arena_settings", "colour_robots", "dress", "hat_offset", "load_arena",
            "robot_colours", "unrendered_ground"]
@@ -83,7 +83,7 @@ class Arena:
 def arena_settings(world: Described) -> dict[str, Any]:
     """The world's ``meta.smart`` (:data:`SMART`) read and checked, defaults filled in:
     what a run gives its actions as ``ctx.settings`` (errors at the world file's line)."""
-    return read_settings(world.meta, {SMART.name: SMART}, path=world.path)[SMART.name]
+    return world_section(world, SMART)
 
 
 def robot_colours(world: Described, settings: Mapping[str, Any] | None = None) -> dict[str, str]:

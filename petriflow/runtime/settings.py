@@ -40,11 +40,12 @@ import copy
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping
 
+from petriflow.capabilities import Described, provides
 from petriflow.errors import NetFormatError, did_you_mean
 from petriflow.runtime.action import REQUIRED, Param
 from petriflow.runtime.config import plain_data
 
-__all__ = ["Setting", "Section", "read_settings", "sections_of"]
+__all__ = ["Setting", "Section", "read_settings", "sections_of", "world_section"]
 
 
 @dataclass(frozen=True)
@@ -162,3 +163,17 @@ def read_settings(meta: Any, sections: Mapping[str, Section], *, path: str | Non
     lines = getattr(meta, "key_lines", {})
     return {name: section.read(meta.get(name), path=path, line=lines.get(name, getattr(meta, "line", None) or line))
             for name, section in sections.items()}
+
+
+def world_section(world: Any, section: Section) -> dict[str, Any]:
+    """The declared ``section`` of ``world``'s settings, checked, defaults filled in: for
+    code that holds a world but no action context (a channel model bound to the world, a
+    metric, a drawing); an action reads ``ctx.settings``. A world without a world file
+    (not :class:`~petriflow.capabilities.Described`) gives the defaults.
+
+    Raises:
+        NetFormatError: the world file's settings do not check (``file:line``).
+    """
+    if not provides(world, Described):
+        return section.read(None)
+    return read_settings(world.meta, {section.name: section}, path=world.path)[section.name]
