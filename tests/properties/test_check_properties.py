@@ -154,3 +154,13 @@ def test_deadlock_reachability_beyond_the_budget_by_stubborn_sets():
     assert (got["stuck"]["verdict"], got["free"]["verdict"]) == (False, True)
     assert got["stuck"]["method"].startswith("stubborn sets")
     assert got["other"]["verdict"] is True       # found before the limit
+
+
+def test_an_empty_place_bound_is_zero():
+    """The contest writes ``<place-bound/>`` with no place (Sudoku-PT-AN01): the empty sum, 0."""
+    from petriflow.properties.mcc_xml import parse_mcc_properties
+
+    text = ('<property-set xmlns="http://mcc.lip6.fr/"><property><id>N-UpperBounds-00</id>'
+            '<formula><place-bound/></formula></property></property-set>')
+    result = check_properties(loads_net(PASSAGE), parse_mcc_properties(text, "UpperBounds.xml"))[0]
+    assert (result["verdict"], result["witness"]) == (0, [])
