@@ -11,7 +11,9 @@ and decides every property on it:
   the witness reaches a marking with the bound; with ``at_most`` the verdict is whether
   the bound stays within it;
 * **ctl**: fixpoints (:mod:`~petriflow.properties.ctl`);
-* **ltl**: Spot's Büchi automaton times the graph (:mod:`~petriflow.properties.ltl`).
+* **ltl**: Spot's Büchi automaton times the graph (:mod:`~petriflow.properties.ltl`);
+* **boolean** (``A G F p && A F q``): each quantified operand by its own checker, the
+  verdicts combined (no evidence: each operand's is its own property's).
 
 Each result is ``{"id", "formula", "kind", "verdict", "method", "witness"}`` and, for a
 lasso, ``"cycle"`` (the firings repeated forever; empty: the last marking is a deadlock,
@@ -51,7 +53,7 @@ from petriflow.properties.ctl import ctl_witness, evaluate
 from petriflow.properties.kripke import Kripke
 from petriflow.analysis.stubborn import stubborn_deadlocks
 from petriflow.properties.language import (
-    AllPaths, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Property, names_used
+    AllPaths, And, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Or, Property, names_used
 )
 from petriflow.properties.ltl import check_ltl
 from petriflow.properties.yaml_props import check_property_names
@@ -105,6 +107,10 @@ def check_properties(net: Net, properties: Sequence[Property], *,
                 _partial_reachability(entry, prop, partial)
             if entry["verdict"] is None and prop.kind == "reachability":
                 _deadlock_by_stubborn_sets(entry, prop, net, start, max_states)
+        elif prop.kind == "boolean":
+            verdict = _boolean(prop.formula, kripke, cache)
+            entry.update(verdict=verdict, method="Boolean combination: each quantified formula decided"
+                         " on the reachability graph (LTL: Spot Büchi automaton; CTL: fixpoints)")
         else:
             _decide(entry, prop, kripke, cache)
         if entry["verdict"] is None and "reason" not in entry:
@@ -170,6 +176,26 @@ def _decide(entry: dict, prop: Property, kripke: Kripke, cache: dict) -> None:
     evidence = ctl_witness(kripke, formula, verdict, cache)
     if evidence is not None:
         entry.update(evidence)
+
+
+def _boolean(formula, kripke: Kripke, cache: dict) -> bool | None:
+    """A Boolean combination of quantified formulas at the initial marking: each operand
+    decided by its own checker, combined (``None``: some operand that matters undecided)."""
+    if isinstance(formula, Not):
+        value = _boolean(formula.operand, kripke, cache)
+        return None if value is None else not value
+    if isinstance(formula, (And, Or)):
+        decisive = isinstance(formula, Or)          # the value that settles the whole
+        values = [_boolean(f, kripke, cache) for f in formula.operands]
+        if decisive in values:
+            return decisive
+        return None if None in values else not decisive
+    sub = Property(id="", formula=formula)
+    if sub.kind == "ctl*":
+        return None
+    entry: dict[str, Any] = {"verdict": None}
+    _decide(entry, sub, kripke, cache)
+    return entry["verdict"]
 
 
 def _partial_reachability(entry: dict, prop: Property, partial: StateSpace) -> None:

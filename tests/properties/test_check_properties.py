@@ -164,3 +164,18 @@ def test_an_empty_place_bound_is_zero():
             '<formula><place-bound/></formula></property></property-set>')
     result = check_properties(loads_net(PASSAGE), parse_mcc_properties(text, "UpperBounds.xml"))[0]
     assert (result["verdict"], result["witness"]) == (0, [])
+
+
+def test_ltl_formulas_under_boolean_connectives_are_decided_one_by_one():
+    """`A G F p || A F q`: each quantified LTL (or CTL) operand decided, the verdicts combined."""
+    net = loads_net(PASSAGE)
+    got = decide(net, {"id": "either", "ltl": "A(G(F(red_in >= 1))) || A(F(blue_in == 1))"},
+                 {"id": "both", "ltl": "E(G(F(red_in >= 1))) && A(G(red_in + blue_in <= 1))"},
+                 {"id": "not", "ltl": "!E(F(G(blue_in == 1)))"},
+                 {"id": "alone", "ltl": "G(F(red_in >= 1))"})
+    assert got["alone"]["verdict"] is False        # blue may take the passage forever
+    assert (got["either"]["kind"], got["either"]["verdict"]) == ("boolean", False)
+    assert got["both"]["verdict"] is True
+    assert got["not"]["verdict"] is True
+    with pytest.raises(NetFormatError, match="quantifiers"):
+        parse_property({"id": "nested", "ltl": "G(A(F(red_in >= 1)))"})
