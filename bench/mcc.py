@@ -5,8 +5,8 @@ the seven property files ``ReachabilityCardinality.xml`` ... ``LTLFireability.xm
 each of the seven categories is decided by
 :func:`petriflow.properties.check.check_properties` in a fresh forked process with a
 budget of ``--budget`` CPU seconds (default 60: the contest's 16 formulas of one
-category together; ``RLIMIT_CPU`` stops the process, and a wall-clock limit of three
-times the budget guards a machine too loaded to give it that CPU). A process stopped by
+category together; ``RLIMIT_CPU`` stops the process, and a wall-clock limit, ``--wall``,
+default ten times the budget, guards a machine too loaded to give it that CPU). A process stopped by
 the budget leaves its 16 properties undecided. Each verdict is compared with the
 contest's consensus in ``--oracle`` (the files ``<model>-<RC|RF|UB|CTLC|CTLF|LTLC|LTLF>.out``
 of the MCC 2021 ``oracle.tar.gz``, lines ``FORMULA <id> <TRUE|FALSE|integer> ...``):
@@ -92,8 +92,9 @@ def _category_child(model_dir: str, category: str, budget: float, pipe) -> None:
                "methods": {r["id"]: r.get("method") or r.get("reason") for r in results}})
 
 
-def run_category(model_dir: Path, category: str, budget: float) -> dict[str, Any]:
-    """Decide one category of one model in a fresh process within ``budget`` CPU s."""
+def run_category(model_dir: Path, category: str, budget: float, wall: float) -> dict[str, Any]:
+    """Decide one category of one model in a fresh process within ``budget`` CPU s
+    (and ``wall`` seconds)."""
     context = multiprocessing.get_context("fork")
     receive, send = context.Pipe(duplex=False)
     child = context.Process(target=_category_child, args=(str(model_dir), category, budget, send))
@@ -101,7 +102,7 @@ def run_category(model_dir: Path, category: str, budget: float) -> dict[str, Any
     child.start()
     send.close()
     try:
-        row = receive.recv() if receive.poll(3 * budget) else {"stopped": "wall clock"}
+        row = receive.recv() if receive.poll(wall) else {"stopped": "wall clock"}
     except EOFError:                         # killed by RLIMIT_CPU (SIGXCPU) or an error
         row = {"stopped": "budget"}
     child.kill()
@@ -173,6 +174,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--models", required=True, type=Path, help="folder of model folders")
     parser.add_argument("--oracle", required=True, type=Path, help="folder of <model>-<cat>.out files")
     parser.add_argument("--budget", type=float, default=60.0, help="CPU seconds per model and category")
+    parser.add_argument("--wall", type=float, help="wall-clock seconds per category (default 10 x budget)")
     parser.add_argument("--only", help="comma-separated categories (default: all seven)")
     parser.add_argument("--json", metavar="OUT", help="also write the rows as JSON")
     parser.add_argument("--sample", type=int, help="pick and extract N models first (needs --inputs)")
@@ -199,7 +201,7 @@ def main(argv: list[str] | None = None) -> int:
         per_model = {"right": 0, "wrong": 0, "undecided": 0, "no_oracle": 0}
         for category in categories:
             expected = oracle_verdicts(args.oracle, model_dir.name, category)
-            row = run_category(model_dir, category, args.budget)
+            row = run_category(model_dir, category, args.budget, args.wall or 10 * args.budget)
             counts = score(row, expected)
             row.update(model=model_dir.name, category=category, **counts)
             rows.append(row)
