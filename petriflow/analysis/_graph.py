@@ -364,8 +364,10 @@ def reachable(offsets: np.ndarray, neighbours: np.ndarray, starts, *,
         raise ValueError(f"start nodes must be 0 .. {n - 1}")
     loops = _compiled(max(len(neighbours), n)) if compiled else None
     if loops is not None:
-        loops["bfs"](offsets, neighbours, starts, seen, np.empty(n, dtype=_node_dtype(n)))
-        return seen
+        parent = np.full(n, -2, dtype=np.int64)      # the search of shortest_path, no goal
+        loops["parents"](offsets, neighbours, starts, seen, np.ones(n, dtype=bool), parent,
+                         np.empty(n, dtype=np.int64))
+        return parent != -2
     offsets_list, neighbours_list = offsets.tolist(), neighbours.tolist()
     seen_list = [False] * n
     queue = [int(s) for s in starts]
@@ -445,26 +447,6 @@ def _parents_loop(offsets, neighbours, starts, goal, allowed, parent, queue):
                 queue[tail] = nxt
                 tail += 1
     return -1
-
-
-def _bfs_loop(offsets, neighbours, starts, seen, queue):
-    """Breadth-first search from ``starts`` (distinct): mark in ``seen`` what it reaches;
-    ``queue`` is scratch space of n entries."""
-    tail = 0
-    for s in starts:
-        seen[s] = True
-        queue[tail] = s
-        tail += 1
-    head = 0
-    while head < tail:
-        node = queue[head]
-        head += 1
-        for edge in range(offsets[node], offsets[node + 1]):
-            nxt = neighbours[edge]
-            if not seen[nxt]:
-                seen[nxt] = True
-                queue[tail] = nxt
-                tail += 1
 
 
 def can_reach(n: int, source, target, goals, *, compiled: bool = True) -> np.ndarray:
@@ -637,7 +619,6 @@ _LOOP_FUNCTIONS = {
     "offsets": _offsets_loop,
     "scatter": _scatter_loop,
     "pearce": _pearce_loop,
-    "bfs": _bfs_loop,
     "parents": _parents_loop,
     "transpose": _transpose_loop,
     "exits": _exits_loop,

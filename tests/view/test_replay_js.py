@@ -141,6 +141,7 @@ def test_a_monitored_violation_is_marked_on_the_page(tmp_path):
     """`run --monitor` records a violation as a `custom` event: the page marks it red and
     its events panel names the property and the event that broke it."""
     from petriflow.cli import main
+    from tests.properties.test_monitor import RACE
 
     net = tmp_path / "race.yaml"
     net.write_text(RACE)
@@ -154,14 +155,3 @@ def test_a_monitored_violation_is_marked_on_the_page(tmp_path):
     assert marked[0]["violation"] == f"VIOLATED property exclusive at event {violated_at[0]} (blue_enter)"
     assert not any(e["bad"] for e in events if not e["violation"])
 
-
-RACE = """
-petriflow: 1
-net: race
-places: [{id: red, tokens: 1}, {id: blue, tokens: 1}, red_in, blue_in]
-transitions:
-  - {id: red_enter, action: core.wait, params: {seconds: 2}, in: [red], out: [red_in]}
-  - {id: blue_enter, action: core.wait, params: {seconds: 3}, in: [blue], out: [blue_in]}
-properties:
-  - {id: exclusive, never: "red_in + blue_in >= 2"}
-"""
