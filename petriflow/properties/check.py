@@ -86,6 +86,7 @@ def check_properties(net: Net, properties: Sequence[Property], *,
         partial = _explored_part(net, start, min(max_states, UNBOUNDED_STATES))
     kripke = Kripke(space) if space is not None else None
     cache: dict = {}
+    quotient: dict = {}            # the symmetry quotient, explored once when needed
     semiflows: list | None = None
     results = []
     for prop in properties:
@@ -107,6 +108,9 @@ def check_properties(net: Net, properties: Sequence[Property], *,
                 _partial_reachability(entry, prop, partial)
             if entry["verdict"] is None and prop.kind == "reachability":
                 _deadlock_by_stubborn_sets(entry, prop, net, start, max_states)
+            if entry["verdict"] is None and prop.kind == "reachability" and space is None \
+                    and reason is not None and reason.startswith("state space over budget"):
+                _by_symmetry(entry, prop, net, start, max_states, quotient)
         elif prop.kind == "boolean":
             verdict = _boolean(prop.formula, kripke, cache)
             entry.update(verdict=verdict, method="Boolean combination: each quantified formula decided"
@@ -226,6 +230,37 @@ def _deadlock_by_stubborn_sets(entry: dict, prop: Property, net: Net, start, max
         return
     entry.update(verdict=found.deadlock != bool(universal), witness=found.witness,
                  method="stubborn sets (every reachable deadlock preserved)")
+
+
+def _by_symmetry(entry: dict, prop: Property, net: Net, start, max_states: int, quotient: dict) -> None:
+    """``AG p`` / ``EF p`` with ``p`` invariant under the agents' permutations, on the
+    quotient (:mod:`~petriflow.properties.symmetric`) when the full space is over budget."""
+    from petriflow.analysis.symmetry import SymmetryUnsupported, find_symmetries, symmetric_graph
+    from petriflow.properties.symmetric import holds_on_quotient, symmetric
+
+    universal, predicate = _reachability_shape(prop.formula)
+    if universal is None:
+        return
+    if "groups" not in quotient:
+        quotient["groups"] = find_symmetries(net)
+    groups = quotient["groups"]
+    if not groups or not symmetric(predicate, groups, net):
+        return
+    if "space" not in quotient:
+        try:
+            quotient["space"] = symmetric_graph(net, start, groups=groups, max_states=max_states)
+        except (StateSpaceLimit, SymmetryUnsupported):
+            quotient["space"] = None
+    space = quotient["space"]
+    if space is None:
+        return
+    holds = holds_on_quotient(space, predicate)
+    bad = np.flatnonzero(~holds if universal else holds)
+    entry.update(verdict=(not bad.size) if universal else bool(bad.size),
+                 method=f"symmetry quotient ({space.num_states} canonical markings; the predicate"
+                        " is invariant under the agents' permutations)")
+    if bad.size:
+        entry["witness"] = space.path(int(bad[0]))
 
 
 def _bound(entry: dict, prop: Property, space: StateSpace | None, proved: int | None,

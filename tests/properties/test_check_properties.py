@@ -179,3 +179,33 @@ def test_ltl_formulas_under_boolean_connectives_are_decided_one_by_one():
     assert got["not"]["verdict"] is True
     with pytest.raises(NetFormatError, match="quantifiers"):
         parse_property({"id": "nested", "ltl": "G(A(F(red_in >= 1)))"})
+
+
+TEAM = """
+petriflow: 1
+subnets:
+""" + "".join(f"""- {{id: a{k}, state: worker, places: [{{id: a{k}_idle, tokens: 1}}, a{k}_busy], transitions: [
+    {{id: a{k}_go, in: [a{k}_idle, lock], out: [a{k}_busy]}},
+    {{id: a{k}_back, in: [a{k}_busy], out: [a{k}_idle, lock]}}]}}
+""" for k in (1, 2, 3)) + """places: [{id: lock, tokens: 1}]
+"""
+
+
+def test_a_symmetric_safety_property_beyond_the_budget_is_decided_on_the_quotient():
+    """Three interchangeable workers, a budget of 2 markings (the full space has 4, the
+    quotient 2): a predicate every permutation keeps is decided; one naming a worker is not."""
+    net = loads_net(TEAM)
+    got = decide(net, {"id": "mutex", "never": "a1_busy + a2_busy + a3_busy >= 2"},
+                 {"id": "pairs", "always": "a1_busy + a2_busy <= 1 && a2_busy + a3_busy <= 1 && a1_busy + a3_busy <= 1"},
+                 {"id": "first", "always": "a1_busy <= 1"}, max_states=2)
+    assert got["mutex"]["verdict"] is True and "symmetry" in got["mutex"]["method"]
+    assert got["pairs"]["verdict"] is True
+    assert got["first"]["verdict"] is None
+
+
+def test_a_symmetric_violation_on_the_quotient_has_a_concrete_witness():
+    net = loads_net(TEAM.replace("{id: lock, tokens: 1}", "{id: lock, tokens: 2}"))
+    got = decide(net, {"id": "mutex", "never": "a1_busy + a2_busy + a3_busy >= 2"}, max_states=4)
+    assert got["mutex"]["verdict"] is False
+    end = fire_sequence(net, net.initial_marking, got["mutex"]["witness"])
+    assert sum(end.get(f"a{k}_busy", 0) for k in (1, 2, 3)) >= 2
