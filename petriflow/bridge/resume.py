@@ -99,6 +99,16 @@ class ReplayingRemote:
         if goal_id not in self.replayed:
             self.dispatcher.forget(goal_id)
 
+    def take_calls(self, goal_id: str) -> list[protocol.Call]:
+        return [] if goal_id in self.replayed else self.dispatcher.take_calls(goal_id)
+
+    def reply(self, reply: protocol.Reply) -> None:
+        self.dispatcher.reply(reply)
+
+    def refuse_calls(self, goal_id: str, why: str) -> None:
+        if goal_id not in self.replayed:
+            self.dispatcher.refuse_calls(goal_id, why)
+
     def is_lost(self, agent: str) -> bool:
         return agent in self.lost if self.replaying else self.dispatcher.is_lost(agent)
 
