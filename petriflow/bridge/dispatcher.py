@@ -80,6 +80,8 @@ class GoalState:
     calls: list[protocol.Call] = field(default_factory=list)
     #: The replies sent, by call number (a call sent again is answered the same).
     replies: dict[int, protocol.Reply] = field(default_factory=dict)
+    #: How many of the action's calls the run answered (recorded with the goal's end).
+    answered_calls: int = 0
     #: On resume, the simulated time the journal shows it ended at (its ending is taken
     #: then, as journaled: :mod:`petriflow.bridge.resume`); ``None``: a live goal.
     at: float | None = None
@@ -223,6 +225,8 @@ class Dispatcher:
         with self._lock:
             state = self.goals.get(reply.id)
             if state is not None:
+                if reply.call not in state.replies:
+                    state.answered_calls += 1
                 state.replies[reply.call] = reply
         self.transport.publish(to_agent(reply.agent), protocol.encode(reply))
 

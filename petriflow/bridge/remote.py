@@ -141,7 +141,7 @@ class RemoteAction(Action):
         """Which agent executed the firing, and the goal's round trip (a custom event)."""
         trip = state.round_trip
         ctx.emit("remote", agent=self.remote_agent, goal=state.goal.id, phase=state.phase, resent=state.resent,
-                 round_trip_ms=None if trip is None else round(trip * 1e3, 3))
+                 round_trip_ms=None if trip is None else round(trip * 1e3, 3), calls=state.answered_calls)
 
 
 def remote_transitions(net: Net, spec: BridgeSpec) -> dict[str, str]:

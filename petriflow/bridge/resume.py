@@ -63,6 +63,7 @@ class Replay:
         state = GoalState(goal, phase=phase, sent=0.0,
                           answered=None if trip is None else trip / 1e3, resent=record.get("resent", 0),
                           data=end.data.get("result"), reason=end.data.get("reason", ""))
+        state.answered_calls = record.get("calls", 0)
         state.at = end.time
         return state
 
