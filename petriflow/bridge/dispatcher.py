@@ -36,6 +36,8 @@ __all__ = ["Dispatcher", "GoalState", "AgentSeen", "Phase"]
 log = logging.getLogger("petriflow.bridge")
 #: Drops logged per reason (the rest are only counted).
 LOGGED_DROPS = 5
+#: Replies kept per goal to answer a call sent again (the latest ones).
+KEPT_REPLIES = 64
 
 
 class Phase:
@@ -228,6 +230,8 @@ class Dispatcher:
                 if reply.call not in state.replies:
                     state.answered_calls += 1
                 state.replies[reply.call] = reply
+                if len(state.replies) > KEPT_REPLIES:  # a call that old is not sent again
+                    del state.replies[min(state.replies)]
         self.transport.publish(to_agent(reply.agent), protocol.encode(reply))
 
     def _restarted(self, seen: AgentSeen, now: float) -> None:
