@@ -74,6 +74,8 @@ def test_smart_helping_over_each_transport_matches_the_simulated_order(middlewar
     assert {t: r["agent"] for t, r in remote.items()} == {"T7": "robot3l", "T8": "robot3l", "T6": "robot4l"}
     assert all(r["phase"] == "ok" for r in remote.values())
     assert remote["T8"]["calls"] > 0  # the walk read the scene through its port, answered by the run
+    walked = next(e["data"]["result"] for e in events if e["kind"] == "end" and e["transition"] == "T8")
+    assert walked["checks"] and all(c["decision"] == "on_track" for c in walked["checks"])  # tracked on them
     executed = [json.loads(line) for line in (tmp_path / "agent.log").read_text().splitlines()]
     assert sorted(e["transition"] for e in executed) == ["T6", "T7", "T8"]
     assert len({e["goal"] for e in executed}) == 3
