@@ -1,6 +1,8 @@
-"""Run services over the bridge: a remote action's calls, answered by the run (no network:
-an in-process hub carries the messages between a real agent server and a dispatcher)."""
+"""Run services over the bridge: a remote action's calls, answered by the run (mostly with no
+network: an in-process hub carries the messages between a real agent server and a
+dispatcher; the last test runs a net over a real broker or router)."""
 
+import json
 import threading
 import time
 
@@ -15,6 +17,7 @@ from petriflow.bridge.spec import BridgeSpec
 from petriflow.bridge.transport import from_agent, to_agent
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.services import RunServices
+from petriflow.runtime.session import run_files
 
 
 class Hub:
@@ -248,3 +251,42 @@ def test_calls_are_messages_of_the_protocol():
     assert protocol.decode(protocol.encode(reply)) == reply
     with pytest.raises(protocol.Refused, match="call numbers a goal's calls from 1"):
         protocol.decode(b'{"v":1,"type":"call","id":"g","agent":"a","call":0,"service":"s","method":"m"}')
+
+
+PORT_NET = """\
+petriflow: 1
+net: board
+subnets:
+  - id: r1
+    agent: r1
+    places: [go]
+    transitions:
+      - {id: peek, action: demo.peek, params: {scene: board}, in: [go], out: [o]}
+  - id: here
+    agent: blue
+    places: [{id: a, tokens: 1}]
+    transitions:
+      - {id: post, action: core.set, params: {value: {robots: {yellow: {x: 0.25}}}}, in: [a], out: [board, go]}
+places: [board, o]
+final: {o: 1, board: 1}
+"""
+
+
+def test_a_bridged_run_reads_the_same_port_values_as_the_simulated_run(middleware, serve, tmp_path):
+    """Over a real broker or router: the remote action's port read and liveness question are
+    answered by the run, and give what the simulated run's local action read."""
+    kind, server = middleware
+    registry = demo_registry()
+    agent = serve(kind, server.connect, ["robot1"], heartbeat=0.1, registry=registry)
+    (tmp_path / "net.yaml").write_text(PORT_NET)
+    simulated = run_files(tmp_path / "net.yaml", registry=registry)
+    spec = {"transport": kind, "connect": server.connect, "agents": {"r1": "robot1"}, "wait": 10}
+    (tmp_path / "run.yaml").write_text(f"seed: 1\nbridge: {json.dumps(spec)}\n")
+    bridged = run_files(tmp_path / "net.yaml", registry=registry, trace=tmp_path / "t.jsonl")
+    assert simulated.reason == bridged.reason == "final"
+    assert bridged.tokens["o"] == simulated.tokens["o"] == [
+        {"latest": {"robots": {"yellow": {"x": 0.25}}}, "blue": True, "red": True}]
+    remote = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+    remote = [e["data"]["data"] for e in remote if e["kind"] == "custom" and e["data"]["name"] == "remote"]
+    assert [(r["agent"], r["calls"]) for r in remote] == [("robot1", 3)]
+    assert agent.server.executed == 1
