@@ -17,17 +17,11 @@ Examples:
     >>> from petriflow.io.yaml import loads_net
     >>> from petriflow.analysis.symmetry import find_symmetries
     >>> from petriflow.properties.yaml_props import parse_formula
-    >>> net = loads_net('''
-    ... petriflow: 1
-    ... subnets:
-    ... - {id: a1, state: worker, places: [{id: a1_idle, tokens: 1}, a1_busy], transitions: [
-    ...     {id: a1_go, in: [a1_idle, lock], out: [a1_busy]},
-    ...     {id: a1_back, in: [a1_busy], out: [a1_idle, lock]}]}
-    ... - {id: a2, state: worker, places: [{id: a2_idle, tokens: 1}, a2_busy], transitions: [
-    ...     {id: a2_go, in: [a2_idle, lock], out: [a2_busy]},
-    ...     {id: a2_back, in: [a2_busy], out: [a2_idle, lock]}]}
-    ... places: [{id: lock, tokens: 1}]
-    ... ''')
+    >>> worker = ("- {{id: a{k}, state: worker, places: [{{id: a{k}_idle, tokens: 1}}, a{k}_busy], transitions: ["
+    ...           "{{id: a{k}_go, in: [a{k}_idle, lock], out: [a{k}_busy]}},"
+    ...           " {{id: a{k}_back, in: [a{k}_busy], out: [a{k}_idle, lock]}}]}}\\n")
+    >>> net = loads_net("petriflow: 1\\nplaces: [{id: lock, tokens: 1}]\\nsubnets:\\n"
+    ...                 + worker.format(k=1) + worker.format(k=2))
     >>> groups = find_symmetries(net)
     >>> symmetric(parse_formula("a1_busy + a2_busy <= 1"), groups, net), symmetric(
     ...     parse_formula("a1_busy <= 0"), groups, net)
