@@ -63,6 +63,8 @@ class Table:
     planned: int = 0  # the trials the file's own seeds give (a default run)
     failed: int = 0
     wall: float = 0.0
+    cpu: float = 0.0  # CPU seconds of the trials' processes (the cost whatever else the machine runs)
+    timed: int = 0  # the trials whose CPU seconds are known
     db: Path | None = None
     page: Path | None = None
 
@@ -174,6 +176,8 @@ def reproduce(root: str | Path, out: str | Path, *, quick: bool = False, only: l
             table.wall = wallclock.perf_counter() - begun
             table.rows, table.names, table.parameters = result.rows, result.names, sweep.parameters
             table.trials, table.failed = len(result.trials), len(result.failures)
+            costs = [t["cpu"] for t in result.trials if t.get("cpu") is not None]
+            table.cpu, table.timed = sum(costs), len(costs)
             if pages:
                 from petriflow.view import view
 
@@ -254,6 +258,8 @@ def markdown(outcome: Outcome, root: str | Path, *, commit: str | None = None, c
             where = _relative(table.path, base)
             page = f"; page: `{_relative(table.page, base)}`" if table.page else ""
             ran = f"{table.trials} trials, {table.failed} failed, {table.wall:.0f} s wall" if table.db else "not run"
+            if table.timed:
+                ran += f", {table.cpu / table.timed:.1f} CPU s a trial"
             lines += ["", f"### {_text(table.source or table.name)}", "", f"`{where}`: {ran}{page}.",
                       "", "| row | metric | published | measured (mean ± sd) | status | deviation | because |",
                       "|---|---|---:|---:|---|---:|---|"]
@@ -280,10 +286,19 @@ def _estimate(outcome: Outcome) -> str:
     """For a quick pass: what a default one would take on the same machine, each table's
     wall scaled by its default trials over the trials run."""
     tables = [t for s in outcome.scenarios for t in s.tables if t.trials]
-    if not outcome.quick or not tables:
+    if not tables:
         return ""
+    timed = [t for t in tables if t.timed]
+    cpu = sum(t.cpu for t in timed) / 60
+    text = f"; {cpu:.1f} CPU min" if timed else ""
+    if not outcome.quick:
+        return text
     minutes = sum(t.wall * t.planned / t.trials for t in tables) / 60
-    return f"; a default run, {sum(t.planned for t in tables)} trials, would take about {minutes:.0f} min here"
+    text += f"; a default run, {sum(t.planned for t in tables)} trials, would take about {minutes:.0f} min here"
+    if timed:
+        default = sum(t.cpu * t.planned / t.timed for t in timed) / 60
+        text += f" ({default:.0f} CPU min: {default / 2:.0f} min on 2 idle cores)"
+    return text
 
 
 def _anchor(title: str) -> str:
