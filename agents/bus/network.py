@@ -337,6 +337,9 @@ class ZigbeeNetworkMedium(BusMedium):
         frame = broadcast.frame
         out = self.radio.airtime(frame) + self.bus.uart_time(len(frame.data))
         self.clock.at(self.clock.now + out, self._arrive, frame, child, rank=MEDIUM)
+        if broadcast.targets is not None:  # the parent's unicast to its child: a sniffer overhears it
+            for sniffer in sorted(self.sniffers - broadcast.reached):
+                self._take(sniffer, broadcast)
         self._check_done(broadcast)
 
     # Through the MAC --------------------------------------------------------------------------
