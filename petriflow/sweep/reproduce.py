@@ -65,6 +65,9 @@ class Table:
     wall: float = 0.0
     cpu: float = 0.0  # CPU seconds of the trials' processes (the cost whatever else the machine runs)
     timed: int = 0  # the trials whose CPU seconds are known
+    ran: int = 0  # trials run by this pass (the others were resumed from its database)
+    costs: list[float] = field(default_factory=list)  # CPU seconds per trial, in the sweep's order
+    default_costs: list[float] = field(default_factory=list)  # the same for a default run, each row's mean
     db: Path | None = None
     page: Path | None = None
 
@@ -87,6 +90,7 @@ class Outcome:
     quick: bool
     wall: float
     out: Path
+    workers: int = 1
 
 
 def _title(readme: Path, fallback: str) -> str:
@@ -177,12 +181,21 @@ def reproduce(root: str | Path, out: str | Path, *, quick: bool = False, only: l
             table.rows, table.names, table.parameters = result.rows, result.names, sweep.parameters
             table.trials, table.failed = len(result.trials), len(result.failures)
             costs = [t["cpu"] for t in result.trials if t.get("cpu") is not None]
-            table.cpu, table.timed = sum(costs), len(costs)
+            table.cpu, table.timed, table.ran, table.costs = sum(costs), len(costs), result.ran, costs
+            per_row: dict[int, list[float]] = {}
+            for trial in result.trials:
+                if trial.get("cpu") is not None:
+                    per_row.setdefault(trial["row"], []).append(trial["cpu"])
+            mean = table.cpu / table.timed if table.timed else 0.0
+            table.default_costs = [sum(per_row[t.row]) / len(per_row[t.row]) if t.row in per_row else mean
+                                   for t in load_sweep(table.path).trials()]
             if pages:
                 from petriflow.view import view
 
                 table.page = view(table.db, sweep=table.path)
-    return Outcome(found, quick, wallclock.perf_counter() - started, out)
+    from petriflow.sweep.backends import default_workers
+
+    return Outcome(found, quick, wallclock.perf_counter() - started, out, workers or default_workers())
 
 
 def _cell(stats: dict[str, Any] | None, ran: bool) -> str:
@@ -228,6 +241,12 @@ def markdown(outcome: Outcome, root: str | Path, *, commit: str | None = None, c
              f" {trials} trials, {failed} failed, {outcome.wall / 60:.1f} min wall{_estimate(outcome)})."
              " Do not edit: run it again.",
              "",
+             "Time: a trial's *CPU seconds* are its own worker process's (building, running, measuring), what"
+             " it costs whatever else the machine runs; the wall time of a shared machine says more about its"
+             " load. *On N idle cores* hands each table's trials, at their measured CPU seconds (a default"
+             " run: each row's mean), to N workers in order as the local backend does, table after table;"
+             " worker start-up and the pages are not in it.",
+             "",
              "Each published value has a status: **predicted** (the simulation's output, no published value"
              " used to get it), **built in** (a published value was an input: agreement proves nothing; the"
              " reason names it) or **missed** (the measurement is off and the paper leaves the mechanism that"
@@ -258,6 +277,8 @@ def markdown(outcome: Outcome, root: str | Path, *, commit: str | None = None, c
             where = _relative(table.path, base)
             page = f"; page: `{_relative(table.page, base)}`" if table.page else ""
             ran = f"{table.trials} trials, {table.failed} failed, {table.wall:.0f} s wall" if table.db else "not run"
+            if table.db and table.ran < table.trials:
+                ran += f" ({table.trials - table.ran} resumed from its database)"
             if table.timed:
                 ran += f", {table.cpu / table.timed:.1f} CPU s a trial"
             lines += ["", f"### {_text(table.source or table.name)}", "", f"`{where}`: {ran}{page}.",
@@ -289,16 +310,33 @@ def _estimate(outcome: Outcome) -> str:
     if not tables:
         return ""
     timed = [t for t in tables if t.timed]
-    cpu = sum(t.cpu for t in timed) / 60
-    text = f"; {cpu:.1f} CPU min" if timed else ""
-    if not outcome.quick:
-        return text
-    minutes = sum(t.wall * t.planned / t.trials for t in tables) / 60
-    text += f"; a default run, {sum(t.planned for t in tables)} trials, would take about {minutes:.0f} min here"
-    if timed:
-        default = sum(t.cpu * t.planned / t.timed for t in timed) / 60
-        text += f" ({default:.0f} CPU min: {default / 2:.0f} min on 2 idle cores)"
+    if not timed:
+        return ""
+    cores = outcome.workers
+    text = (f"; the trials' own CPU time {sum(t.cpu for t in timed) / 60:.1f} min, on {cores} idle"
+            f" core{'s' if cores != 1 else ''} about {sum(makespan(t.costs, cores) for t in timed) / 60:.1f} min")
+    if outcome.quick:
+        text += (f"; a default run, {sum(t.planned for t in tables)} trials: about"
+                 f" {sum(sum(t.default_costs) for t in timed) / 60:.0f} CPU min, on {cores} idle core"
+                 f"{'s' if cores != 1 else ''} about {sum(makespan(t.default_costs, cores) for t in timed) / 60:.0f}"
+                 " min")
     return text
+
+
+def makespan(costs: list[float], workers: int) -> float:
+    """Seconds ``workers`` idle processes take for trials costing ``costs`` CPU seconds,
+    each trial in order to the first free one (as the local backend hands them out).
+
+    Examples:
+        >>> makespan([3.0, 1.0, 1.0, 1.0], 2), makespan([3.0, 1.0], 1)
+        (3.0, 4.0)
+    """
+    import heapq
+
+    free = [0.0] * max(1, workers)
+    for cost in costs:
+        heapq.heappush(free, heapq.heappop(free) + cost)
+    return max(free)
 
 
 def _anchor(title: str) -> str:
