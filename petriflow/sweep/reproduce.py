@@ -261,7 +261,9 @@ def markdown(outcome: Outcome, root: str | Path, *, commit: str | None = None, c
              " reason, or **missed (no mechanism stated)** where the file gives none; those are counted apart"
              " (*no mechanism*, a part of *missed*), so the misses nobody has explained are visible. A value"
              " within the tolerance stays predicted; built in and missed values keep their status whatever the"
-             " deviation.",
+             " deviation." + (" In this quick pass each row has one trial: a value judged missed may be that"
+                              " trial's spread, and the default run (the file's own trials) judges with the"
+                              " 2 sd clause too." if outcome.quick else ""),
              "", "| scenario | tables | predicted | built in | missed | of which no mechanism | unstated |",
              "|---|---:|" + "---:|" * len(COUNTED)]
     for scenario in outcome.scenarios:
