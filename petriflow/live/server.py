@@ -1,7 +1,9 @@
 """The live page's server: the run page fed as the run goes, and its controls.
 
 ``petriflow run NET --live [HOST:]PORT`` starts a :class:`LiveServer` beside the run.
-It serves, on one port, the page (``GET /?token=…``) and a WebSocket (``/ws?token=…``)
+It serves, on one port, the page (``GET /?token=…``; drawn when first asked for, and a
+folded net's subnets at ``/part?key=agent:SUBNET&token=…`` when the page opens one:
+:class:`~petriflow.live.page.LivePage`) and a WebSocket (``/ws?token=…``)
 that sends the page a snapshot when it connects, then what changed, at most
 :data:`RATE` times a second, and takes the page's (and ``petriflow ctl``'s) controls,
 which go to the run's :class:`~petriflow.runtime.control.Control` and nowhere else.
@@ -72,16 +74,17 @@ class LiveServer:
 
     Args:
         control: the run's control queue.
-        page: the page's HTML (made from the net before the run).
+        page: the page's HTML, or what makes it when first asked for (a
+            :class:`~petriflow.live.page.LivePage`: ``page()`` and ``part(key)``).
         host, port: where to listen (port 0: a free one).
         token: the secret every request must carry (default: a new random one).
         window: events a page keeps.
     """
 
-    def __init__(self, control: Control, page: str, host: str = "127.0.0.1", port: int = 0, *,
+    def __init__(self, control: Control, page: Any, host: str = "127.0.0.1", port: int = 0, *,
                  token: str | None = None, window: int = WINDOW) -> None:
         self.control = control
-        self.page = page.encode("utf-8")
+        self.page = page
         self.host, self.port = host, port
         self.token = token or secrets.token_urlsafe(24)
         self.state = LiveState(window)
@@ -197,7 +200,7 @@ class LiveServer:
             for client in list(self.clients):
                 await client.close(1001, "the run ended")
 
-    def _request(self, connection: Any, request: Any) -> Any:
+    async def _request(self, connection: Any, request: Any) -> Any:
         """Every HTTP request: the token, the origin, the path; the page, or on to the
         WebSocket handshake."""
         from websockets.datastructures import Headers
@@ -223,7 +226,15 @@ class LiveServer:
         if origin is not None and urlsplit(origin).netloc != request.headers.get("Host"):
             return answer(http.HTTPStatus.FORBIDDEN, b"forbidden: another origin\n")
         if parts.path == "/":
-            return answer(http.HTTPStatus.OK, self.page, "text/html; charset=utf-8")
+            page = self.page.encode("utf-8") if isinstance(self.page, str) else \
+                await asyncio.to_thread(self.page.page)  # drawn in a thread: the updates go on
+            return answer(http.HTTPStatus.OK, page, "text/html; charset=utf-8")
+        if parts.path == "/part":
+            key = (query.get("key") or [""])[0]
+            svg = None if isinstance(self.page, str) else await asyncio.to_thread(self.page.part, key)
+            if svg is None:
+                return answer(http.HTTPStatus.NOT_FOUND, b"no such part of the net\n")
+            return answer(http.HTTPStatus.OK, svg, "image/svg+xml")
         if parts.path != "/ws":
             return answer(http.HTTPStatus.NOT_FOUND, b"not found\n")
         if "websocket" not in request.headers.get("Upgrade", "").lower():
