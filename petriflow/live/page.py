@@ -47,7 +47,9 @@ def live_page(net: Any, *, subnets: bool = True) -> str:
                             for t in net.transitions.values()},
     }
     title = f"{net.id}: live run"
-    return render(title=title, body=_BODY.replace("{title}", html.escape(title)), data=data, scripts=SCRIPTS,
+    about = net.label if net.label and net.label != net.id else ""  # the net's own description
+    body = _BODY.replace("{title}", html.escape(title)).replace("{about}", html.escape(about))
+    return render(title=f"{title}: {about}" if about else title, body=body, data=data, scripts=SCRIPTS,
                   styles=["common.css", "run.css"], connect=True)
 
 
@@ -89,6 +91,7 @@ class LivePage:
 _BODY = """
 <header>
   <h1>{title}</h1>
+  <div id="about" class="note">{about}</div>
   <div id="summary"><span id="status">connecting…</span></div>
 </header>
 <section id="controls" class="bar">

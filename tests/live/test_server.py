@@ -157,3 +157,15 @@ def test_a_folded_nets_page_and_subnets_are_drawn_when_asked_for():
         assert get(live, "/part?key=../../etc/passwd&token=secret-token")[0] == 404
     finally:
         live.stop()
+
+
+def test_the_page_names_the_net_and_says_what_it_is():
+    """The page's title and header give the net's id and its own description (its label)."""
+    from petriflow.io.yaml import loads_net
+    from petriflow.live.page import live_page
+
+    net = loads_net("petriflow: 1\nnet: relay\nlabel: two robots <hand over> a box\nplaces: [{id: i, tokens: 1}, o]\n"
+                    "transitions: [{id: t, in: [i], out: [o]}]\n")
+    page = live_page(net)
+    assert "<title>relay: live run: two robots &lt;hand over&gt; a box</title>" in page
+    assert '<div id="about" class="note">two robots &lt;hand over&gt; a box</div>' in page
