@@ -97,12 +97,24 @@ class LiveServer:
         self._ready = threading.Event()
         self._done: asyncio.Event | None = None
         self._error: BaseException | None = None
-        control.listeners.append(self._inbox.append)
+        self._fresh: asyncio.Event | None = None  # set (in the server's thread) when the inbox has something
+        control.listeners.append(self._put)
 
     # The run's thread -------------------------------------------------------------
     def __call__(self, event: Event) -> None:
         """An observer of the run's events (``scheduler.on_event``)."""
-        self._inbox.append(event)
+        self._put(event)
+
+    def _put(self, item: Any) -> None:
+        """Leave ``item`` for the server's thread and wake it (it sleeps while the run
+        sends nothing: a paused run, or one between samples, costs no wakeup)."""
+        self._inbox.append(item)
+        loop, fresh = self._loop, self._fresh
+        if loop is not None and fresh is not None and not fresh.is_set():
+            try:
+                loop.call_soon_threadsafe(fresh.set)
+            except RuntimeError:  # the server has stopped; stop() drains what is left
+                pass
 
     def watch(self, scheduler: Any) -> None:
         """Follow ``scheduler``: its rare events (``run``, ``control``, ``stop``), and
@@ -129,7 +141,7 @@ class LiveServer:
             running = tuple({"t": ids[f.index], "agent": agents[f.index], "firing": f.number,
                              "since": f.ctx.started if f.ctx is not None else f.started}
                             for f in scheduler.runner.in_firing_order())
-            self._inbox.append(Sample(round(scheduler.now, 9), changed, running))
+            self._put(Sample(round(scheduler.now, 9), changed, running))
 
         scheduler.on_event(self, kinds=["run", "control", "stop"])
         scheduler.on_instant(sample)
@@ -182,6 +194,7 @@ class LiveServer:
 
         self._loop = asyncio.get_running_loop()
         self._done = asyncio.Event()
+        self._fresh = asyncio.Event()
         async with serve(self._connection, self.host, self.port, process_request=self._request,
                          max_size=MAX_FRAME, max_queue=4, open_timeout=5, ping_interval=20,
                          ping_timeout=20, close_timeout=2, server_header=None,
@@ -304,9 +317,12 @@ class LiveServer:
                 state.control = item
 
     async def _publish(self) -> None:
-        """Every 1/RATE s: what changed, to every page."""
+        """What changed, to every page, when the run has left something, at most
+        :data:`RATE` times a second."""
         while True:
-            await asyncio.sleep(1.0 / RATE)
+            await self._fresh.wait()
+            await asyncio.sleep(1.0 / RATE)  # what else comes meanwhile goes in the same batch
+            self._fresh.clear()
             self._drain()
             if self.clients:
                 self._send(self.state.batch())
