@@ -413,10 +413,17 @@ class Follow(Walk):
             x, y, _ = self.robot.pose()
             return (x, y)
         scene = ctx.latest("scene")
-        if not _is_scene(scene) or scene is self._last_scene or self.colour is None:
+        # a scene, or its token form (read by a robot on a remote agent: docs/bridge.md)
+        token = isinstance(scene, Mapping) and isinstance(scene.get("robots"), Mapping)
+        if not (_is_scene(scene) or token) or scene is self._last_scene or self.colour is None:
+            return None
+        if token and scene == self._last_scene:
             return None
         self._last_scene = scene
         pose = (_field(scene, "robots") or {}).get(self.colour)
+        if isinstance(pose, Mapping):
+            x, y = pose.get("x"), pose.get("y")
+            return None if x is None or y is None else (float(x), float(y))
         position = getattr(pose, "position", None)
         return None if position is None else (float(position[0]), float(position[1]))
 

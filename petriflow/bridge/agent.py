@@ -8,8 +8,11 @@ when the goal comes, ``poll`` at every step of its own world (``--world``, a pyb
 stand-in for the hardware) or when the action asked (``wake_at``), ``cancel`` when
 the run cancels the goal. Its context has the goal's transition, agent, parameters,
 input tokens and seed (so ``ctx.rng`` draws as in a local run), its world, and the
-world file's settings the action declares (``ctx.settings``); it has no other run
-services (an action that reads another agent's state or a port runs locally).
+world file's settings the action declares (``ctx.settings``), and the run's services
+that are served over the bridge (``ctx.read``/``ctx.latest`` of its ports,
+``ctx.running``): each use sends a ``call`` and waits for the run's ``reply``
+(:mod:`petriflow.bridge.calls`), heartbeats going on meanwhile; a service that is not
+served fails the goal with its reason.
 
 Goals are de-duplicated by id: a goal sent again (the run re-sends after a broker
 restart) is answered from what the server holds of that id (``accepted`` while it
@@ -32,12 +35,12 @@ from dataclasses import dataclass
 from typing import Any, Callable, TextIO
 
 from petriflow.bridge import protocol
+from petriflow.bridge.calls import CallRefused, calling_services
 from petriflow.bridge.protocol import Refused
 from petriflow.bridge.transport import Transport, agent_of, from_agent, to_agent
 from petriflow.errors import NetFormatError
 from petriflow.runtime.action import REQUIRED, Action, ActionContext, Status, first_data, type_names
 from petriflow.runtime.registry import Registry, UnknownActionError, default_registry
-from petriflow.runtime.services import RunServices
 from petriflow.runtime.settings import read_settings
 
 __all__ = ["AgentServer", "announcement"]
@@ -45,6 +48,8 @@ __all__ = ["AgentServer", "announcement"]
 log = logging.getLogger("petriflow.bridge.agent")
 #: Ended goals remembered per server (to answer a goal sent again); the oldest are forgotten.
 REMEMBERED = 100_000
+#: Seconds an action waits for the run to answer a call, by default.
+CALL_TIMEOUT = 60.0
 
 
 def announcement(registry: Registry) -> dict[str, dict[str, Any]]:
@@ -94,11 +99,13 @@ class AgentServer:
         heartbeat: seconds between heartbeats (an announcement every four).
         log_file: where to write one JSON line per goal executed.
         now: the wall clock.
+        call_timeout: seconds an action waits for the run to answer a call (a run
+            paused longer: the call fails, and the action with it).
     """
 
     def __init__(self, names: list[str], transport: Transport, *, registry: Registry | None = None,
                  world: Any = None, speed: float = 1.0, heartbeat: float = 0.5, log_file: TextIO | None = None,
-                 now: Callable[[], float] = time.perf_counter) -> None:
+                 now: Callable[[], float] = time.perf_counter, call_timeout: float = CALL_TIMEOUT) -> None:
         self.names = list(dict.fromkeys(names))
         self.transport = transport
         self.registry = registry or default_registry
@@ -110,6 +117,9 @@ class AgentServer:
         self.instance = uuid.uuid4().hex[:12]
         self.actions = announcement(self.registry)
         self.inbox: queue.SimpleQueue[tuple[str, bytes]] = queue.SimpleQueue()
+        self.replies: queue.SimpleQueue[protocol.Reply] = queue.SimpleQueue()
+        self.call_timeout = call_timeout
+        self.calls: dict[str, int] = {}  # goal id -> calls its action made
         self.running: dict[str, _Running] = {}
         self.ended: dict[str, protocol.BridgeMessage] = {}
         self.instances: dict[tuple[str, str, str], Action] = {}
@@ -127,7 +137,48 @@ class AgentServer:
         return (self.wall() - self._start) * self.speed
 
     def _receive(self, topic: str, payload: bytes) -> None:
+        if payload[:40].replace(b" ", b"").find(b'"type":"reply"') >= 0:  # for an action waiting on a call
+            try:
+                message = protocol.decode(payload)
+            except Refused:
+                message = None
+            if isinstance(message, protocol.Reply) and message.agent == agent_of(topic):
+                self.replies.put(message)
+                return
         self.inbox.put((topic, payload))
+
+    def call(self, goal: protocol.Goal, service: str, method: str, args: list[Any]) -> Any:
+        """Ask the run's ``service`` for a running goal and wait for its reply (sent again
+        every two heartbeats; heartbeats go on meanwhile).
+
+        Raises:
+            CallRefused: the run refused it (the reply's error), or no reply came within
+                :attr:`call_timeout` seconds.
+        """
+        number = self.calls[goal.id] = self.calls.get(goal.id, 0) + 1
+        message = protocol.Call(goal.id, goal.agent, number, service, method, protocol.to_data(args))
+        self._send(goal.agent, message)
+        start = self.wall()
+        resend = next_beat = start
+        while True:
+            wall = self.wall()
+            if wall - start > self.call_timeout:
+                raise CallRefused(f"{service}.{method}: no reply from the run within {self.call_timeout:g} s")
+            if wall >= next_beat:
+                next_beat = wall + self.heartbeat
+                self._beat(announce=False)
+            if wall - resend >= 2 * self.heartbeat:
+                resend = wall
+                self._send(goal.agent, message)
+            try:
+                reply = self.replies.get(timeout=max(0.0, min(next_beat, resend + 2 * self.heartbeat) - wall))
+            except queue.Empty:
+                continue
+            if reply.id != goal.id or reply.call != number:
+                continue  # an answer to a call given up, or sent twice
+            if reply.error:
+                raise CallRefused(f"{service}.{method}: the run refused: {reply.error}")
+            return reply.value
 
     def _send(self, agent: str, message: protocol.BridgeMessage) -> None:
         self.transport.publish(from_agent(agent), protocol.encode(message))
@@ -245,6 +296,7 @@ class AgentServer:
             self._remember(goal_id, protocol.Cancelled(goal_id, running.goal.agent))
 
     def _remember(self, goal_id: str, answer: protocol.BridgeMessage) -> None:
+        self.calls.pop(goal_id, None)
         self.ended[goal_id] = answer
         if len(self.ended) > REMEMBERED:
             del self.ended[next(iter(self.ended))]
@@ -276,7 +328,8 @@ class AgentServer:
             return
         now = self.now
         ctx = ActionContext(goal.transition or goal.action, goal.agent, params, dict(goal.inputs), self.world,
-                            goal.seed or goal.id, now, now, services=RunServices(settings=settings), action=cls)
+                            goal.seed or goal.id, now, now, action=cls,
+                            services=calling_services(settings, lambda *asked: self.call(goal, *asked)))
         self.executed += 1
         if self.log_file is not None:
             self.log_file.write(json.dumps({"goal": goal.id, "agent": goal.agent, "action": goal.action,

@@ -62,6 +62,8 @@ def cmd_agent(args: argparse.Namespace) -> int:
             raise PetriflowError(f"--name {name!r}: an agent name is letters, digits, '_', '.', '-' (at most 64)")
     if not args.speed > 0:
         raise PetriflowError(f"--speed must be > 0, got {args.speed}")
+    if not args.call_timeout > 0:
+        raise PetriflowError(f"--call-timeout must be > 0, got {args.call_timeout}")
     if args.actions:
         config = RunConfig(actions=[os.path.abspath(a) if a.endswith(".py") else a for a in args.actions])
         config.import_actions()
@@ -75,7 +77,7 @@ def cmd_agent(args: argparse.Namespace) -> int:
     transport = open_transport(args.transport, endpoint, "-".join(args.name))
     log_file = open(args.log, "a", encoding="utf-8") if args.log else None
     server = AgentServer(args.name, transport, world=world, speed=args.speed, heartbeat=args.heartbeat,
-                         log_file=log_file)
+                         log_file=log_file, call_timeout=args.call_timeout)
     _stop_on_signals(server.stop)
     print(f"petriflow agent: {', '.join(args.name)} serving {len(server.actions)} actions over {args.transport}"
           f" at {endpoint.connect}", flush=True)
@@ -110,6 +112,9 @@ def add_parser(sub: Any) -> None:
     agent.add_argument("--speed", type=limits.number_argument, default=1.0,
                        help="agent seconds per wall-clock second (default 1; more for demonstrations)")
     agent.add_argument("--heartbeat", type=limits.number_argument, default=0.5, help="seconds between heartbeats")
+    agent.add_argument("--call-timeout", type=limits.number_argument, default=60.0,
+                       help="seconds an action waits for the run to answer a call of its services (ctx.read,"
+                       " ctx.running); then it fails (default 60)")
     agent.add_argument("--log", help="append one JSON line per goal executed to this file")
     agent.add_argument("--user", help="authenticate to the router or broker as this user")
     agent.add_argument("--password-env", help="the environment variable that holds the password")

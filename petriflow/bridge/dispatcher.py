@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from petriflow.bridge import protocol
+from petriflow.bridge.calls import check_call
 from petriflow.bridge.protocol import Drop, Refused
 from petriflow.bridge.spec import BridgeSpec
 from petriflow.bridge.transport import Transport, agent_of, from_agent, open_transport, to_agent
@@ -35,6 +36,8 @@ __all__ = ["Dispatcher", "GoalState", "AgentSeen", "Phase"]
 log = logging.getLogger("petriflow.bridge")
 #: Drops logged per reason (the rest are only counted).
 LOGGED_DROPS = 5
+#: Replies kept per goal to answer a call sent again (the latest ones).
+KEPT_REPLIES = 64
 
 
 class Phase:
@@ -75,6 +78,12 @@ class GoalState:
     reason: str = ""
     cancel_sent: float | None = None
     feedback: Any = None
+    #: Calls of the goal's action waiting for the kernel to answer them (:mod:`~.calls`).
+    calls: list[protocol.Call] = field(default_factory=list)
+    #: The replies sent, by call number (a call sent again is answered the same).
+    replies: dict[int, protocol.Reply] = field(default_factory=dict)
+    #: How many of the action's calls the run answered (recorded with the goal's end).
+    answered_calls: int = 0
     #: On resume, the simulated time the journal shows it ended at (its ending is taken
     #: then, as journaled: :mod:`petriflow.bridge.resume`); ``None``: a live goal.
     at: float | None = None
@@ -155,7 +164,7 @@ class Dispatcher:
             self.drop(Drop.WRONG_AGENT, f"{message.kind.value} on {sender!r}'s topic names agent"
                                         f" {getattr(message, 'agent', '')!r}")
             return
-        if isinstance(message, (protocol.Goal, protocol.Cancel)):
+        if isinstance(message, (protocol.Goal, protocol.Cancel, protocol.Reply)):
             self.drop(Drop.MALFORMED, f"an agent sent a {message.kind.value}")
             return
         now = self.now()
@@ -180,7 +189,50 @@ class Dispatcher:
             self.drop(Drop.WRONG_AGENT, f"{message.kind.value} from {sender!r} for a goal sent to"
                                         f" {state.goal.agent!r}")
             return
+        if isinstance(message, protocol.Call):
+            self._called(state, message)
+            return
         self._apply(state, message, now)
+
+    def _called(self, state: GoalState, call: protocol.Call) -> None:
+        """A call of a goal's action: kept for the kernel to answer (:meth:`take_calls`),
+        answered again if it was, refused if the goal ended, dropped if not served."""
+        why = check_call(call)
+        if why:
+            self.drop(Drop.UNKNOWN_CALL, f"from {call.agent!r} for goal {call.id[:80]!r}: {why}")
+            return
+        with self._lock:
+            reply = state.replies.get(call.call)
+            if reply is None and state.ended:
+                reply = protocol.Reply(call.id, call.agent, call.call, None,
+                                       f"the goal ended ({state.phase}): the run answers no more calls for it")
+            elif reply is None:
+                if all(c.call != call.call for c in state.calls):
+                    state.calls.append(call)
+                return
+        self.transport.publish(to_agent(call.agent), protocol.encode(reply))
+
+    def take_calls(self, goal_id: str) -> list[protocol.Call]:
+        """The calls of the goal's action not yet answered, oldest first (the kernel's
+        thread answers them with :meth:`reply`)."""
+        with self._lock:
+            state = self.goals.get(goal_id)
+            if state is None or not state.calls:
+                return []
+            calls, state.calls = state.calls, []
+            return calls
+
+    def reply(self, reply: protocol.Reply) -> None:
+        """Send ``reply`` (and keep it: a call sent again gets it again)."""
+        with self._lock:
+            state = self.goals.get(reply.id)
+            if state is not None:
+                if reply.call not in state.replies:
+                    state.answered_calls += 1
+                state.replies[reply.call] = reply
+                if len(state.replies) > KEPT_REPLIES:  # a call that old is not sent again
+                    del state.replies[min(state.replies)]
+        self.transport.publish(to_agent(reply.agent), protocol.encode(reply))
 
     def _restarted(self, seen: AgentSeen, now: float) -> None:
         """``seen`` announced itself as a new process: the goals its old one held died
@@ -272,11 +324,18 @@ class Dispatcher:
         self.transport.publish(to_agent(goal.agent), protocol.encode(protocol.Cancel(goal.id, goal.agent)))
 
     def forget(self, goal_id: str) -> None:
-        """The run is done with this goal (it ended, was cancelled, or its agent lost)."""
+        """The run is done with this goal (it ended, was cancelled, or its agent lost);
+        its calls waiting for an answer are refused."""
         with self._lock:
             state = self.goals.get(goal_id)
             if state is not None and not state.ended:
                 state.phase = Phase.CANCELLED
+        self.refuse_calls(goal_id, "the run gave up the goal (cancelled, or its agent lost)")
+
+    def refuse_calls(self, goal_id: str, why: str) -> None:
+        """Refuse the goal's calls waiting for an answer, with ``why``."""
+        for call in self.take_calls(goal_id):
+            self.reply(protocol.Reply(call.id, call.agent, call.call, None, why))
 
     def is_lost(self, agent: str) -> bool:
         """Whether ``agent`` was lost (as :meth:`watch` last found)."""

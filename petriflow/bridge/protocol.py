@@ -19,6 +19,8 @@ message         sent by         says
 ``result``      agent           ``ok`` with the output token data, or ``failed``
 ``cancel``      orchestrator    stop this goal
 ``cancelled``   agent           the goal was stopped (the cancel's acknowledgement)
+``call``        agent           a running goal's action asks the run's services (a port, liveness)
+``reply``       orchestrator    the call's value, or why it was refused
 ==============  ==============  ===================================================
 
 Everything that comes from the network is data: :func:`decode` parses JSON (never
@@ -50,7 +52,7 @@ from petriflow.errors import PetriflowError
 from petriflow.outcome import Name
 
 __all__ = ["VERSION", "MAX_MESSAGE", "Kind", "Drop", "Refused", "Announce", "Heartbeat", "Goal", "Accepted",
-           "Rejected", "Feedback", "Result", "Cancel", "Cancelled", "BridgeMessage", "About", "encode", "decode", "goal_id",
+           "Rejected", "Feedback", "Result", "Cancel", "Cancelled", "Call", "Reply", "BridgeMessage", "About", "encode", "decode", "goal_id",
            "to_data"]
 
 #: The protocol version this code speaks (a message of another version is dropped).
@@ -73,6 +75,8 @@ class Kind(Name):
     RESULT = "result"
     CANCEL = "cancel"
     CANCELLED = "cancelled"
+    CALL = "call"
+    REPLY = "reply"
 
 
 class Drop(Name):
@@ -92,6 +96,8 @@ class Drop(Name):
     """About a goal already ended (a result or acknowledgement received twice)."""
     WRONG_AGENT = "wrong_agent"
     """About a goal sent to another agent."""
+    UNKNOWN_CALL = "unknown_call"
+    """A call of a service or method the run does not serve, or with ill-typed arguments."""
 
 
 class Refused(PetriflowError):
@@ -202,13 +208,37 @@ def _bare(name: str, kind: Kind, doc: str) -> type[About]:
     return dataclass(frozen=True)(cls)
 
 
+@dataclass(frozen=True)
+class Call(About):
+    """The running goal ``id``'s action asks the run's ``service`` (``method`` with
+    ``args``, JSON data); ``call`` numbers the goal's calls from 1, so a call sent
+    again (no reply came) is answered once (see :mod:`petriflow.bridge.calls`)."""
+
+    kind: ClassVar[Kind] = Kind.CALL
+    call: int
+    service: str
+    method: str
+    args: list[Any] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Reply(About):
+    """The answer to the goal ``id``'s call ``call``: its ``value`` (JSON data), or
+    ``error`` (not empty: the call was refused, e.g. the goal was cancelled)."""
+
+    kind: ClassVar[Kind] = Kind.REPLY
+    call: int
+    value: Any = None
+    error: str = ""
+
+
 Accepted = _bare("Accepted", Kind.ACCEPTED, "The goal ``id`` runs.")
 Cancel = _bare("Cancel", Kind.CANCEL, "Stop the goal ``id``.")
 Cancelled = _bare("Cancelled", Kind.CANCELLED, "The goal ``id`` stopped (acknowledges :class:`Cancel`).")
 
 _TYPES: dict[str, type[BridgeMessage]] = {cls.kind.value: cls for cls in
                                     (Announce, Heartbeat, Goal, Accepted, Rejected, Feedback, Result, Cancel,
-                                     Cancelled)}
+                                     Cancelled, Call, Reply)}
 _OUTCOMES = ("ok", "failed")
 
 
@@ -276,7 +306,8 @@ def _depth(value: Any, depth: int = 0) -> int:
 
 
 _FIELD_TYPES = {"str": str, "dict[str, Any]": dict, "dict[str, dict[str, Any]]": dict,
-                "dict[str, list[Any]]": dict, "list[str]": list}
+                "dict[str, list[Any]]": dict, "list[str]": list,
+                "int": int, "list[Any]": list}
 
 
 def decode(data: bytes | bytearray | memoryview | str) -> BridgeMessage:
@@ -322,6 +353,8 @@ def decode(data: bytes | bytearray | memoryview | str) -> BridgeMessage:
         raise Refused(Drop.MALFORMED, "heartbeat: running lists goal ids (strings)")
     if cls is Goal and not all(isinstance(v, list) for v in values.get("inputs", {}).values()):
         raise Refused(Drop.MALFORMED, "goal: inputs maps places to lists of token data")
+    if cls in (Call, Reply) and (isinstance(values["call"], bool) or values["call"] < 1):
+        raise Refused(Drop.MALFORMED, f"{kind}: call numbers a goal's calls from 1")
     if cls is Announce and not all(isinstance(v, dict) for v in values["actions"].values()):
         raise Refused(Drop.MALFORMED, "announce: actions maps each action to its parameters")
     return cls(**values)

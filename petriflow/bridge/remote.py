@@ -20,6 +20,7 @@ import dataclasses
 from typing import Any, ClassVar
 
 from petriflow.bridge import protocol
+from petriflow.bridge.calls import answer
 from petriflow.bridge.dispatcher import Dispatcher, Phase
 from petriflow.bridge.spec import BridgeSpec
 from petriflow.errors import NetFormatError, did_you_mean
@@ -73,6 +74,7 @@ class RemoteAction(Action):
 
     def poll(self, ctx: ActionContext) -> Status:
         dispatcher = self._dispatcher(ctx)
+        self._answer(ctx, dispatcher)
         state = dispatcher.goal(self.goal_id)
         if state is not None and state.at is not None:  # a resume replays the journaled ending
             return self._replayed(ctx, state)
@@ -101,11 +103,23 @@ class RemoteAction(Action):
         if not self.cancel_asked:
             self.cancel_asked = True
             dispatcher.cancel(self.goal_id)
+        dispatcher.refuse_calls(self.goal_id, "the goal is being cancelled")
         state = dispatcher.goal(self.goal_id)
         if state is not None and state.ended:
             self._record(ctx, state)
             return True
         return False
+
+    def _answer(self, ctx: ActionContext, dispatcher: Any) -> None:
+        """Answer the goal's calls from the run's services, now: on the kernel's thread,
+        at this firing's poll (:mod:`petriflow.bridge.calls`)."""
+        calls = dispatcher.take_calls(self.goal_id)
+        if not calls:
+            return
+        ports = {ctx.params.get(name) for name, declared in type(self).params.items() if isinstance(declared, Port)}
+        services = ctx.services
+        for call in calls:
+            dispatcher.reply(answer(call, services, {p for p in ports if isinstance(p, str)}))
 
     def _replayed(self, ctx: ActionContext, state: Any) -> Status:
         """The journaled ending of a resumed run's firing, at its journaled time."""
@@ -127,7 +141,7 @@ class RemoteAction(Action):
         """Which agent executed the firing, and the goal's round trip (a custom event)."""
         trip = state.round_trip
         ctx.emit("remote", agent=self.remote_agent, goal=state.goal.id, phase=state.phase, resent=state.resent,
-                 round_trip_ms=None if trip is None else round(trip * 1e3, 3))
+                 round_trip_ms=None if trip is None else round(trip * 1e3, 3), calls=state.answered_calls)
 
 
 def remote_transitions(net: Net, spec: BridgeSpec) -> dict[str, str]:
@@ -198,12 +212,14 @@ def _at(net: Net, tid: str, path: str | None, message: str, param: str | None = 
 
 def _check_places(net: Net, tid: str, path: str | None, name: str, local: type[Action],
                   params: dict[str, Any]) -> None:
-    """The places a remote action's parameters name must be the net's; a port (a place
-    the action reads while it runs) cannot be read on a remote agent."""
+    """The places a remote action's parameters name must be the net's (its ports are
+    read through the bridge, :mod:`petriflow.bridge.calls`); an action that declares
+    resources cannot run on a remote agent (they are not served)."""
+    resources = getattr(local, "resources", None) or {}
+    if resources:
+        raise _at(net, tid, path, f"action {name} takes the run's resource(s) {', '.join(sorted(resources))},"
+                  " which are not served to remote agents (leave its subnet out of bridge: agents)")
     for pname, declared in getattr(local, "params", {}).items():
-        if isinstance(declared, Port):
-            raise _at(net, tid, path, f"action {name} reads place {params.get(pname)!r} through its port {pname!r}"
-                      " while it runs, which a remote agent cannot (leave its subnet out of bridge: agents)", pname)
         for place in declared.place_names(params.get(pname)):
             if not isinstance(place, str) or place not in net.places:
                 hint = did_you_mean(place, net.places) if isinstance(place, str) else ""

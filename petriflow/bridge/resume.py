@@ -63,6 +63,7 @@ class Replay:
         state = GoalState(goal, phase=phase, sent=0.0,
                           answered=None if trip is None else trip / 1e3, resent=record.get("resent", 0),
                           data=end.data.get("result"), reason=end.data.get("reason", ""))
+        state.answered_calls = record.get("calls", 0)
         state.at = end.time
         return state
 
@@ -98,6 +99,16 @@ class ReplayingRemote:
     def forget(self, goal_id: str) -> None:
         if goal_id not in self.replayed:
             self.dispatcher.forget(goal_id)
+
+    def take_calls(self, goal_id: str) -> list[protocol.Call]:
+        return [] if goal_id in self.replayed else self.dispatcher.take_calls(goal_id)
+
+    def reply(self, reply: protocol.Reply) -> None:
+        self.dispatcher.reply(reply)
+
+    def refuse_calls(self, goal_id: str, why: str) -> None:
+        if goal_id not in self.replayed:
+            self.dispatcher.refuse_calls(goal_id, why)
 
     def is_lost(self, agent: str) -> bool:
         return agent in self.lost if self.replaying else self.dispatcher.is_lost(agent)

@@ -100,6 +100,15 @@ class RemoteGoals(Protocol):
     def is_lost(self, agent: str) -> bool:
         """Whether the remote ``agent`` stopped answering."""
 
+    def take_calls(self, goal_id: str) -> list[Any]:
+        """The calls of the goal's action on the run's services, not yet answered."""
+
+    def reply(self, reply: Any) -> None:
+        """Send the answer to a call."""
+
+    def refuse_calls(self, goal_id: str, why: str) -> None:
+        """Refuse the goal's calls not yet answered, with ``why``."""
+
 
 @dataclass(frozen=True, eq=False)
 class RunServices:

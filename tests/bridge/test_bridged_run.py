@@ -457,20 +457,25 @@ def test_a_bad_bridge_section_is_one_line_at_its_line(tmp_path, bridge, message)
     assert not (tmp_path / "run.sqlite").exists()
 
 
-def test_an_action_reading_ports_cannot_be_put_on_a_remote_agent(tmp_path):
-    """A port is read while the action runs, from the run's places: refused at bind time, at the line."""
-    from petriflow import Param, Port
+def test_an_action_taking_resources_cannot_be_put_on_a_remote_agent(tmp_path):
+    """Resources are not served to remote agents (ports are: tests/bridge/test_calls.py):
+    refused at bind time, at the line, before anything is written."""
+    from petriflow import Action, Status
     from petriflow.runtime.registry import Registry
 
     registry = Registry()
 
-    @registry.action("demo.watch", {"scene": Port("the place watched"), "every": Param(float, 1.0)})
-    def watch(ctx):
-        return ctx.latest("scene")
+    class Planner(Action):
+        resources = {"plan": dict}
 
+        def poll(self, ctx):
+            return Status.OK
+
+    registry.register("demo.plan", Planner)
     (tmp_path / "net.yaml").write_text(NET.replace("action: core.set, params: {value: {x: 1}}",
-                                                   "action: demo.watch, params: {scene: c}"))
+                                                   "action: demo.plan"))
     (tmp_path / "run.yaml").write_text("seed: 1\nbridge: {transport: mqtt, agents: {r1: x}}\n")
-    with pytest.raises(NetFormatError, match=r"net.yaml:9: 'mark': action demo.watch reads place 'c' through its"
-                                             r" port 'scene'"):
-        run_files(tmp_path / "net.yaml", registry=registry)
+    with pytest.raises(NetFormatError, match=r"net.yaml:9: 'mark': action demo.plan takes the run's resource\(s\)"
+                                             r" plan, which are not served to remote agents"):
+        run_files(tmp_path / "net.yaml", registry=registry, db=tmp_path / "run.sqlite")
+    assert not (tmp_path / "run.sqlite").exists()
