@@ -261,7 +261,8 @@ class AgentServer:
         with self._held:
             held = [(g, r.goal.agent) for g, r in self.running.items()]
         for name in self.names:
-            self._send(name, protocol.Heartbeat(name, [g for g, agent in held if agent == name], self.instance))
+            goals = [goal_id for goal_id, agent in held if agent == name]
+            self._send(name, protocol.Heartbeat(name, goals, self.instance))
 
     def _hold(self, running: _Running) -> None:
         with self._held:

@@ -266,8 +266,11 @@ class Dispatcher:
                     state.phase, state.answered = Phase.CANCELLED, now
                 if state.ended:
                     self._ended.notify_all()
-        # an answer to a goal or cancel sent again is expected twice; otherwise an ended goal's answer is a replay
-        if replayed and state.resent == 0 and state.cancels_resent == 0 and not isinstance(message, (protocol.Accepted, protocol.Feedback)):
+        # an answer to a goal or a cancel sent again is expected twice; otherwise an ended goal's
+        # answer is a replay
+        expected = state.resent or state.cancels_resent or \
+            isinstance(message, (protocol.Accepted, protocol.Feedback))
+        if replayed and not expected:
             self.drop(Drop.REPLAYED, f"{message.kind.value} for goal {state.goal.id!r}, which had ended")
 
     # what the run's thread calls --------------------------------------------------------

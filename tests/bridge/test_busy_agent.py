@@ -62,28 +62,33 @@ def busy_registry():
 
 
 def net(seconds, timeout=None, hold=False):
-    return BUSY.replace("SECONDS", f"{seconds}, hold: {str(hold).lower()}").replace("TIMEOUT", "" if timeout is None else f", timeout: {timeout}")
+    text = BUSY.replace("SECONDS", f"{seconds}, hold: {str(hold).lower()}")
+    return text.replace("TIMEOUT", "" if timeout is None else f", timeout: {timeout}")
 
 
-def events_of(folder):
-    return [json.loads(line) for line in (folder / "t.jsonl").read_text().splitlines()]
+def run_busy(middleware, serve, folder, net_text, final):
+    """Serve the busy action on an agent, run ``net_text`` on it to its ``final`` marking
+    with the agent never lost; ``(agent, result, {what: the plan firing's event})``."""
+    kind, server = middleware
+    agent = serve(kind, server.connect, ["robot1"], heartbeat=HEARTBEAT, registry=busy_registry())
+    path = write(folder, kind, server.connect, net=net_text, heartbeat=HEARTBEAT,
+                 heartbeat_timeout=HEARTBEAT_TIMEOUT)
+    result = run_files(path, trace=folder / "t.jsonl")
+    events = [json.loads(line) for line in (folder / "t.jsonl").read_text().splitlines()]
+    assert not [e for e in events if e["kind"] == "fault"], "the busy agent was declared lost"
+    assert result.reason == "final" and result.marking.to_dict() == final
+    found = {"end": next(e["data"] for e in events if e["kind"] == "end" and e["transition"] == "plan"),
+             "remote": next(e["data"]["data"] for e in events
+                            if e["kind"] == "custom" and e["data"]["name"] == "remote")}
+    return agent, result, found
 
 
 def test_an_action_computing_for_three_heartbeat_timeouts_in_start_is_not_lost(middleware, serve, tmp_path):
     """The action blocks its agent's action thread for 3 x heartbeat_timeout inside ``start``:
     the agent is never declared lost, and the firing ends ok with the action's data."""
-    kind, server = middleware
-    agent = serve(kind, server.connect, ["robot1"], heartbeat=HEARTBEAT, registry=busy_registry())
-    path = write(tmp_path, kind, server.connect, net=net(3 * HEARTBEAT_TIMEOUT), heartbeat=HEARTBEAT,
-                 heartbeat_timeout=HEARTBEAT_TIMEOUT)
-    result = run_files(path, trace=tmp_path / "t.jsonl")
-    events = events_of(tmp_path)
-    assert not [e for e in events if e["kind"] == "fault"], "the busy agent was declared lost"
-    assert result.reason == "final" and result.marking.to_dict() == {"b": 1}
-    end = next(e for e in events if e["kind"] == "end" and e["transition"] == "plan")
-    assert end["data"]["outcome"] == "ok"
-    remote = next(e for e in events if e["kind"] == "custom" and e["data"]["name"] == "remote")
-    assert remote["data"]["data"]["round_trip_ms"] >= 3000 * HEARTBEAT_TIMEOUT
+    agent, result, found = run_busy(middleware, serve, tmp_path, net(3 * HEARTBEAT_TIMEOUT), {"b": 1})
+    assert found["end"]["outcome"] == "ok"
+    assert found["remote"]["round_trip_ms"] >= 3000 * HEARTBEAT_TIMEOUT
     assert result.tokens["b"][0]["count"] > 0
     assert agent.server.executed == 1
 
@@ -93,18 +98,10 @@ def test_a_timeout_during_the_computation_cancels_the_goal_once_start_returns(mi
     cancelled): the run's cancel waits on the agent until ``start`` returns, then the action's
     ``cancel`` runs and is acknowledged; the firing ends ``timeout`` (its route fires), the
     agent never lost."""
-    kind, server = middleware
-    serve(kind, server.connect, ["robot1"], heartbeat=HEARTBEAT, registry=busy_registry())
-    path = write(tmp_path, kind, server.connect, net=net(3 * HEARTBEAT_TIMEOUT, timeout=1, hold=True).replace(
-        "final: {b: 1}", "final: {late: 1}"), heartbeat=HEARTBEAT, heartbeat_timeout=HEARTBEAT_TIMEOUT)
     started = time.monotonic()
-    result = run_files(path, trace=tmp_path / "t.jsonl")
-    events = events_of(tmp_path)
-    assert not [e for e in events if e["kind"] == "fault"], "the busy agent was declared lost"
-    assert result.reason == "final" and result.marking.to_dict() == {"late": 1}
-    end = next(e for e in events if e["kind"] == "end" and e["transition"] == "plan")
-    assert end["data"]["outcome"] == "timeout"
+    text = net(3 * HEARTBEAT_TIMEOUT, timeout=1, hold=True).replace("final: {b: 1}", "final: {late: 1}")
+    _, result, found = run_busy(middleware, serve, tmp_path, text, {"late": 1})
+    assert found["end"]["outcome"] == "timeout"
     assert len(Compute.cancels) == 1 and Compute.cancels[0] - started >= 3 * HEARTBEAT_TIMEOUT
-    remote = next(e for e in events if e["kind"] == "custom" and e["data"]["name"] == "remote")
-    assert remote["data"]["data"]["phase"] == "cancelled"
+    assert found["remote"]["phase"] == "cancelled"
     assert result.metrics["bridge.dropped"] == 0  # each cancel sent again is answered: none a replay
