@@ -21,8 +21,11 @@ compressed is the events: the run is a net that never ends and sends the page ab
 watches the mission itself, which ends after about 190 s simulated, a minute of wall
 time), so ten minutes of it hold more events than an hour of the mission.
 
+``--paced`` instead runs that net at 1 s a firing kept to the wall clock: a real hour of
+updates and events (about 120 lines a second) at little CPU.
+
 Run: ``python bench/live.py [--pairs 3] [--until 60] [--browser]`` or
-``python bench/live.py --memory 600 [--every 30] [--mission]``. Prints Markdown.
+``python bench/live.py --memory 600 [--every 30] [--mission | --paced]``. Prints Markdown.
 """
 
 from __future__ import annotations
@@ -163,22 +166,27 @@ def heap(driver) -> tuple[float, float]:
 
 #: A net that never ends and makes events as fast as it can: sixty transitions, each
 #: firing again and again (a 10 ms action), about 2,000 lines a second for the page.
-BUSY = "petriflow: 1\nplaces: [" + ", ".join(f"{{id: p{i}, tokens: 1}}" for i in range(60)) + "]\ntransitions:\n" + \
-    "".join(f"- {{id: t{i}, action: core.wait, params: {{seconds: 0.01}}, in: [p{i}], out: [p{i}]}}\n"
-            for i in range(60))
+def busy(seconds: float) -> str:
+    """A net that never ends: 60 transitions, each waiting ``seconds`` then firing again."""
+    return ("petriflow: 1\nplaces: [" + ", ".join(f"{{id: p{i}, tokens: 1}}" for i in range(60)) + "]\ntransitions:\n"
+            + "".join(f"- {{id: t{i}, action: core.wait, params: {{seconds: {seconds}}}, in: [p{i}], out: [p{i}]}}\n"
+                      for i in range(60)))
 
 
-def memory(seconds: float, every: float, folder: Path, mission: bool) -> None:
+def memory(seconds: float, every: float, folder: Path, mission: bool, paced: bool = False) -> None:
     """The page's memory over a long run: the page open from the start for ``seconds`` of
     wall time (or until the run ends), its JS heap sampled every ``every`` s. The run is
     the 20-robot mission (``mission``; it ends after about 190 s simulated) or a net that
-    never ends and sends the page more events a second than the mission does."""
+    never ends and sends the page more events a second than the mission does; ``paced``: that
+    net's transitions wait 1 s each and the run keeps to the wall clock (``--realtime``), so
+    a run of an hour is an hour of simulated time at little CPU."""
     if mission:
         command = [*RUN, "--until", "1e9", "--live", "0"]
     else:
-        (folder / "busy.yaml").write_text(BUSY)
+        (folder / "busy.yaml").write_text(busy(1.0 if paced else 0.01))
         command = [sys.executable, "-c", "import sys; from petriflow.cli import main; sys.exit(main())", "run",
-                   str(folder / "busy.yaml"), "--until", "1e9", "--quiet", "--live", "0"]
+                   str(folder / "busy.yaml"), "--until", "1e9", "--quiet", "--live", "0",
+                   *(["--realtime"] if paced else [])]
     driver = chromium()
     stderr = folder / "memory-run.txt"
     samples = []
@@ -210,8 +218,10 @@ def memory(seconds: float, every: float, folder: Path, mission: bool) -> None:
         driver.quit()
     kept = [s[6] for s in samples]
     print()
-    what = "the 20-robot bidding mission" if mission else "a net of 60 transitions firing as fast as they can"
-    print(f"`python bench/live.py --memory {seconds:g} --every {every:g}{' --mission' if mission else ''}` ({what},"
+    what = ("the 20-robot bidding mission" if mission else "a net of 60 transitions of 1 s each, in real time"
+            if paced else "a net of 60 transitions firing as fast as they can")
+    flag = " --mission" if mission else " --paced" if paced else ""
+    print(f"`python bench/live.py --memory {seconds:g} --every {every:g}{flag}` ({what},"
           f" page open from the start, {samples[-1][0]:.0f} s of wall time)")
     print()
     print("| | wall (s) | simulated (s) | updates | events received | events held | JS heap after GC (MB) |")
@@ -235,11 +245,13 @@ def main() -> None:
     parser.add_argument("--mission", action="store_true",
                         help="with --memory: the 20-robot mission (it ends after ~190 s simulated) instead of a net"
                              " that never ends")
+    parser.add_argument("--paced", action="store_true",
+                        help="with --memory: the net that never ends, 1 s a firing, kept to the wall clock (an hour's run)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="petriflow-bench-live-") as name:
         folder = Path(name)
         if args.memory:
-            memory(args.memory, args.every, folder, args.mission)
+            memory(args.memory, args.every, folder, args.mission, args.paced)
             return
         rows = []
         for k in range(args.pairs):
