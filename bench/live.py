@@ -2,16 +2,30 @@
 
 The 20-robot bidding mission (``nets/bidding/bidding-autonomous-20.yaml``, its
 ``run-20.yaml``) is run alternately without ``--live`` and with ``--live`` and a client
-following the page's WebSocket (it receives the snapshot and every update, at most 20
-a second: what the page receives; the browser's own work is in another process and
-is not the run's). Each run is a process of its own; its CPU time (user + system, from
+that loads the page (the server draws it then) and follows its WebSocket (it receives
+the snapshot and every update, at most 20 a second: what a page asks of the run's
+process; the browser's own work is in another process and is not the run's). Each run is a process of its own; its CPU time (user + system, from
 ``wait4``) is compared, pair by pair, so both sides of a pair met the same load.
 
 Then a page opened mid-run: the time from connecting to the snapshot (the current
 marking) arriving, over the WebSocket; with ``--browser`` also in headless Chromium
 (from navigation to the marking shown).
 
-Run: ``python bench/live.py [--pairs 3] [--until 60] [--browser]``. Prints Markdown.
+With ``--memory SECONDS`` instead: one run watched for SECONDS of wall time by the page
+in Chromium, open from the start, its JS heap sampled (before and after a garbage
+collection, through the DevTools protocol) every ``--every`` seconds; start, end and
+largest are printed. The page takes at most 20 updates a second of wall time whatever
+the run does, so it cannot be fed an hour of updates in less than an hour; what can be
+compressed is the events: the run is a net that never ends and sends the page about
+2,000 lines a second, more than ten times the 20-robot mission's rate (``--mission``
+watches the mission itself, which ends after about 190 s simulated, a minute of wall
+time), so ten minutes of it hold more events than an hour of the mission.
+
+``--paced`` instead runs that net at 1 s a firing kept to the wall clock: a real hour of
+updates and events (about 120 lines a second) at little CPU.
+
+Run: ``python bench/live.py [--pairs 3] [--until 60] [--browser]`` or
+``python bench/live.py --memory 600 [--every 30] [--mission | --paced]``. Prints Markdown.
 """
 
 from __future__ import annotations
@@ -43,10 +57,17 @@ def cpu_of(process: subprocess.Popen) -> float:
 
 
 def follow(url: str, counts: dict) -> None:
-    """A client that follows the live page's WebSocket to the end (what a page receives)."""
+    """A client that loads the live page (the server draws it then) and follows its
+    WebSocket to the end: what a page asks of the run's process."""
+    from urllib.request import urlopen
+
     from websockets.sync.client import connect
 
     target = url.replace("http://", "ws://").replace("/?token=", "/ws?token=")
+    started = time.perf_counter()
+    with urlopen(url, timeout=60) as response:
+        counts["page_bytes"] = len(response.read())
+    counts["page_s"] = time.perf_counter() - started
     started = time.perf_counter()
     with connect(target, max_size=2 ** 26, open_timeout=30) as socket:
         first = json.loads(socket.recv())
@@ -94,16 +115,7 @@ def one(until: float, live: bool, folder: Path, delay: float = 0.0) -> dict:
 
 def browser_open(until: float, folder: Path, delay: float) -> float:
     """Seconds from navigating to a live page mid-run to its marking shown, in Chromium."""
-    import shutil
-
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-
-    options = webdriver.ChromeOptions()
-    options.binary_location = shutil.which("chromium")
-    for argument in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"):
-        options.add_argument(argument)
-    driver = webdriver.Chrome(service=Service(shutil.which("chromedriver")), options=options)
+    driver = chromium()
     stderr = folder / "browser-run.txt"
     try:
         with open(stderr, "w") as err:
@@ -116,11 +128,110 @@ def browser_open(until: float, folder: Path, delay: float) -> float:
                 time.sleep(0.02)
             shown = driver.execute_script("return window.pfLive.readyMs") / 1000
             marked = driver.execute_script("return Object.keys(window.pfLive.shownMarking()).length")
+            held = driver.execute_script("return Object.keys(window.pfLive.marking()).length")
             process.wait()
-        print(f"browser: page ready with {marked} places marked, {shown:.2f} s after navigation")
+        print(f"browser: page ready {shown:.2f} s after navigation, showing tokens in {marked} of the picture's"
+              f" places or agents' boxes (a folded net: one box per agent); {held} places marked in the snapshot")
         return shown
     finally:
         driver.quit()
+
+
+def chromium():
+    """Headless Chromium through Selenium (Debian's chromium and chromium-driver)."""
+    import shutil
+
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    options = webdriver.ChromeOptions()
+    options.binary_location = shutil.which("chromium")
+    for argument in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                     "--window-size=1400,1000"):
+        options.add_argument(argument)
+    return webdriver.Chrome(service=Service(shutil.which("chromedriver")), options=options)
+
+
+def heap(driver) -> tuple[float, float]:
+    """The page's JavaScript heap in use, MB: as it is, and after a full garbage collection
+    (what the page holds on to)."""
+    def used() -> float:
+        metrics = driver.execute_cdp_cmd("Performance.getMetrics", {})["metrics"]
+        return next(m["value"] for m in metrics if m["name"] == "JSHeapUsedSize") / 1e6
+
+    raw = used()
+    driver.execute_cdp_cmd("HeapProfiler.collectGarbage", {})
+    return raw, used()
+
+
+#: A net that never ends and makes events as fast as it can: sixty transitions, each
+#: firing again and again (a 10 ms action), about 2,000 lines a second for the page.
+def busy(seconds: float) -> str:
+    """A net that never ends: 60 transitions, each waiting ``seconds`` then firing again."""
+    return ("petriflow: 1\nplaces: [" + ", ".join(f"{{id: p{i}, tokens: 1}}" for i in range(60)) + "]\ntransitions:\n"
+            + "".join(f"- {{id: t{i}, action: core.wait, params: {{seconds: {seconds}}}, in: [p{i}], out: [p{i}]}}\n"
+                      for i in range(60)))
+
+
+def memory(seconds: float, every: float, folder: Path, mission: bool, paced: bool = False) -> None:
+    """The page's memory over a long run: the page open from the start for ``seconds`` of
+    wall time (or until the run ends), its JS heap sampled every ``every`` s. The run is
+    the 20-robot mission (``mission``; it ends after about 190 s simulated) or a net that
+    never ends and sends the page more events a second than the mission does; ``paced``: that
+    net's transitions wait 1 s each and the run keeps to the wall clock (``--realtime``), so
+    a run of an hour is an hour of simulated time at little CPU."""
+    if mission:
+        command = [*RUN, "--until", "1e9", "--live", "0"]
+    else:
+        (folder / "busy.yaml").write_text(busy(1.0 if paced else 0.01))
+        command = [sys.executable, "-c", "import sys; from petriflow.cli import main; sys.exit(main())", "run",
+                   str(folder / "busy.yaml"), "--until", "1e9", "--quiet", "--live", "0",
+                   *(["--realtime"] if paced else [])]
+    driver = chromium()
+    stderr = folder / "memory-run.txt"
+    samples = []
+    try:
+        with open(stderr, "w") as err:
+            process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=err)
+            try:
+                driver.get(live_url(stderr, process))
+                driver.execute_cdp_cmd("Performance.enable", {})
+                started = time.monotonic()
+                while not driver.execute_script("return window.pfLive && window.pfLive.ready"):
+                    time.sleep(0.05)
+                while True:
+                    state = driver.execute_script("const l = window.pfLive; return [l.time, l.updates, l.received,"
+                                                  " l.events, !!l.stop]")
+                    raw, kept = heap(driver)
+                    samples.append((time.monotonic() - started, *state[:4], raw, kept))
+                    print(f"  {samples[-1][0]:7.1f} s wall, t = {state[0]:7.1f} s: {state[1]} updates,"
+                          f" {state[2]} events received, {state[3]} held; heap {raw:.2f} MB, {kept:.2f} MB"
+                          " after GC", flush=True)
+                    if state[4] or process.poll() is not None or samples[-1][0] >= seconds:
+                        break
+                    time.sleep(every)
+            finally:
+                if process.poll() is None:
+                    process.kill()
+                process.wait()
+    finally:
+        driver.quit()
+    kept = [s[6] for s in samples]
+    print()
+    what = ("the 20-robot bidding mission" if mission else "a net of 60 transitions of 1 s each, in real time"
+            if paced else "a net of 60 transitions firing as fast as they can")
+    flag = " --mission" if mission else " --paced" if paced else ""
+    print(f"`python bench/live.py --memory {seconds:g} --every {every:g}{flag}` ({what},"
+          f" page open from the start, {samples[-1][0]:.0f} s of wall time)")
+    print()
+    print("| | wall (s) | simulated (s) | updates | events received | events held | JS heap after GC (MB) |")
+    print("|---|---|---|---|---|---|---|")
+    first, last = samples[0], samples[-1]
+    top = max(samples, key=lambda s: s[6])
+    for name, row in (("start", first), ("end", last), ("max", top)):
+        print(f"| {name} | {row[0]:.0f} | {row[1]:.0f} | {row[2]} | {row[3]} | {row[4]} | {row[6]:.2f} |")
+    print(f"\nheap after GC: start {kept[0]:.2f} MB, end {kept[-1]:.2f} MB, max {max(kept):.2f} MB;"
+          f" in use (no GC) at most {max(s[5] for s in samples):.2f} MB")
 
 
 def main() -> None:
@@ -128,9 +239,20 @@ def main() -> None:
     parser.add_argument("--pairs", type=int, default=3)
     parser.add_argument("--until", type=float, default=60.0, help="simulated seconds of each run")
     parser.add_argument("--browser", action="store_true", help="also open the page mid-run in Chromium")
+    parser.add_argument("--memory", type=float, metavar="SECONDS",
+                        help="instead: the page's JS heap over SECONDS of wall time of one run (Chromium)")
+    parser.add_argument("--every", type=float, default=10.0, help="with --memory: wall seconds between samples")
+    parser.add_argument("--mission", action="store_true",
+                        help="with --memory: the 20-robot mission (it ends after ~190 s simulated) instead of a net"
+                             " that never ends")
+    parser.add_argument("--paced", action="store_true",
+                        help="with --memory: the net that never ends, 1 s a firing, kept to the wall clock (an hour's run)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="petriflow-bench-live-") as name:
         folder = Path(name)
+        if args.memory:
+            memory(args.memory, args.every, folder, args.mission, args.paced)
+            return
         rows = []
         for k in range(args.pairs):
             plain = one(args.until, False, folder)

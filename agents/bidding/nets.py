@@ -190,7 +190,7 @@ def build(robots: int = 2, deployment: str = "autonomous", *, lists: list[list[i
         mission["lists"] = [[int(z) for z in zs] for zs in lists]
     if zones is not None:
         mission["zones"] = [[float(v) for v in z] for z in zones]
-    b = NetBuilder(f"bidding-{deployment}-{robots}", label=f"seed 004 collaborative mapping: {robots}"
+    b = NetBuilder(f"bidding-{deployment}-{robots}", label=f"collaborative mapping: {robots}"
                    f" robot{'s' if robots > 1 else ''}, {deployment} deployment")
     operator, _ = _agent(b, "operator", "the human operator", "bidding.operator", listens=False)
     if not is_capacity(mailbox):

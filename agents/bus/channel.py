@@ -228,6 +228,7 @@ class BusView:
     * :meth:`quiet_for`: how long the bus has been quiet, now;
     * :attr:`sender_in_identifier`: whether the sender's address travels in the frame's
       identifier (CAN), so a payload need not carry it;
+    * :attr:`loop_cost`: what each iteration of the module's loop spends on the bus;
     * :meth:`sniff`, :meth:`captured`: for a sniffer's agent, join the bus as a sniffer
       and count what it captured.
 
@@ -246,6 +247,12 @@ class BusView:
     def sender_in_identifier(self) -> bool:
         """The sender's address travels in the frame's identifier (CAN)."""
         return bool(self._carrier.bus.sender_in_identifier)
+
+    @property
+    def loop_cost(self) -> float:
+        """Seconds each iteration of the module's control loop spends on the bus's
+        interface (the bus's ``loop_cost``)."""
+        return float(self._carrier.bus.loop_cost)
 
     def reads_every(self, period: float, start: float | None = None) -> None:
         """This module reads its receive buffer every ``period`` seconds (0: on arrival),

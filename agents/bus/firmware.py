@@ -218,12 +218,14 @@ class Boot(_Timed):
         address = addresses[name]
         rng = ctx.rng
         rate = 1.0 + rng.uniform(-p["crystal_ppm"], p["crystal_ppm"]) * 1e-6
+        # one iteration: the control step and what the bus's interface costs each iteration
+        step = p["step_time"] + max((ctx.medium(place).loop_cost for place in p["mailboxes"]), default=0.0)
         if p["algorithm"] == 1:
-            scheme: Any = NativeScheme(address, len(chain), rng, step_time=p["step_time"], max_delay=p["max_delay"])
-            read_every = p["step_time"] + scheme.delay  # its reception runs once per iteration, after the wait
+            scheme: Any = NativeScheme(address, len(chain), rng, step_time=step, max_delay=p["max_delay"])
+            read_every = step + scheme.delay  # its reception runs once per iteration, after the wait
         else:
-            scheme = BusAwareScheme(address, len(chain), rng, step_time=p["step_time"], idle_window=p["idle_window"])
-            read_every = p["step_time"]
+            scheme = BusAwareScheme(address, len(chain), rng, step_time=step, idle_window=p["idle_window"])
+            read_every = step
         read_every = 0.0 if p["reception"] == "interrupt" else read_every * rate
         parameters = CpgParameters(lag=p["lag"], dt=p["step_time"])
         oscillator = Oscillator(parameters, rng.uniform(0.0, 2 * math.pi), address > 0, address < len(chain) - 1)

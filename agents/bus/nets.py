@@ -163,7 +163,7 @@ def build(modules: int = 3, algorithm: int = 2, *, messages: int = 100, step_tim
         raise ValueError(f"messages must be >= 1, got {messages}")
     chain = [f"m{k + 1}" for k in range(modules)]
     b = NetBuilder(f"bus-algorithm{algorithm}-{modules}",
-                   label=f"seed 002: {modules} modules, algorithm {algorithm}")
+                   label=f"{modules} modules on a shared bus, algorithm {algorithm}")
     # every place first (a module sends into its neighbour's mailbox), in the net's order
     chained = [_Module(b.agent(name, label=f"module {name}"), chain[k - 1] if k > 0 else None,
                        chain[k + 1] if k + 1 < modules else None, []) for k, name in enumerate(chain)]

@@ -18,6 +18,13 @@ broadcast for all of them, a newer one replacing it
 (:attr:`~petriflow.agents.bus.records.Loss.PARENT_BUFFER`). The parameters are
 :class:`~petriflow.agents.bus.parameters.ZigbeeBus`.
 
+With ``addressing: unicast`` each device's own address is used instead: a frame goes as
+one acknowledged unicast to each of its addressees (to an end device through its parent,
+which buffers it until the child polls), retried ``mac_retries`` times when no
+acknowledgement comes; nobody relays it and no broadcast transaction table records it.
+A frame for no module (an address nobody holds) is a unicast nobody acknowledges: it is
+sent ``mac_retries`` + 1 times. A sniffer overhears every intact unicast in its range.
+
 Examples:
     Three routers in range: the originator's frame and one relay from each other node;
     each hears every other relay, so nobody retransmits.
@@ -110,23 +117,28 @@ class _Hop(Name):
     """An end device's frame to its parent (acknowledged, retried)."""
     BROADCAST = "broadcast"
     """A network broadcast (the sender then listens for passive acknowledgements)."""
+    UNICAST = "unicast"
+    """A frame to one node (``addressing: unicast``; acknowledged, retried)."""
 
 
 class _Broadcast:
-    """One payload-addressed frame as a ZigBee network broadcast: which nodes have it,
-    why the others have not (yet), and how much of its relaying is still under way."""
+    """One frame on the ZigBee network, a network broadcast or (``targets`` not ``None``)
+    unicasts to its addressees: which nodes have it, why the others have not (yet), and
+    how much of its relaying is still under way."""
 
-    __slots__ = ("frame", "origin", "key", "pending", "reached", "why", "heard", "tries", "intact", "done")
+    __slots__ = ("frame", "origin", "key", "pending", "reached", "why", "heard", "tries", "intact", "done",
+                 "targets")
 
-    def __init__(self, frame: Frame, origin: int, key: Any) -> None:
+    def __init__(self, frame: Frame, origin: int, key: Any, targets: frozenset[int] | None = None) -> None:
         self.frame = frame
+        self.targets = targets
         self.origin = origin
         self.key = key
         self.pending = 0  # transmissions, jitter waits, passive-ack waits and polls to come
         self.reached: set[int] = {origin}
         self.why: dict[int | None, Loss] = {}
         self.heard: dict[int, set[int]] = {}  # node -> the routers it heard transmit this broadcast
-        self.tries: dict[int, int] = {}
+        self.tries: dict[Any, int] = {}  # node (or (node, next hop) for a unicast) -> transmissions
         self.intact = False
         self.done = False
 
@@ -149,7 +161,8 @@ class ZigbeeNetworkMedium(BusMedium):
         self.radio = CsmaCa(bus, clock, rng, on_start=self._started, on_sent=self._sent,
                             on_failure=self._failed, on_free=self._free, positions=positions)
         self._tables: dict[int, BroadcastTable] = {}
-        self._outbox: dict[int, deque[tuple[_Broadcast, _Hop]]] = {}  # what each radio has to send
+        # what each radio has to send: (frame, hop, next hop of a unicast)
+        self._outbox: dict[int, deque[tuple[_Broadcast, _Hop, int | None]]] = {}
         self._uart_free: dict[int, float] = {}
         self._buffered: dict[int, tuple[_Broadcast, set[int]]] = {}  # parent -> (broadcast, children to poll)
         self._polls: dict[int, Timer] = {}
@@ -210,7 +223,14 @@ class ZigbeeNetworkMedium(BusMedium):
         """The radio has the frame from its host's UART: a new broadcast."""
         frame = self._queues[node].popleft()
         self._sequence += 1
-        broadcast = _Broadcast(frame, node, (node, self._sequence))
+        unicast = self.bus.addressing == "unicast"
+        broadcast = _Broadcast(frame, node, (node, self._sequence),
+                               frozenset(frame.receivers) - {node} if unicast else None)
+        if unicast and self.role(node) is not Role.END_DEVICE:
+            if not broadcast.targets:
+                self._push(node, broadcast, _Hop.UNICAST, None)
+            self._forward(node, broadcast)
+            return
         if self.role(node) is Role.END_DEVICE:
             self._push(node, broadcast, _Hop.UP)
             return
@@ -228,6 +248,17 @@ class ZigbeeNetworkMedium(BusMedium):
         if node in broadcast.reached:
             return  # a duplicate: only a passive acknowledgement
         now = self.clock.now
+        if broadcast.targets is not None:  # a unicast: its addressee, or the parent of some
+            broadcast.reached.add(node)
+            broadcast.why.pop(node, None)
+            if node in broadcast.targets or node in self.sniffers:
+                frame = broadcast.frame
+                self.clock.at(now + self.bus.uart_time(len(frame.data)), self._arrive, frame, node, rank=MEDIUM)
+            if node not in self.sniffers and self.parent(broadcast.origin) == node:
+                self._forward(node, broadcast)  # from its end device: on to every addressee
+            elif node not in self.sniffers:
+                self._buffer_for_children(node, broadcast)  # its own end devices' copies
+            return
         if not self._tables[node].record(broadcast.key, now):
             broadcast.why[node] = Loss.BTT_FULL
             for child in self.modules:  # its end devices get nothing from it either
@@ -247,9 +278,24 @@ class ZigbeeNetworkMedium(BusMedium):
         broadcast.pending -= 1
         self._push(node, broadcast, _Hop.BROADCAST)
 
+    def _forward(self, node: int, broadcast: _Broadcast) -> None:
+        """A unicast at ``node``: one to each addressee it has not reached whose next hop
+        is another node (the addressee, or an end device's parent); ``node``'s own end
+        devices get it when they poll."""
+        hops = []
+        for target in sorted(broadcast.targets or ()):
+            hop = self.parent(target) if self.role(target) is Role.END_DEVICE else target
+            if target not in broadcast.reached and hop not in (node, None) and hop not in hops \
+                    and hop not in broadcast.reached:
+                hops.append(hop)
+        for hop in hops:
+            self._push(node, broadcast, _Hop.UNICAST, hop)
+        self._buffer_for_children(node, broadcast)
+
     # End devices --------------------------------------------------------------------------
     def _buffer_for_children(self, node: int, broadcast: _Broadcast) -> None:
-        children = {m for m in self.modules if m != broadcast.origin and self.parent(m) == node}
+        children = {m for m in self.modules if m != broadcast.origin and self.parent(m) == node
+                    and (broadcast.targets is None or m in broadcast.targets)}
         if not children:
             return
         old = self._buffered.pop(node, None)
@@ -287,15 +333,19 @@ class ZigbeeNetworkMedium(BusMedium):
         broadcast.pending -= 1
         broadcast.reached.add(child)
         broadcast.why.pop(child, None)
+        broadcast.intact = True  # the child has it intact (a unicast may reach nobody else)
         frame = broadcast.frame
         out = self.radio.airtime(frame) + self.bus.uart_time(len(frame.data))
         self.clock.at(self.clock.now + out, self._arrive, frame, child, rank=MEDIUM)
+        if broadcast.targets is not None:  # the parent's unicast to its child: a sniffer overhears it
+            for sniffer in sorted(self.sniffers - broadcast.reached):
+                self._take(sniffer, broadcast)
         self._check_done(broadcast)
 
     # Through the MAC --------------------------------------------------------------------------
-    def _push(self, node: int, broadcast: _Broadcast, hop: _Hop) -> None:
+    def _push(self, node: int, broadcast: _Broadcast, hop: _Hop, to: int | None = None) -> None:
         broadcast.pending += 1
-        self._outbox[node].append((broadcast, hop))
+        self._outbox[node].append((broadcast, hop, to))
         if not self.radio.serving(node):
             self._serve(node)
 
@@ -304,17 +354,17 @@ class ZigbeeNetworkMedium(BusMedium):
         self.radio.send(node, self._outbox[node][0][0].frame)
 
     def _sent(self, node: int, transmission: Transmission) -> None:
-        broadcast, hop = self._outbox[node][0]
+        broadcast, hop, to = self._outbox[node][0]
         if not transmission.garbled:
             broadcast.intact = True
         self._ended(transmission)
-        self._after(node, broadcast, hop, transmission)
+        self._after(node, broadcast, hop, transmission, to)
         self._outbox[node].popleft()
 
     def _failed(self, node: int) -> None:
-        broadcast, hop = self._outbox[node][0]
+        broadcast, hop, to = self._outbox[node][0]
         broadcast.why.setdefault(None, Loss.ACCESS_FAILURE)
-        self._after(node, broadcast, hop, None)
+        self._after(node, broadcast, hop, None, to)
         self._outbox[node].popleft()
 
     def _free(self, node: int) -> None:
@@ -323,10 +373,26 @@ class ZigbeeNetworkMedium(BusMedium):
         elif not self._queues[node]:
             self._notify_idle([node])
 
-    def _after(self, node: int, broadcast: _Broadcast, hop: _Hop, transmission: Transmission | None) -> None:
-        """``node``'s transmission of ``broadcast`` is over (``None``: CSMA/CA gave up)."""
+    def _after(self, node: int, broadcast: _Broadcast, hop: _Hop, transmission: Transmission | None,
+               to: int | None = None) -> None:
+        """``node``'s transmission of ``broadcast`` is over (``None``: CSMA/CA gave up);
+        ``to``: a unicast's next hop."""
         broadcast.tries[node] = broadcast.tries.get(node, 0) + 1
-        if hop is _Hop.UP:
+        if broadcast.targets is not None and transmission is not None and not transmission.garbled:
+            for sniffer in self.sniffers:  # a sniffer overhears every unicast in its range
+                if sniffer != node and self.radio.survives(node, sniffer, transmission):
+                    self._take(sniffer, broadcast)
+        if hop is _Hop.UNICAST:
+            tries = broadcast.tries[(node, to)] = broadcast.tries.get((node, to), 0) + 1
+            if to is not None and transmission is not None and not transmission.garbled \
+                    and self.radio.survives(node, to, transmission):
+                self._take(to, broadcast)
+            else:
+                if transmission is not None and to is not None:
+                    broadcast.why[to] = Loss.COLLISION if transmission.garbled else Loss.RADIO
+                if tries <= self.bus.mac_retries:
+                    self._push(node, broadcast, _Hop.UNICAST, to)
+        elif hop is _Hop.UP:
             parent = self.parent(node)
             if transmission is not None and not transmission.garbled and parent is not None \
                     and self.radio.survives(node, parent, transmission):
@@ -379,5 +445,6 @@ class ZigbeeNetworkMedium(BusMedium):
             return
         default = broadcast.why.get(None, Loss.COLLISION)
         for node in self.modules:
-            if node not in broadcast.reached:
+            if node not in broadcast.reached and (broadcast.targets is None or node in broadcast.targets
+                                                  or node in self.sniffers):
                 self._lost(Lost(broadcast.frame, node, broadcast.why.get(node, default), now))

@@ -83,6 +83,10 @@ class BusModel(Medium):
         acceptance_filter: only frames addressed to a module enter its buffer.
         read_period: how often a module reads its receive buffer, until its firmware
             says otherwise (0: on arrival).
+        loop_cost: seconds each iteration of a module's control loop spends driving
+            its bus interface (a controller's registers, a driver), added to the
+            iteration (0: none); the firmware asks it through
+            :attr:`~petriflow.agents.bus.channel.BusView.loop_cost`.
         logs: in a run, keep every transmission, delivery and loss in the medium's
             lists (memory grows with the run; for tests and figures).
         sender_in_identifier: (class constant) the sender's address travels in the
@@ -93,6 +97,7 @@ class BusModel(Medium):
     rx_buffer: int = _ranged(1, 1, 10_000)
     acceptance_filter: bool = False
     read_period: float = _ranged(0.0, 0.0, 3600.0)
+    loop_cost: float = _ranged(0.0, 0.0, 10.0)
     logs: bool = False
 
     sender_in_identifier: ClassVar[bool] = False
@@ -196,7 +201,11 @@ class CanBus(BusModel):
 @dataclass
 class ZigbeeBus(BusModel):
     """XBee radios: UART at ``uart_baud`` to each module, 802.15.4 CSMA/CA on the air;
-    a ZigBee network unless ``network`` is false (see the module).
+    a ZigBee network unless ``network`` is false (see the module). ``addressing``:
+    ``broadcast`` (the default: a payload-addressed frame is a network broadcast, the
+    XBee's transparent mode to 0xFFFF) or ``unicast`` (each module has its own address: a
+    frame goes, acknowledged, to each of its addressees only;
+    :mod:`~petriflow.agents.bus.network`).
 
     Examples:
         >>> bus = ZigbeeBus()
@@ -232,10 +241,13 @@ class ZigbeeBus(BusModel):
     max_jitter: float = _ranged(0.063, 0.0, 10.0)
     poll_period: float = _ranged(0.1, 1e-4, 60.0)
     mac_retries: int = _ranged(3, 0, 10)
+    addressing: str = "broadcast"
 
     def __post_init__(self) -> None:
         if self.min_be > self.max_be:
             raise FrameError(f"min_be {self.min_be} is above max_be {self.max_be}")
+        if self.addressing not in ("broadcast", "unicast"):
+            raise FrameError(f"addressing is 'broadcast' or 'unicast', not {self.addressing!r}")
         if self.roles not in ("routers", "end_devices"):
             raise FrameError(f"roles is 'routers' or 'end_devices', not {self.roles!r}")
 

@@ -206,6 +206,9 @@ class CsmaCa:
 
 class ZigbeeMedium(BusMedium):
     """XBee radios sharing the air with unslotted CSMA/CA, single hop (see the module).
+    With ``addressing: unicast`` a radio hands its module only frames addressed to it (a
+    sniffer takes all); acknowledgements and retries are the network's
+    (:class:`~petriflow.agents.bus.network.ZigbeeNetworkMedium`), not this medium's.
 
     Attributes:
         radio: the radios on the air (:class:`CsmaCa`).
@@ -256,9 +259,10 @@ class ZigbeeMedium(BusMedium):
         self._ended(transmission)
         if not transmission.garbled:
             out = self.bus.uart_time(len(frame.data))
+            unicast = self.bus.addressing == "unicast"
             for module in self.modules:
-                if module == sender:
-                    continue
+                if module == sender or (unicast and module not in frame.receivers and module not in self.sniffers):
+                    continue  # with unicast addressing a radio drops frames for other addresses
                 if self.radio.survives(sender, module, transmission):
                     self.clock.at(now + out, self._arrive, frame, module, rank=MEDIUM)
                 else:

@@ -107,7 +107,7 @@ def build(robots: int = 2, mode: str = "decentralised", monitor: bool = False, *
     breakdown = {} if breakdown is None else {breakdown: float(fail_at)}
     peers = {a["name"]: [p["name"] for p in _peers(a, agents, mode)] for a in agents}
     b = NetBuilder(f"comm-{mode}-{robots}{'-monitor' if monitor else ''}",
-                   label=f"seed 000 mapping mission: {robots} robots, {mode}{', a monitor' if monitor else ''}")
+                   label=f"mapping mission: {robots} robots, {mode}{', a monitor' if monitor else ''}")
     subnets = {a["name"]: b.agent(a["name"], label=f"{a['kind']} {a['name']} (192.168.1.{a['address']})",
                                   state="comm.agent") for a in agents}
     address = {a["name"]: a["address"] for a in agents}

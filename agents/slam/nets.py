@@ -84,7 +84,7 @@ def build(mode: str = "decentralised", robots: int = 1, reserves: int = 1, was: 
     was = was if mode == "decentralised" else 0
     total = robots + reserves
     names = [f"ra{j}" for j in range(1, total + 1)]
-    label = f"seed 001: {robots} RA{'s' if robots > 1 else ''}, {reserves} in reserve, {mode}"
+    label = f"SLAM mission: {robots} RA{'s' if robots > 1 else ''}, {reserves} in reserve, {mode}"
     b = NetBuilder(f"slam-{mode}" + (f"-{robots}" if robots > 1 else ""), label=label)
     ras = {name: b.agent(name, label=f"robotic agent {name}", state="slam.robot") for name in names}
     wa_names = {name: [f"wa_r{j}_{k}" for k in range(1, was + 1)] for j, name in enumerate(names, 1)}

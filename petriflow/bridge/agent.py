@@ -21,6 +21,15 @@ JSON line per goal executed, for the operator (and the tests) to count execution
 
 ``speed`` runs the agent's clock faster than the wall clock (2: twice as fast), for
 demonstrations and tests; a robot runs at 1.
+
+Threads: the goals are executed on one thread, the one that calls :meth:`AgentServer.serve`
+(every ``setup``, ``start``, ``poll``, ``cancel`` and ``teardown``, one at a time, in the
+order the messages came: action code is never concurrent with itself). A second thread
+sends the heartbeats (and an announcement every four) of every name served, listing the
+goals held, whatever the action thread does: an action computing for a minute inside
+``start`` or ``poll`` leaves its agent alive to the run. What comes in meanwhile (goals,
+cancels) waits in the inbox for the action thread: a cancel is carried out, and
+acknowledged, when the computing call returns.
 """
 
 from __future__ import annotations
@@ -126,6 +135,7 @@ class AgentServer:
         self.executed = 0
         self.dropped = 0
         self._stop = threading.Event()
+        self._held = threading.Lock()  # self.running, between the action thread and the heartbeats
         self._start = now()
         self._dt = float(getattr(world, "dt", None) or 0.01)
         for name in self.names:
@@ -149,7 +159,7 @@ class AgentServer:
 
     def call(self, goal: protocol.Goal, service: str, method: str, args: list[Any]) -> Any:
         """Ask the run's ``service`` for a running goal and wait for its reply (sent again
-        every two heartbeats; heartbeats go on meanwhile).
+        every two heartbeats; the heartbeat thread goes on meanwhile).
 
         Raises:
             CallRefused: the run refused it (the reply's error), or no reply came within
@@ -158,20 +168,16 @@ class AgentServer:
         number = self.calls[goal.id] = self.calls.get(goal.id, 0) + 1
         message = protocol.Call(goal.id, goal.agent, number, service, method, protocol.to_data(args))
         self._send(goal.agent, message)
-        start = self.wall()
-        resend = next_beat = start
+        start = resend = self.wall()
         while True:
             wall = self.wall()
             if wall - start > self.call_timeout:
                 raise CallRefused(f"{service}.{method}: no reply from the run within {self.call_timeout:g} s")
-            if wall >= next_beat:
-                next_beat = wall + self.heartbeat
-                self._beat(announce=False)
             if wall - resend >= 2 * self.heartbeat:
                 resend = wall
                 self._send(goal.agent, message)
             try:
-                reply = self.replies.get(timeout=max(0.0, min(next_beat, resend + 2 * self.heartbeat) - wall))
+                reply = self.replies.get(timeout=max(0.0, resend + 2 * self.heartbeat - wall))
             except queue.Empty:
                 continue
             if reply.id != goal.id or reply.call != number:
@@ -194,19 +200,18 @@ class AgentServer:
         self.inbox.put(("", b""))
 
     def serve(self, until: Callable[[], bool] | None = None) -> None:
-        """Serve goals until :meth:`stop` (or ``until()`` is true); running goals are
+        """Serve goals until :meth:`stop` (or ``until()`` is true), on this thread, with
+        the heartbeats on a thread of their own (see the module); running goals are
         cancelled and every action torn down at the end."""
         self.announce()
-        beats = 0
-        next_beat = self.wall() + self.heartbeat
+        beating = threading.Event()
+        beats = threading.Thread(target=self._heartbeats, args=(beating,), name="petriflow-agent-heartbeat",
+                                 daemon=True)
+        beats.start()
         next_step = self.wall()
         try:
             while not self._stop.is_set() and not (until is not None and until()):
                 wall = self.wall()
-                if wall >= next_beat:
-                    beats += 1
-                    next_beat = wall + self.heartbeat
-                    self._beat(announce=beats % 4 == 0)
                 if wall >= next_step:
                     next_step += self._dt / self.speed
                     if next_step < wall:
@@ -214,7 +219,7 @@ class AgentServer:
                     if self.world is not None and self.running:
                         self.world.step()
                     self._poll_all()
-                wait = max(0.0, min(next_beat, next_step if self.running else next_beat) - self.wall())
+                wait = max(0.0, next_step - self.wall()) if self.running else self.heartbeat
                 try:
                     topic, payload = self.inbox.get(timeout=wait)
                 except queue.Empty:
@@ -229,6 +234,8 @@ class AgentServer:
                     if topic:
                         self.handle(agent_of(topic), payload)
         finally:
+            beating.set()
+            beats.join(timeout=10)
             for goal_id in list(self.running):
                 self._finish_cancel(goal_id, force=True)
             for action in self.instances.values():
@@ -237,12 +244,33 @@ class AgentServer:
                 except Exception as exc:
                     log.warning("teardown failed: %s", exc)
 
+    def _heartbeats(self, done: threading.Event) -> None:
+        """The heartbeat thread: every :attr:`heartbeat` seconds until ``done``, one
+        heartbeat per name served (listing its goals held), an announcement every four."""
+        beats = 0
+        while not done.wait(self.heartbeat):
+            beats += 1
+            try:
+                self._beat(announce=beats % 4 == 0)
+            except Exception as exc:  # a transport error must not end the heartbeats
+                log.warning("heartbeat failed: %s", exc)
+
     def _beat(self, announce: bool) -> None:
         if announce:
             self.announce()
+        with self._held:
+            held = [(g, r.goal.agent) for g, r in self.running.items()]
         for name in self.names:
-            running = [g for g, r in self.running.items() if r.goal.agent == name]
-            self._send(name, protocol.Heartbeat(name, running, self.instance))
+            goals = [goal_id for goal_id, agent in held if agent == name]
+            self._send(name, protocol.Heartbeat(name, goals, self.instance))
+
+    def _hold(self, running: _Running) -> None:
+        with self._held:
+            self.running[running.goal.id] = running
+
+    def _release(self, goal_id: str) -> None:
+        with self._held:
+            del self.running[goal_id]
 
     # one message -----------------------------------------------------------------------------
     def handle(self, agent: str, payload: bytes) -> None:
@@ -292,7 +320,7 @@ class AgentServer:
             log.warning("cancel of %s raised %s", goal_id, exc)
             done = True
         if done or force:
-            del self.running[goal_id]
+            self._release(goal_id)
             self._remember(goal_id, protocol.Cancelled(goal_id, running.goal.agent))
 
     def _remember(self, goal_id: str, answer: protocol.BridgeMessage) -> None:
@@ -339,7 +367,8 @@ class AgentServer:
         if setup_error is not None:
             self._end(goal, ctx, Status.FAILED, setup_error)
             return
-        running = self.running[goal.id] = _Running(goal, action, ctx)
+        running = _Running(goal, action, ctx)
+        self._hold(running)
         try:
             seconds = action.delay()
         except Exception:
@@ -351,7 +380,7 @@ class AgentServer:
         try:
             action.start(ctx)
         except Exception as exc:
-            del self.running[goal.id]
+            self._release(goal.id)
             self._end(goal, ctx, Status.FAILED, f"{type(exc).__name__}: {exc}")
             return
         wake = action.wake_at
@@ -385,7 +414,7 @@ class AgentServer:
                 status = Status.FAILED
         if status is Status.RUNNING:
             return
-        del self.running[running.goal.id]
+        self._release(running.goal.id)
         self._end(running.goal, ctx, status if status in (Status.OK, Status.FAILED) else Status.FAILED,
                   ctx.reason or ("" if status in (Status.OK, Status.FAILED) else f"poll() returned {status!r}"))
 

@@ -65,6 +65,8 @@ class GoalState:
         data: the result's output token data.
         reason: why it failed or was rejected.
         cancel_sent: wall-clock time a cancel was sent (``None``: none).
+        cancels_resent: how many times the cancel was sent again (not acknowledged yet:
+            an agent computing answers each when its action's call returns).
         feedback: the last feedback's data.
     """
 
@@ -77,6 +79,7 @@ class GoalState:
     data: Any = None
     reason: str = ""
     cancel_sent: float | None = None
+    cancels_resent: int = 0
     feedback: Any = None
     #: Calls of the goal's action waiting for the kernel to answer them (:mod:`~.calls`).
     calls: list[protocol.Call] = field(default_factory=list)
@@ -263,8 +266,11 @@ class Dispatcher:
                     state.phase, state.answered = Phase.CANCELLED, now
                 if state.ended:
                     self._ended.notify_all()
-        # an answer to a goal sent again is expected twice; otherwise an ended goal's answer is a replay
-        if replayed and state.resent == 0 and not isinstance(message, (protocol.Accepted, protocol.Feedback)):
+        # an answer to a goal or a cancel sent again is expected twice; otherwise an ended goal's
+        # answer is a replay
+        expected = state.resent or state.cancels_resent or \
+            isinstance(message, (protocol.Accepted, protocol.Feedback))
+        if replayed and not expected:
             self.drop(Drop.REPLAYED, f"{message.kind.value} for goal {state.goal.id!r}, which had ended")
 
     # what the run's thread calls --------------------------------------------------------
@@ -395,6 +401,7 @@ class Dispatcher:
                 if state.cancel_sent is not None:
                     if now - state.cancel_sent > period:
                         state.cancel_sent = now
+                        state.cancels_resent += 1
                         cancels.append(state.goal)
                 elif state.goal.id not in seen.running and now - state.last_sent > 2 * period and \
                         seen.last > state.last_sent:

@@ -40,9 +40,10 @@ class LineDict(dict):
 
 
 class LineList(list):
-    """A list that remembers its line."""
+    """A list that remembers its line and the line of each item."""
 
     line: int = 0
+    item_lines: list[int] = []
 
 
 _Composer = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
@@ -144,6 +145,7 @@ class _Builder:
         if kind is yaml.SequenceNode:
             result = LineList()
             result.line = node.start_mark.line + 1
+            result.item_lines = [child.start_mark.line + 1 for child in node.value]
             result.extend(self.build(child, depth + 1) for child in node.value)
             return result
         if kind is not yaml.MappingNode:  # pragma: no cover - the composer makes only these

@@ -102,6 +102,10 @@ class _Reader:
             self.net.run = _exact(run, "an inline 'run' configuration", lambda m: self.fail(
                 m, data, line=data.key_lines.get("run")))
             self.net.lines["run"] = data.key_lines.get("run", data.line)
+            for key, at in getattr(run, "key_lines", {}).items():  # where each setting is, for its errors
+                self.net.lines[f"run.{key}"] = at
+                for i, item_at in enumerate(getattr(run[key], "item_lines", ())):
+                    self.net.lines[f"run.{key}/{i}"] = item_at
         for subnet in self.as_list(data.get("subnets"), "subnets", data):
             self.read_subnet(subnet)
         places = self.as_list(data.get("places"), "places", data)

@@ -2,30 +2,38 @@
 latest events, and the controls (pause, resume, step, breakpoints, tokens, forced
 outcomes, speed).
 
-The page is made once, before the run, from the net (no trace: the run's state comes
-over the WebSocket, :mod:`petriflow.live.server`). It reuses the run page's net panel
-(``panel-net.js``, the same picture as ``petriflow view``); a net too big to draw
-readably (the threshold ``export`` folds at, :func:`petriflow.fold.should_fold`) is
-drawn folded, one box per agent, and a click on a box opens that agent's subnet.
+The page is made from the net alone (no trace: the run's state comes over the
+WebSocket, :mod:`petriflow.live.server`), and only when a page is first asked for
+(:class:`LivePage`): a run served live that nobody watches draws nothing, and the
+drawing is done in the server's thread, not before the run. It reuses the run page's
+net panel (``panel-net.js``, the same picture as ``petriflow view``); a net too big to
+draw readably (the threshold ``export`` folds at, :func:`petriflow.fold.should_fold`)
+is drawn folded, one box per agent, and a click on a box opens that agent's subnet,
+which is drawn then (:meth:`LivePage.part`, served at ``/part?key=agent:SUBNET``) and
+kept: the 20-robot mission's 22 subnets cost a second of Graphviz that a page opening
+one of them does not need.
 """
 
 from __future__ import annotations
 
 import html
+import threading
 from typing import Any
 
-from petriflow.view.page import pack, render
+from petriflow.view.page import render
 
-__all__ = ["live_page"]
+__all__ = ["live_page", "LivePage"]
 
 SCRIPTS = ["common.js", "panel-net.js", "live.js"]
 
 
-def live_page(net: Any) -> str:
-    """The HTML of the live page of a run of ``net``."""
+def live_page(net: Any, *, subnets: bool = True) -> str:
+    """The HTML of the live page of a run of ``net``; ``subnets=False``: a folded net's
+    subnets are left out, for the page to ask for when one is opened."""
+    from petriflow.view.page import pack
     from petriflow.view.run_page import net_pictures
 
-    svg, why, folded = net_pictures(net)
+    svg, why, folded = net_pictures(net, subnets=subnets)
     agents = {s.id: (s.agent or s.id) for s in net.subnets.values()}
     data = {
         "kind": "live",
@@ -39,13 +47,51 @@ def live_page(net: Any) -> str:
                             for t in net.transitions.values()},
     }
     title = f"{net.id}: live run"
-    return render(title=title, body=_BODY.replace("{title}", html.escape(title)), data=data, scripts=SCRIPTS,
+    about = net.label if net.label and net.label != net.id else ""  # the net's own description
+    body = _BODY.replace("{title}", html.escape(title)).replace("{about}", html.escape(about))
+    return render(title=f"{title}: {about}" if about else title, body=body, data=data, scripts=SCRIPTS,
                   styles=["common.css", "run.css"], connect=True)
+
+
+class LivePage:
+    """A run's live page and the pictures of its subnets, each made when first asked
+    for, then kept (thread-safe: the server asks from its own threads).
+
+    Args:
+        net: the net run.
+    """
+
+    def __init__(self, net: Any) -> None:
+        self.net = net
+        self._lock = threading.Lock()
+        self._page: bytes | None = None
+        self._parts: dict[str, bytes | None] = {}
+
+    def page(self) -> bytes:
+        """The page's HTML (UTF-8)."""
+        with self._lock:
+            if self._page is None:
+                self._page = live_page(self.net, subnets=False).encode("utf-8")
+            return self._page
+
+    def part(self, key: str) -> bytes | None:
+        """The SVG of the subnet ``key`` (``agent:SUBNET``) drawn in full; ``None`` for
+        no such subnet (or no Graphviz)."""
+        from petriflow.view.run_page import subnet_picture
+
+        with self._lock:
+            if key not in self._parts:
+                svg = subnet_picture(self.net, key)
+                if svg is None:
+                    return None
+                self._parts[key] = svg.encode("utf-8")
+            return self._parts[key]
 
 
 _BODY = """
 <header>
   <h1>{title}</h1>
+  <div id="about" class="note">{about}</div>
   <div id="summary"><span id="status">connecting…</span></div>
 </header>
 <section id="controls" class="bar">

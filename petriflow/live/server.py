@@ -1,7 +1,9 @@
 """The live page's server: the run page fed as the run goes, and its controls.
 
 ``petriflow run NET --live [HOST:]PORT`` starts a :class:`LiveServer` beside the run.
-It serves, on one port, the page (``GET /?token=…``) and a WebSocket (``/ws?token=…``)
+It serves, on one port, the page (``GET /?token=…``; drawn when first asked for, and a
+folded net's subnets at ``/part?key=agent:SUBNET&token=…`` when the page opens one:
+:class:`~petriflow.live.page.LivePage`) and a WebSocket (``/ws?token=…``)
 that sends the page a snapshot when it connects, then what changed, at most
 :data:`RATE` times a second, and takes the page's (and ``petriflow ctl``'s) controls,
 which go to the run's :class:`~petriflow.runtime.control.Control` and nowhere else.
@@ -72,16 +74,17 @@ class LiveServer:
 
     Args:
         control: the run's control queue.
-        page: the page's HTML (made from the net before the run).
+        page: the page's HTML, or what makes it when first asked for (a
+            :class:`~petriflow.live.page.LivePage`: ``page()`` and ``part(key)``).
         host, port: where to listen (port 0: a free one).
         token: the secret every request must carry (default: a new random one).
         window: events a page keeps.
     """
 
-    def __init__(self, control: Control, page: str, host: str = "127.0.0.1", port: int = 0, *,
+    def __init__(self, control: Control, page: Any, host: str = "127.0.0.1", port: int = 0, *,
                  token: str | None = None, window: int = WINDOW) -> None:
         self.control = control
-        self.page = page.encode("utf-8")
+        self.page = page
         self.host, self.port = host, port
         self.token = token or secrets.token_urlsafe(24)
         self.state = LiveState(window)
@@ -94,12 +97,24 @@ class LiveServer:
         self._ready = threading.Event()
         self._done: asyncio.Event | None = None
         self._error: BaseException | None = None
-        control.listeners.append(self._inbox.append)
+        self._fresh: asyncio.Event | None = None  # set (in the server's thread) when the inbox has something
+        control.listeners.append(self._put)
 
     # The run's thread -------------------------------------------------------------
     def __call__(self, event: Event) -> None:
         """An observer of the run's events (``scheduler.on_event``)."""
-        self._inbox.append(event)
+        self._put(event)
+
+    def _put(self, item: Any) -> None:
+        """Leave ``item`` for the server's thread and wake it (it sleeps while the run
+        sends nothing: a paused run, or one between samples, costs no wakeup)."""
+        self._inbox.append(item)
+        loop, fresh = self._loop, self._fresh
+        if loop is not None and fresh is not None and not fresh.is_set():
+            try:
+                loop.call_soon_threadsafe(fresh.set)
+            except RuntimeError:  # the server has stopped; stop() drains what is left
+                pass
 
     def watch(self, scheduler: Any) -> None:
         """Follow ``scheduler``: its rare events (``run``, ``control``, ``stop``), and
@@ -126,7 +141,7 @@ class LiveServer:
             running = tuple({"t": ids[f.index], "agent": agents[f.index], "firing": f.number,
                              "since": f.ctx.started if f.ctx is not None else f.started}
                             for f in scheduler.runner.in_firing_order())
-            self._inbox.append(Sample(round(scheduler.now, 9), changed, running))
+            self._put(Sample(round(scheduler.now, 9), changed, running))
 
         scheduler.on_event(self, kinds=["run", "control", "stop"])
         scheduler.on_instant(sample)
@@ -179,6 +194,7 @@ class LiveServer:
 
         self._loop = asyncio.get_running_loop()
         self._done = asyncio.Event()
+        self._fresh = asyncio.Event()
         async with serve(self._connection, self.host, self.port, process_request=self._request,
                          max_size=MAX_FRAME, max_queue=4, open_timeout=5, ping_interval=20,
                          ping_timeout=20, close_timeout=2, server_header=None,
@@ -197,7 +213,7 @@ class LiveServer:
             for client in list(self.clients):
                 await client.close(1001, "the run ended")
 
-    def _request(self, connection: Any, request: Any) -> Any:
+    async def _request(self, connection: Any, request: Any) -> Any:
         """Every HTTP request: the token, the origin, the path; the page, or on to the
         WebSocket handshake."""
         from websockets.datastructures import Headers
@@ -223,7 +239,15 @@ class LiveServer:
         if origin is not None and urlsplit(origin).netloc != request.headers.get("Host"):
             return answer(http.HTTPStatus.FORBIDDEN, b"forbidden: another origin\n")
         if parts.path == "/":
-            return answer(http.HTTPStatus.OK, self.page, "text/html; charset=utf-8")
+            page = self.page.encode("utf-8") if isinstance(self.page, str) else \
+                await asyncio.to_thread(self.page.page)  # drawn in a thread: the updates go on
+            return answer(http.HTTPStatus.OK, page, "text/html; charset=utf-8")
+        if parts.path == "/part":
+            key = (query.get("key") or [""])[0]
+            svg = None if isinstance(self.page, str) else await asyncio.to_thread(self.page.part, key)
+            if svg is None:
+                return answer(http.HTTPStatus.NOT_FOUND, b"no such part of the net\n")
+            return answer(http.HTTPStatus.OK, svg, "image/svg+xml")
         if parts.path != "/ws":
             return answer(http.HTTPStatus.NOT_FOUND, b"not found\n")
         if "websocket" not in request.headers.get("Upgrade", "").lower():
@@ -293,9 +317,12 @@ class LiveServer:
                 state.control = item
 
     async def _publish(self) -> None:
-        """Every 1/RATE s: what changed, to every page."""
+        """What changed, to every page, when the run has left something, at most
+        :data:`RATE` times a second."""
         while True:
-            await asyncio.sleep(1.0 / RATE)
+            await self._fresh.wait()
+            await asyncio.sleep(1.0 / RATE)  # what else comes meanwhile goes in the same batch
+            self._fresh.clear()
             self._drain()
             if self.clients:
                 self._send(self.state.batch())

@@ -227,8 +227,15 @@ class RunConfig:
                  for key, at in lines.items()}
         world, located = _files(data, folder, fail)
         metrics = [] if data.get("metrics") is None else parse_refs(data["metrics"], fail)
-        breakpoints = _breakpoints(data.get("breakpoints"), lambda message: fail(message, key="breakpoints"))
-        lines["breakpoints"] = getattr(data, "key_lines", {}).get("breakpoints") or line
+        given = data.get("breakpoints")
+        at = getattr(data, "key_lines", {}).get("breakpoints") or line
+        lines["breakpoints"] = at
+        lines.update({f"breakpoints/{i}": item_at for i, item_at in enumerate(getattr(given, "item_lines", ()))})
+
+        def breakpoint_fail(message: str, i: int | None = None) -> None:
+            raise NetFormatError(message, path=path, line=lines.get(f"breakpoints/{i}") or at)
+
+        breakpoints = _breakpoints(given, breakpoint_fail)
         bridge = None if data.get("bridge") is None else BridgeSpec.from_dict(plain_data(data["bridge"]), fail)
         config = cls(seed, None if until is None else float(until), float(dt), world,
                      {str(k): dict(v) for k, v in channels.items()}, faults, path, located,
@@ -348,13 +355,13 @@ class RunConfig:
                         f"fault {fault.kind} names unknown agent {agent!r}{did_you_mean(agent, agents)}",
                         path=self.path, line=self.lines.get(f"faults/{i}"),
                     )
-        for spec in self.breakpoints:
+        for i, spec in enumerate(self.breakpoints):
             point = parse_breakpoint(spec)
             names = net.transitions if point.kind == "transition" else net.places if point.kind == "place" else None
             if names is not None and point.name not in names:
                 raise NetFormatError(f"breakpoint {spec!r}: net {net.id!r} has no {point.kind} {point.name!r}"
                                      f"{did_you_mean(point.name, list(names))}", path=self.path,
-                                     line=self.lines.get("breakpoints"))
+                                     line=self.lines.get(f"breakpoints/{i}") or self.lines.get("breakpoints"))
         if self.bridge is not None:
             names = {*net.subnets, *agents}
             for subnet in self.bridge.agents:
@@ -392,19 +399,20 @@ class RunConfig:
         return data
 
 
-def _breakpoints(given: Any, fail: Callable[[str], Any]) -> list[str]:
+def _breakpoints(given: Any, fail: Callable[..., Any]) -> list[str]:
     """A configuration's ``breakpoints``: a list of breakpoints, each checked for its
-    syntax (the names are checked against the net by :meth:`RunConfig.check`)."""
+    syntax (the names are checked against the net by :meth:`RunConfig.check`); ``fail``
+    is told the message and the index of the bad one."""
     if given is None:
         return []
     if not isinstance(given, list):
         fail(f"breakpoints is a list ({BREAKPOINT_SYNTAX}), got {given!r}")
     out = []
-    for entry in given:
+    for i, entry in enumerate(given):
         try:
             out.append(parse_breakpoint(entry).text)
         except ControlError as exc:
-            fail(str(exc))
+            fail(str(exc), i)
     return out
 
 

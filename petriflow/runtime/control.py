@@ -14,8 +14,10 @@ was asked, the checkpoint's number).
 While paused the run waits at a checkpoint: in simulation the clock stops (nothing
 moves until the run goes on); with remote agents (actions whose work goes on outside
 the process) pausing stops the dispatching of new firings, since every firing passes
-:meth:`Control.admit` first, while the actions already running go on, and their ends
-are taken in when the run goes on.
+:meth:`Control.admit` first, while the actions already running go on: the run's time
+goes on with them (its :attr:`Control.idle`, the scheduler's ``pass_paused``), their
+ends (and an agent lost, its firings ``failed``) are recorded when they happen, during
+the pause, and what they enable fires when the run goes on.
 
 **Breakpoints** (:class:`Breakpoint`, :func:`parse_breakpoint`) pause the run:
 
@@ -329,6 +331,10 @@ class Control:
         #: Called (in the run's thread) when the run stops to wait (paused): a live page
         #: samples the run's state then.
         self.waiting: list[Any] = []
+        #: Called (in the run's thread) over and over while paused, instead of sleeping,
+        #: by a run whose time goes on during a pause (remote agents): it takes in what
+        #: happens meanwhile and fires nothing; ``True`` when something happened.
+        self.idle: Any = None
 
     # Any thread -------------------------------------------------------------------
     def submit(self, intervention: Intervention) -> Reply:
@@ -348,6 +354,11 @@ class Control:
             while self._queue:
                 self._queue.popleft().reply.set(False, "the run has ended")
             self._wakeup.notify_all()
+
+    @property
+    def holding(self) -> bool:
+        """Whether a pause holds the run now (no firing may start)."""
+        return self.paused and not self.steps and self.interactive and not self._script and not self.closed
 
     def state(self) -> dict[str, Any]:
         """What a page shows of the controls: paused, steps left, breakpoints."""
@@ -413,15 +424,18 @@ class Control:
                     raise ControlError(f"the journal's control event {head.seq} ({head.data.get('action')}) does"
                                        " not come where it did: this run is not the one journaled")
                 continue  # replaying: what was applied after a hit at this point comes next
-            if self.paused and not self.steps and self.interactive and not self._script and not self.closed:
+            if self.holding:
                 seen = self._run.recorder_count()
                 if seen != told:  # something happened since the watchers last looked
                     told = seen
                     for watcher in self.waiting:
                         watcher()
-                with self._wakeup:
-                    if not self._queue and not self.closed:
-                        self._wakeup.wait(0.25)
+                if self.idle is not None:  # the run's time goes on: take in what comes
+                    changed |= self.idle()
+                else:
+                    with self._wakeup:
+                        if not self._queue and not self.closed:
+                            self._wakeup.wait(0.25)
                 waited = True
                 continue
             if waited:

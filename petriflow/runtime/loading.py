@@ -39,6 +39,7 @@ import yaml
 
 from petriflow.errors import NetFormatError
 from petriflow.io.files import read_text_file
+from petriflow.io.safe_yaml import LineDict, LineList
 from petriflow.net import Net
 from petriflow.runtime.config import RunConfig, load_config
 
@@ -116,7 +117,22 @@ def net_config(net: Net, path: Path) -> RunConfig | None:
             raise NetFormatError(f"run configuration {named!r} not found (looked for {file}); give it with"
                                  " --config, or put it beside the net", path=str(path), line=net.lines.get("run"))
         return load_config(file)
-    return RunConfig.from_dict(named, str(path), base=str(path.parent), line=net.lines.get("run"))
+    return RunConfig.from_dict(_located(named, net.lines), str(path), base=str(path.parent),
+                               line=net.lines.get("run"))
+
+
+def _located(run: dict, lines: dict[str, int]) -> LineDict:
+    """A net's inline ``run:`` with the lines of its keys and of their lists' items
+    (``run.KEY``, ``run.KEY/I`` in the net's lines), so its errors name them."""
+    located = LineDict(run)
+    located.line = lines.get("run", 0)
+    located.key_lines = {key: lines[f"run.{key}"] for key in run if f"run.{key}" in lines}
+    for key, value in run.items():
+        if isinstance(value, list) and f"run.{key}/0" in lines:
+            items = located[key] = LineList(value)
+            items.line = located.key_lines.get(key, located.line)
+            items.item_lines = [lines.get(f"run.{key}/{i}", items.line) for i in range(len(value))]
+    return located
 
 
 def _config_for(net: Net, path: Path, given: str | Path | RunConfig | None) -> RunConfig:

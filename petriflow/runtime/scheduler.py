@@ -63,6 +63,7 @@ Examples:
 
 from __future__ import annotations
 
+import time as wallclock
 from typing import Any, Iterable, Mapping
 
 from petriflow import limits
@@ -99,6 +100,10 @@ from petriflow.workflow import final_marking_of
 __all__ = ["Scheduler", "RunResult", "ZenoError", "EmptySchedule"]
 
 _RUN, _STOP = EventKind.RUN.value, EventKind.STOP.value
+
+#: Seconds a paused run with remote agents lets pass at a time (between two looks at
+#: its control queue), taking in what its agents did meanwhile.
+PAUSED_STEP = 0.05
 
 
 class EmptySchedule(PetriflowError):
@@ -182,6 +187,8 @@ class Scheduler:
             self.firer.control = control
             control.attach(self)
             self.clock.interrupt = control.interrupt  # a pause stops the clock between instants too
+            if remote is not None:  # remote agents work on during a pause: their results are taken as they come
+                control.idle = self.pass_paused
         self._started = self._closed = self._opened = False  # _opened: the instant at tick 0 was processed
         self._watchers: list[Any] = []
         self._finished: RunResult | None = None
@@ -267,12 +274,18 @@ class Scheduler:
         transitions = self.index.of_agent.get(agent, [])
         self.enabled_set.mark(transitions)
         self.runner.drive(self.runner.cancel(transitions, Outcome.FAILED))
-        self.firer.fire_instant()  # a failure route, at the instant the loss is noticed
+        if not self._holding():
+            self.firer.fire_instant()  # a failure route, at the instant the loss is noticed
 
     def agent_back(self, agent: str) -> None:
         """A lost ``agent`` announced itself again: it runs again, as a late joiner."""
         self.faults.rejoin(agent)
-        self.firer.fire_instant()
+        if not self._holding():
+            self.firer.fire_instant()
+
+    def _holding(self) -> bool:
+        """Whether a pause holds the firing (what became enabled fires when it ends)."""
+        return self.control is not None and self.control.holding
 
     def agent_started(self, agent: str) -> None:
         """``agent`` started (a late joiner): its transitions may fire."""
@@ -349,6 +362,28 @@ class Scheduler:
         self.clock = SimulatedClock(stopwatch) if factor == 0 else RealtimeClock(stopwatch, factor, self.now)
         if self.control is not None:
             self.clock.interrupt = self.control.interrupt
+
+    def pass_paused(self) -> bool:
+        """While paused with remote agents, time goes on (theirs does): advance at most
+        :data:`PAUSED_STEP` seconds, take in what is due (a remote firing's result, its
+        ``end`` recorded now; an agent lost, its firings ended ``failed``) and let the
+        watchers look, but fire nothing (a pause stops dispatching). ``True`` if
+        something happened. The control calls it while it waits, instead of sleeping.
+        """
+        kernel, seen = self.kernel, self.recorder.count
+        tick = kernel.peek()
+        target = kernel.tick + max(1, kernel.ticks_at(PAUSED_STEP))
+        if tick is not None:
+            target = min(target, max(tick, kernel.tick + 1))
+        if getattr(self.clock, "rebase", None) is None:  # an unpaced clock would race ahead of the agents
+            wallclock.sleep(PAUSED_STEP)
+        while kernel.tick < target:  # the clock stops after each tick while paused (interrupt)
+            self.clock.advance(kernel, self.world, target)
+        self.firer.new_instant()
+        kernel.run_due()
+        for watcher in self._watchers:
+            watcher(self)
+        return self.recorder.count != seen
 
     def rebase_clock(self) -> None:
         """The run stood still: a paced run goes on from now, without rushing to catch up."""

@@ -162,11 +162,11 @@ def _execute(checked: CheckedRun, inputs: dict[str, Any], *, journal: Journal | 
                           interactive=live is not None, script=script)
     server = None
     if live is not None:
-        from petriflow.live.page import live_page
+        from petriflow.live.page import LivePage
         from petriflow.live.server import LiveServer, parse_address
 
         host, port = parse_address(live.address)
-        server = LiveServer(control, live_page(checked.net), host, port)
+        server = LiveServer(control, LivePage(checked.net), host, port)  # drawn when a page asks
         url = server.start()
         if live.announce is not None:
             live.announce(url)

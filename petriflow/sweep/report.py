@@ -13,7 +13,12 @@ Examples:
 A published value's status (``paper_status``, from the sweep file) is ``predicted``,
 ``built-in`` or ``missed`` (:data:`petriflow.sweep.spec.PAPER_STATUSES`), with the
 reason (``because``); the text table shows it beside the value and lists the reasons
-under the table (:func:`status_notes`).
+under the table (:func:`status_notes`). The file declares it; the measurement has the
+last word (:func:`judge`): a value declared ``predicted`` whose measured mean is off by
+more than :data:`TOLERANCE` of the published value *and* by more than two standard
+deviations of the trials is reported ``missed`` (with the file's ``because`` if it gives
+one, else as a miss with no mechanism stated, counted apart: ``unexplained``); built in
+and missed values keep their status whatever the deviation.
 
 A trial's status is ``ok``, ``run failed`` (it ran, and the run ended ``failed``: an
 action failed with no failure route), ``error`` (it could not run: a bad parameter, a
@@ -34,7 +39,16 @@ from typing import Any
 from petriflow.sweep.spec import Row
 
 __all__ = ["summary", "metric_names", "text_table", "write_csv", "plot", "trial_status", "fixed", "deviation",
-           "status_label", "status_notes", "status_counts"]
+           "status_label", "status_notes", "status_counts", "judge", "TOLERANCE", "SPREADS", "COUNTED"]
+
+#: A predicted value stays predicted while the measured mean is within this share of the
+#: published value (or within :data:`SPREADS` standard deviations of the trials).
+TOLERANCE = 0.25
+#: ... or within this many standard deviations of the measured trials.
+SPREADS = 2.0
+#: What :func:`status_counts` counts: the statuses, the misses with no mechanism stated
+#: (a part of ``missed``) and the values with no status.
+COUNTED = ("predicted", "built-in", "missed", "unexplained", "unstated")
 
 #: A trial that ran and whose run ended ``failed`` (an action failure with no route).
 RUN_FAILED = "run failed"
@@ -74,9 +88,46 @@ def _stats(values: list[Any]) -> dict[str, Any]:
     return {"mean": round(mean, 6), "sd": round(sd, 6), "n": n}
 
 
+def judge(status: dict[str, str] | None, stats: dict[str, Any] | None, published: Any) -> dict[str, Any] | None:
+    """A published value's reported status: the declared ``status`` unless it is
+    ``predicted`` and the measured mean is off by more than :data:`TOLERANCE` of
+    ``published`` and by more than :data:`SPREADS` standard deviations; then
+    ``missed``, with ``declared: predicted``, the deviation's share (``off``), the file's
+    ``because`` if any, else ``unexplained: True`` (no mechanism stated). A value with no
+    numeric mean or no numeric published value keeps its declared status.
+
+    Examples:
+        >>> judge({"status": "predicted"}, {"mean": 168.4, "sd": 0.0, "n": 1}, 95)
+        {'status': 'missed', 'declared': 'predicted', 'off': 0.772632, 'unexplained': True}
+        >>> judge({"status": "predicted"}, {"mean": 120.0, "sd": 15.0, "n": 5}, 90)   # within 2 sd
+        {'status': 'predicted'}
+        >>> judge({"status": "predicted", "because": "the wait"}, {"mean": 2.0, "sd": 0.1, "n": 5}, 1)["because"]
+        'the wait'
+        >>> judge({"status": "built-in", "because": "the speed"}, {"mean": 9.0, "sd": 0.0, "n": 1}, 1)["status"]
+        'built-in'
+    """
+    if not status or status.get("status") != "predicted" or not stats or stats.get("mean") is None:
+        return status
+    if not isinstance(published, (int, float)) or isinstance(published, bool):
+        return status
+    off = abs(stats["mean"] - published)
+    spread = SPREADS * (stats.get("sd") or 0.0) if stats.get("n", 0) > 1 else 0.0
+    if off <= TOLERANCE * abs(published) + 1e-12 or off <= spread:
+        return status
+    judged: dict[str, Any] = {"status": "missed", "declared": "predicted",
+                              "off": round(off / abs(published), 6) if published else None}
+    if status.get("because"):
+        judged["because"] = status["because"]
+    else:
+        judged["unexplained"] = True
+    return judged
+
+
 def summary(rows: list[Row], trials: list[dict[str, Any]], names: list[str]) -> list[dict[str, Any]]:
     """One entry per row, in the sweep's order:
-    ``{"params", "trials", "failed", "metrics": {name: {"mean", "sd", "n"}}, "paper"}``."""
+    ``{"params", "trials", "failed", "metrics": {name: {"mean", "sd", "n"}}, "paper",
+    "paper_status"}``; each published value's status is the declared one as the
+    measurement leaves it (:func:`judge`)."""
     by_row: dict[int, list[dict[str, Any]]] = {row.index: [] for row in rows}
     for trial in trials:
         by_row.setdefault(trial["row"], []).append(trial)
@@ -87,9 +138,14 @@ def summary(rows: list[Row], trials: list[dict[str, Any]], names: list[str]) -> 
         measured = [t for t in done if t["status"] == "ok"]  # a failed run's metrics still describe it
         metrics = {name: _stats([t["metrics"][name] for t in measured if t["metrics"].get(name) is not None])
                    for name in names}
+        judged = {}
+        for key, declared in row.paper_status.items():
+            verdict = judge(dict(declared), metrics.get(key), row.paper.get(key))
+            if verdict:
+                judged[key] = verdict
         out.append({"params": row.params, "trials": len(done), "failed": len(done) - statuses.get("ok", 0),
                     "status": dict(sorted(statuses.items())), "metrics": metrics, "paper": dict(row.paper),
-                    "paper_status": {k: dict(v) for k, v in row.paper_status.items()}})
+                    "paper_status": judged})
     return out
 
 
@@ -133,14 +189,26 @@ def deviation(mean: float | None, paper: Any) -> str:
     return text if paper == 0 else f"{text} ({100 * difference / abs(paper):+.1f}%)"
 
 
-def status_label(status: dict[str, str] | None) -> str:
-    """A published value's status as the reports write it (``-`` for none given).
+def status_label(status: dict[str, Any] | None) -> str:
+    """A published value's status as the reports write it (``-`` for none given); a
+    value declared predicted that the measurement missed says so.
 
     Examples:
         >>> status_label({"status": "built-in", "because": "x"}), status_label(None)
         ('built in', '-')
+        >>> status_label({"status": "missed", "declared": "predicted", "unexplained": True})
+        'missed (no mechanism stated)'
+        >>> status_label({"status": "missed", "declared": "predicted", "because": "x"})
+        'missed (declared predicted)'
     """
-    return "-" if not status else status["status"].replace("-", " ")
+    if not status:
+        return "-"
+    label = status["status"].replace("-", " ")
+    if status.get("unexplained"):
+        return f"{label} (no mechanism stated)"
+    if status.get("declared") and status["declared"] != status["status"]:
+        return f"{label} (declared {status['declared'].replace('-', ' ')})"
+    return label
 
 
 def status_notes(rows: list[dict[str, Any]], names: list[str], parameters: list[str]) -> list[str]:
@@ -157,25 +225,33 @@ def status_notes(rows: list[dict[str, Any]], names: list[str], parameters: list[
         where = ", ".join(f"{p}={_number(row['params'].get(p))}" for p in parameters)
         for name in names:
             status = row.get("paper_status", {}).get(name)
-            if name in row["paper"] and status and status.get("because"):
-                lines.append(f"{status_label(status)}: {name}{f' ({where})' if where else ''}: {status['because']}")
+            if name not in row["paper"] or not status:
+                continue
+            reason = status.get("because")
+            if status.get("declared") and status.get("off") is not None:
+                off = f"{100 * status['off']:.0f} % off the published value"
+                reason = f"{off}: {reason}" if reason else off
+            if reason:
+                lines.append(f"{status_label(status)}: {name}{f' ({where})' if where else ''}: {reason}")
     return lines
 
 
 def status_counts(rows: list[dict[str, Any]]) -> dict[str, int]:
-    """How many published values are predicted, built in, missed, or have no status.
+    """How many published values are predicted, built in, missed (and of those, missed
+    with no mechanism stated: ``unexplained``), or have no status (:data:`COUNTED`).
 
     Examples:
-        >>> status_counts([{"paper": {"a": 1, "b": 2}, "paper_status": {"a": {"status": "missed"}}}])
-        {'predicted': 0, 'built-in': 0, 'missed': 1, 'unstated': 1}
+        >>> status_counts([{"paper": {"a": 1, "b": 2, "c": 3}, "paper_status": {"a": {"status": "missed"},
+        ...                "c": {"status": "missed", "declared": "predicted", "unexplained": True}}}])
+        {'predicted': 0, 'built-in': 0, 'missed': 2, 'unexplained': 1, 'unstated': 1}
     """
-    from petriflow.sweep.spec import PAPER_STATUSES
-
-    counts = dict.fromkeys((*PAPER_STATUSES, "unstated"), 0)
+    counts = dict.fromkeys(COUNTED, 0)
     for row in rows:
         for name in row["paper"]:
             status = row.get("paper_status", {}).get(name)
             counts[status["status"] if status else "unstated"] += 1
+            if status and status.get("unexplained"):
+                counts["unexplained"] += 1
     return counts
 
 

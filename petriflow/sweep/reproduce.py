@@ -44,8 +44,7 @@ from typing import Any, Callable
 
 from petriflow.errors import PetriflowError
 from petriflow.io.files import read_yaml_file
-from petriflow.sweep.report import deviation, fixed, status_counts, status_label
-from petriflow.sweep.spec import PAPER_STATUSES
+from petriflow.sweep.report import COUNTED, SPREADS, TOLERANCE, deviation, fixed, status_counts, status_label
 
 __all__ = ["Scenario", "Table", "Outcome", "scenarios", "reproduce", "markdown", "published_values"]
 
@@ -64,6 +63,11 @@ class Table:
     planned: int = 0  # the trials the file's own seeds give (a default run)
     failed: int = 0
     wall: float = 0.0
+    cpu: float = 0.0  # CPU seconds of the trials' processes (the cost whatever else the machine runs)
+    timed: int = 0  # the trials whose CPU seconds are known
+    ran: int = 0  # trials run by this pass (the others were resumed from its database)
+    costs: list[float] = field(default_factory=list)  # CPU seconds per trial, in the sweep's order
+    default_costs: list[float] = field(default_factory=list)  # the same for a default run, each row's mean
     db: Path | None = None
     page: Path | None = None
 
@@ -86,6 +90,7 @@ class Outcome:
     quick: bool
     wall: float
     out: Path
+    workers: int = 1
 
 
 def _title(readme: Path, fallback: str) -> str:
@@ -175,11 +180,22 @@ def reproduce(root: str | Path, out: str | Path, *, quick: bool = False, only: l
             table.wall = wallclock.perf_counter() - begun
             table.rows, table.names, table.parameters = result.rows, result.names, sweep.parameters
             table.trials, table.failed = len(result.trials), len(result.failures)
+            costs = [t["cpu"] for t in result.trials if t.get("cpu") is not None]
+            table.cpu, table.timed, table.ran, table.costs = sum(costs), len(costs), result.ran, costs
+            per_row: dict[int, list[float]] = {}
+            for trial in result.trials:
+                if trial.get("cpu") is not None:
+                    per_row.setdefault(trial["row"], []).append(trial["cpu"])
+            mean = table.cpu / table.timed if table.timed else 0.0
+            table.default_costs = [sum(per_row[t.row]) / len(per_row[t.row]) if t.row in per_row else mean
+                                   for t in load_sweep(table.path).trials()]
             if pages:
                 from petriflow.view import view
 
                 table.page = view(table.db, sweep=table.path)
-    return Outcome(found, quick, wallclock.perf_counter() - started, out)
+    from petriflow.sweep.backends import default_workers
+
+    return Outcome(found, quick, wallclock.perf_counter() - started, out, workers or default_workers())
 
 
 def _cell(stats: dict[str, Any] | None, ran: bool) -> str:
@@ -194,16 +210,19 @@ def _text(value: Any) -> str:
     return str(value).replace("|", "\\|")
 
 
+def _count_name(key: str) -> str:
+    return "missed with no mechanism stated" if key == "unexplained" else key.replace("-", " ")
+
+
 def _counts_line(counts: dict[str, int]) -> str:
-    return ", ".join(f"{counts[k]} {k.replace('-', ' ')}" for k in (*PAPER_STATUSES, "unstated")
-                     if counts.get(k) or k != "unstated")
+    return ", ".join(f"{counts[k]} {_count_name(k)}" for k in COUNTED if counts.get(k) or k != "unstated")
 
 
 def markdown(outcome: Outcome, root: str | Path, *, commit: str | None = None, command: str = "") -> str:
     """The report (see the module), with links to each table's page relative to ``root``'s
     parent (the project's folder)."""
     base = Path(root).resolve().parent
-    total = dict.fromkeys((*PAPER_STATUSES, "unstated"), 0)
+    total = dict.fromkeys(COUNTED, 0)
     per: dict[str, dict[str, int]] = {}
     for scenario in outcome.scenarios:
         counts = dict.fromkeys(total, 0)
@@ -222,20 +241,37 @@ def markdown(outcome: Outcome, root: str | Path, *, commit: str | None = None, c
              f" {trials} trials, {failed} failed, {outcome.wall / 60:.1f} min wall{_estimate(outcome)})."
              " Do not edit: run it again.",
              "",
+             "Time: a trial's *CPU seconds* are its own worker process's (building, running, measuring), what"
+             " it costs whatever else the machine runs; the wall time of a shared machine says more about its"
+             " load. *On N idle cores* hands each table's trials, at their measured CPU seconds (a default"
+             " run: each row's mean), to N workers in order as the local backend does, table after table;"
+             " worker start-up and the pages are not in it.",
+             "",
              "Each published value has a status: **predicted** (the simulation's output, no published value"
              " used to get it), **built in** (a published value was an input: agreement proves nothing; the"
              " reason names it) or **missed** (the measurement is off and the paper leaves the mechanism that"
              " would close the gap unstated; the reason names it). Deviation is measured minus published."
              " The counts are comparisons: a published value counts once for every sweep row it is compared"
              " with (a sensitivity sweep compares the same value with each of its rows).",
-             "", "| scenario | tables | " + " | ".join(k.replace("-", " ") for k in (*PAPER_STATUSES, "unstated"))
-             + " |", "|---|---:|" + "---:|" * (len(PAPER_STATUSES) + 1)]
+             "",
+             f"The sweep file declares each status; the measurement has the last word. A value declared"
+             f" predicted whose measured mean is off the published value by more than {100 * TOLERANCE:.0f} %"
+             f" of it **and** by more than {SPREADS:g} standard deviations of the trials (with one trial a row,"
+             f" the {100 * TOLERANCE:.0f} % alone) is reported **missed (declared predicted)** with the file's"
+             " reason, or **missed (no mechanism stated)** where the file gives none; those are counted apart"
+             " (*no mechanism*, a part of *missed*), so the misses nobody has explained are visible. A value"
+             " within the tolerance stays predicted; built in and missed values keep their status whatever the"
+             " deviation." + (" In this quick pass each row has one trial: a value judged missed may be that"
+                              " trial's spread, and the default run (the file's own trials) judges with the"
+                              " 2 sd clause too." if outcome.quick else ""),
+             "", "| scenario | tables | predicted | built in | missed | of which no mechanism | unstated |",
+             "|---|---:|" + "---:|" * len(COUNTED)]
     for scenario in outcome.scenarios:
         counts = per[scenario.name]
         lines.append(f"| [{_text(scenario.title)}](#{_anchor(scenario.title)}) | {len(scenario.tables)} | "
-                     + " | ".join(str(counts[k]) for k in (*PAPER_STATUSES, "unstated")) + " |")
+                     + " | ".join(str(counts[k]) for k in COUNTED) + " |")
     lines.append(f"| **all** | {sum(len(s.tables) for s in outcome.scenarios)} | "
-                 + " | ".join(f"**{total[k]}**" for k in (*PAPER_STATUSES, "unstated")) + " |")
+                 + " | ".join(f"**{total[k]}**" for k in COUNTED) + " |")
     for scenario in outcome.scenarios:
         lines += ["", f"## {scenario.title}", "",
                   f"`{_relative(scenario.folder, base)}/`: {_counts_line(per[scenario.name])}."]
@@ -243,6 +279,10 @@ def markdown(outcome: Outcome, root: str | Path, *, commit: str | None = None, c
             where = _relative(table.path, base)
             page = f"; page: `{_relative(table.page, base)}`" if table.page else ""
             ran = f"{table.trials} trials, {table.failed} failed, {table.wall:.0f} s wall" if table.db else "not run"
+            if table.db and table.ran < table.trials:
+                ran += f" ({table.trials - table.ran} resumed from its database)"
+            if table.timed:
+                ran += f", {table.cpu / table.timed:.1f} CPU s a trial"
             lines += ["", f"### {_text(table.source or table.name)}", "", f"`{where}`: {ran}{page}.",
                       "", "| row | metric | published | measured (mean ± sd) | status | deviation | because |",
                       "|---|---|---:|---:|---|---:|---|"]
@@ -253,18 +293,52 @@ def markdown(outcome: Outcome, root: str | Path, *, commit: str | None = None, c
                     status = row.get("paper_status", {}).get(name)
                     lines.append(f"| {label} | {name} | {_text(value)} | {_cell(stats, table.db is not None)} | {status_label(status)} |"
                                  f" {deviation(stats['mean'] if stats else None, value)} |"
-                                 f" {_text((status or {}).get('because', ''))} |".replace("|  |", "| |"))
+                                 f" {_text(_reason(status))} |".replace("|  |", "| |"))
     return "\n".join(lines) + "\n"
+
+
+def _reason(status: dict[str, Any] | None) -> str:
+    """The because column: the file's reason; for a value declared predicted and missed
+    with none, that no mechanism is stated."""
+    if not status:
+        return ""
+    return status.get("because") or ("no mechanism stated" if status.get("unexplained") else "")
 
 
 def _estimate(outcome: Outcome) -> str:
     """For a quick pass: what a default one would take on the same machine, each table's
     wall scaled by its default trials over the trials run."""
     tables = [t for s in outcome.scenarios for t in s.tables if t.trials]
-    if not outcome.quick or not tables:
+    if not tables:
         return ""
-    minutes = sum(t.wall * t.planned / t.trials for t in tables) / 60
-    return f"; a default run, {sum(t.planned for t in tables)} trials, would take about {minutes:.0f} min here"
+    timed = [t for t in tables if t.timed]
+    if not timed:
+        return ""
+    cores = outcome.workers
+    text = (f"; the trials' own CPU time {sum(t.cpu for t in timed) / 60:.1f} min, on {cores} idle"
+            f" core{'s' if cores != 1 else ''} about {sum(makespan(t.costs, cores) for t in timed) / 60:.1f} min")
+    if outcome.quick:
+        text += (f"; a default run, {sum(t.planned for t in tables)} trials: about"
+                 f" {sum(sum(t.default_costs) for t in timed) / 60:.0f} CPU min, on {cores} idle core"
+                 f"{'s' if cores != 1 else ''} about {sum(makespan(t.default_costs, cores) for t in timed) / 60:.0f}"
+                 " min")
+    return text
+
+
+def makespan(costs: list[float], workers: int) -> float:
+    """Seconds ``workers`` idle processes take for trials costing ``costs`` CPU seconds,
+    each trial in order to the first free one (as the local backend hands them out).
+
+    Examples:
+        >>> makespan([3.0, 1.0, 1.0, 1.0], 2), makespan([3.0, 1.0], 1)
+        (3.0, 4.0)
+    """
+    import heapq
+
+    free = [0.0] * max(1, workers)
+    for cost in costs:
+        heapq.heappush(free, heapq.heappop(free) + cost)
+    return max(free)
 
 
 def _anchor(title: str) -> str:

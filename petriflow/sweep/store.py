@@ -2,7 +2,8 @@
 
 Tables: ``sweep`` (``key``, ``value``: the sweep file, its digest, the format) and
 ``trials`` (``row``, ``params`` as canonical JSON, ``seed``, ``status`` ok / error /
-timeout / crashed, ``outcome``, ``metrics`` as JSON, ``wall`` seconds, ``error``), with
+timeout / crashed, ``outcome``, ``metrics`` as JSON, ``wall`` seconds, ``error``, ``cpu``
+seconds of the worker process: the trial's own cost, whatever else the machine runs), with
 one trial per (params, seed): a sweep resumed after a kill runs only what is missing,
 and never records a trial twice.
 
@@ -35,7 +36,7 @@ _SCHEMA = """
 CREATE TABLE IF NOT EXISTS sweep (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE IF NOT EXISTS trials (
     row INTEGER NOT NULL, params TEXT NOT NULL, seed INTEGER NOT NULL, status TEXT NOT NULL,
-    outcome TEXT, metrics TEXT NOT NULL, wall REAL, error TEXT,
+    outcome TEXT, metrics TEXT NOT NULL, wall REAL, error TEXT, cpu REAL,
     PRIMARY KEY (params, seed)
 );
 """
@@ -106,6 +107,8 @@ class Store:
             if known.get("digest") != meta["digest"]:
                 raise StoreError(f"{where}: {_changed(known, meta)}")
             self.db.execute("SELECT row, params, seed, status, outcome, metrics, wall, error FROM trials LIMIT 1")
+            if "cpu" not in {column[1] for column in self.db.execute("PRAGMA table_info(trials)")}:
+                self.db.execute("ALTER TABLE trials ADD COLUMN cpu REAL")  # recorded before CPU seconds were
         except sqlite3.Error as exc:
             self.close()
             raise StoreError(f"{where}: not a petriflow sweep results database ({exc})") from None
@@ -147,9 +150,11 @@ class Store:
         assert self.db is not None
         with self.db:
             self.db.execute(
-                "INSERT OR REPLACE INTO trials VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
+                "INSERT OR REPLACE INTO trials (row, params, seed, status, outcome, metrics, wall, error, cpu)"
+                " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
                 (row, canonical(params), seed, result["status"], result.get("outcome"),
-                 json.dumps(result.get("metrics", {}), sort_keys=True), result.get("wall"), result.get("error")),
+                 json.dumps(result.get("metrics", {}), sort_keys=True), result.get("wall"), result.get("error"),
+                 result.get("cpu")),
             )
 
     def results(self) -> list[dict[str, Any]]:
@@ -157,10 +162,12 @@ class Store:
         assert self.db is not None
         out = []
         try:
-            for row, params, seed, status, outcome, metrics, wall, error in self.db.execute(
-                    "SELECT row, params, seed, status, outcome, metrics, wall, error FROM trials ORDER BY row, seed"):
+            for row, params, seed, status, outcome, metrics, wall, error, cpu in self.db.execute(
+                    "SELECT row, params, seed, status, outcome, metrics, wall, error, cpu FROM trials"
+                    " ORDER BY row, seed"):
                 out.append({"row": row, "params": json.loads(params), "seed": seed, "status": status,
-                            "outcome": outcome, "metrics": json.loads(metrics), "wall": wall, "error": error})
+                            "outcome": outcome, "metrics": json.loads(metrics), "wall": wall, "error": error,
+                            "cpu": cpu})
         except (sqlite3.Error, ValueError) as exc:
             raise StoreError(f"{self.path}: damaged results ({exc})") from None
         return out

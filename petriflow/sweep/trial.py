@@ -251,9 +251,9 @@ def run_trial(payload: dict[str, Any]) -> dict[str, Any]:
     Returns:
         ``{"status": "ok" | "error", "metrics": {name: value}, "outcome": reason,
         "error": one line or None (the trial's error, or the run's unrouted failure),
-        "wall": seconds}``.
+        "wall": seconds, "cpu": CPU seconds of this process (building, running, measuring)}``.
     """
-    started = wallclock.perf_counter()
+    started, cpu_started = wallclock.perf_counter(), wallclock.process_time()
     try:
         metrics, outcome, error = _measure(payload["sweep"], payload["params"], payload["seed"])
         status = "ok"  # a run that ended failed is a measured run; its error is kept
@@ -263,4 +263,4 @@ def run_trial(payload: dict[str, Any]) -> dict[str, Any]:
         metrics, outcome, status, error = {}, None, "error", f"{type(exc).__name__}: {exc}"
     error = None if error is None else " ".join(error.split())[:2000]
     return {"status": status, "metrics": metrics, "outcome": outcome, "error": error,
-            "wall": wallclock.perf_counter() - started}
+            "wall": wallclock.perf_counter() - started, "cpu": wallclock.process_time() - cpu_started}

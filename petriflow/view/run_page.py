@@ -24,7 +24,7 @@ from petriflow.runtime.trace import read_trace
 from petriflow.view.columns import encoded
 from petriflow.view.page import pack, pack_bytes, render
 
-__all__ = ["run_page", "net_picture", "net_pictures", "model", "unpacked", "stored", "restored"]
+__all__ = ["run_page", "net_picture", "net_pictures", "subnet_picture", "model", "unpacked", "stored", "restored"]
 
 
 def net_picture(net: Any) -> tuple[str | None, str | None]:
@@ -35,14 +35,14 @@ def net_picture(net: Any) -> tuple[str | None, str | None]:
     return _svg(to_dot(net, {p: 0 for p in net.places}, title=""))
 
 
-def net_pictures(net: Any) -> tuple[str | None, str | None, dict[str, Any] | None]:
+def net_pictures(net: Any, *, subnets: bool = True) -> tuple[str | None, str | None, dict[str, Any] | None]:
     """The net panel's pictures: ``(svg, why, folded)`` as :func:`net_picture`, with
     ``folded`` ``None``; or, for a net ``export`` folds (:func:`petriflow.fold.should_fold`),
     the folded drawing as ``svg`` and ``folded`` = ``{"agent:SUBNET": {"places": [...],
     "svg": packed SVG of the subnet drawn in full}}``, which the panel opens when its box
-    is clicked."""
-    from petriflow.export import to_dot
-    from petriflow.fold import agent_net, folded_dot, should_fold
+    is clicked. ``subnets=False``: the subnets are not drawn (``"svg": None``); a page
+    that can ask for them draws each when it is opened (:func:`subnet_picture`)."""
+    from petriflow.fold import folded_dot, should_fold
 
     if not should_fold(net):
         svg, why = net_picture(net)
@@ -52,11 +52,24 @@ def net_pictures(net: Any) -> tuple[str | None, str | None, dict[str, Any] | Non
         return None, why, None
     folded: dict[str, Any] = {}
     for subnet in net.subnets:
-        part = agent_net(net, subnet)
-        inner, _ = _svg(to_dot(part, {p: 0 for p in part.places}, title=part.label or ""))
+        inner = subnet_picture(net, f"agent:{subnet}") if subnets else None
         places, _ = net.nodes_of(subnet)
         folded[f"agent:{subnet}"] = {"places": list(places), "svg": None if inner is None else pack(inner)}
     return svg, None, folded
+
+
+def subnet_picture(net: Any, key: str) -> str | None:
+    """The SVG of one agent's subnet drawn in full (``key``: ``agent:SUBNET``, as in
+    :func:`net_pictures`' ``folded``); ``None`` for no such subnet or no Graphviz."""
+    from petriflow.export import to_dot
+    from petriflow.fold import agent_net
+
+    subnet = key[len("agent:"):] if key.startswith("agent:") else None
+    if subnet not in net.subnets:
+        return None
+    part = agent_net(net, subnet)
+    inner, _ = _svg(to_dot(part, {p: 0 for p in part.places}, title=part.label or ""))
+    return inner
 
 
 def _svg(source: str) -> tuple[str | None, str | None]:

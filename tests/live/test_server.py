@@ -124,3 +124,48 @@ def test_addresses():
     for bad in ("", "host:", "x:70000", "abc"):
         with pytest.raises(PetriflowError, match="HOST:]PORT"):
             parse_address(bad)
+
+
+def test_a_folded_nets_page_and_subnets_are_drawn_when_asked_for():
+    """A net drawn folded: the page holds no subnet's picture; each is served, with the
+    token, when the page opens it (an SVG of that subnet); an unknown one is 404."""
+    pytest.importorskip("shutil").which("dot") or pytest.skip("Graphviz is not installed")
+    import re
+    import tempfile
+    from pathlib import Path
+
+    from petriflow.io import load_net
+    from petriflow.live.page import LivePage
+    from tests.live.test_live_memory import team
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "team.yaml"
+        path.write_text(team())
+        net = load_net(path)
+    page = LivePage(net)
+    live = LiveServer(Control(interactive=True), page, "127.0.0.1", 0, token="secret-token")
+    live.start()
+    try:
+        status, body = get(live, "/?token=secret-token")
+        data = json.loads(re.search(rb'id="pf-data">(.*?)</script>', body, re.S).group(1))
+        assert sorted(data["folded"]) == ["agent:a", "agent:b"]
+        assert all(part["svg"] is None for part in data["folded"].values())  # drawn when opened
+        status, svg = get(live, "/part?key=agent:a&token=secret-token")
+        assert status == 200 and svg.lstrip().startswith(b"<svg") and b">at0<" in svg and b">bt0<" not in svg
+        assert get(live, "/part?key=agent:a")[0] == 403
+        assert get(live, "/part?key=agent:nobody&token=secret-token")[0] == 404
+        assert get(live, "/part?key=../../etc/passwd&token=secret-token")[0] == 404
+    finally:
+        live.stop()
+
+
+def test_the_page_names_the_net_and_says_what_it_is():
+    """The page's title and header give the net's id and its own description (its label)."""
+    from petriflow.io.yaml import loads_net
+    from petriflow.live.page import live_page
+
+    net = loads_net("petriflow: 1\nnet: relay\nlabel: two robots <hand over> a box\nplaces: [{id: i, tokens: 1}, o]\n"
+                    "transitions: [{id: t, in: [i], out: [o]}]\n")
+    page = live_page(net)
+    assert "<title>relay: live run: two robots &lt;hand over&gt; a box</title>" in page
+    assert '<div id="about" class="note">two robots &lt;hand over&gt; a box</div>' in page

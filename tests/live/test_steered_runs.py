@@ -88,3 +88,19 @@ def test_breakpoints_in_the_run_configuration_are_checked(tmp_path, capsys):
     hits = [e for e in read_trace(tmp_path / "t.jsonl") if e.kind == "control"]
     assert [e.data["spec"] for e in hits] == ["place o >= 1"]  # recorded; nobody to pause for
     json.loads(capsys.readouterr().out)
+
+
+def test_a_bad_breakpoint_in_an_inline_run_section_names_its_own_line(tmp_path, capsys):
+    """A net's inline ``run:`` section: a breakpoint of bad syntax, or naming no place, is
+    reported at its own line (not the ``run:`` line); so is one in a run file."""
+    head = "petriflow: 1\nplaces: [{id: i, tokens: 1}, o]\ntransitions: [{id: t, in: [i], out: [o]}]\n"
+    for bad, message in (("when done", "not a breakpoint: 'when done'"), ("place dne >= 1", "no place 'dne'")):
+        (tmp_path / "net.yaml").write_text(head + f"run:\n  seed: 1\n  breakpoints:\n    - failed\n    - {bad}\n")
+        assert main(["run", str(tmp_path / "net.yaml"), "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert "net.yaml:8: " in err and message in err and err.count("\n") == 1, err
+        (tmp_path / "run.yaml").write_text(f"seed: 1\nbreakpoints: [failed,\n  {bad}]\n")
+        (tmp_path / "net.yaml").write_text(head)
+        assert main(["run", str(tmp_path / "net.yaml"), "--config", str(tmp_path / "run.yaml"), "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert "run.yaml:3: " in err and message in err, err

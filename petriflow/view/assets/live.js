@@ -10,7 +10,7 @@
   const live = {
     counts: new Array(places.length).fill(0), running: [], failures: [], time: 0, seq: -1,
     events: [], window: 400, control: { paused: false, steps: 0, breakpoints: [] }, stop: null,
-    connected: false, snapshotAt: null, updates: 0, violations: [],
+    connected: false, snapshotAt: null, updates: 0, received: 0, violations: [],
   };
   let socket = null, nextId = 1, panel = null;
   const waiting = new Map();
@@ -25,6 +25,9 @@
       runningAt: () => live.running.map(f => ({ t: f.t, ts: f.since })),
       failedAt: (i, recent) => new Map(live.failures.filter(f => live.time - f.time <= recent).map(f => [f.t, f])),
     },
+    /** A folded net's subnet, drawn by the server when it is first opened. */
+    part: key => fetch(`/part?key=${encodeURIComponent(key)}&token=${encodeURIComponent(token)}`)
+      .then(r => (r.ok ? r.text() : null)),
   };
 
   function setMarking(marking, whole) {
@@ -38,6 +41,7 @@
   }
 
   function addEvents(events) {
+    live.received += events.length;
     for (const e of events) {
       live.events.push(e);
       if (e.kind === "custom" && e.data && e.data.name === "property_violated") live.violations.push(e);
@@ -179,6 +183,8 @@
     get violations() { return live.violations.map(e => ({ property: e.data.property, event: e.data.event })); },
     get control() { return live.control; },
     get events() { return live.events.length; },
+    get received() { return live.received; },
+    get window() { return live.window; },
     get updates() { return live.updates; },
     marking() { const out = {}; places.forEach((p, i) => { if (live.counts[i] > 0) out[p] = live.counts[i]; }); return out; },
     shownMarking: () => panel.shown(),

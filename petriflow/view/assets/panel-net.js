@@ -121,47 +121,60 @@ PF.netPanel = function (view, svg) {
     panZoom(box, picture);
   }
 
-  /** Open one agent's subnet (drawn in full) in place of the folded drawing. */
+  /** Open one agent's subnet (drawn in full) in place of the folded drawing: from the
+   *  page's data, or asked of the page's server (`view.part`, a live page) when it is not there. */
   function open(id) {
     const part = D.folded && D.folded[id];
-    if (!part || !part.svg) return;
-    PF.inflate(part.svg).then(text => { show(text, id); redraw(); });
+    if (!part) return;
+    const text = part.svg ? PF.inflate(part.svg) : view.part ? view.part(id) : null;
+    if (!text) return;
+    Promise.resolve(text).then(svgText => { if (svgText) { show(svgText, id); redraw(); } });
   }
 
   function redraw() { if (net.last !== undefined) draw(net.last); }
 
-  /** Wheel zooms around the pointer, dragging pans (the SVG's viewBox). */
+  /** Wheel zooms around the pointer, dragging pans (the SVG's viewBox). The listeners are
+   *  added once, on the first picture, and act on the picture shown now (`zoom`): one
+   *  added per picture would keep every picture ever opened alive. */
+  const zoom = { svg: null, vb: null, home: null, whole: null, drag: null, zoomedOut: false, box: null };
   function panZoom(box, svg) {
     const vb = svg.viewBox.baseVal;
+    zoom.svg = null;
     if (!vb || !vb.width) return;
-    const set = (x, y, w, h) => svg.setAttribute("viewBox", `${x} ${y} ${w} ${h}`);
     // start readable: fill the box in one direction (at most life size), from the top left
     const r0 = box.getBoundingClientRect();
     const cover = Math.min(1.0, Math.max(r0.width / vb.width, r0.height / vb.height));
-    const home = [vb.x, vb.y, r0.width / cover, r0.height / cover];
-    const whole = [vb.x, vb.y, vb.width, vb.height];
-    set(...home);
+    Object.assign(zoom, { svg, vb, home: [vb.x, vb.y, r0.width / cover, r0.height / cover],
+                          whole: [vb.x, vb.y, vb.width, vb.height], drag: null, zoomedOut: false });
+    set(...zoom.home);
+    if (zoom.box === box) return;
+    zoom.box = box;
     box.addEventListener("wheel", e => {
+      if (!zoom.svg) return;
       e.preventDefault();
-      const r = box.getBoundingClientRect();
+      const vb = zoom.vb, r = box.getBoundingClientRect();
       const scale = Math.min(r.width / vb.width, r.height / vb.height);
       const fx = vb.x + (e.clientX - r.left - (r.width - vb.width * scale) / 2) / scale;
       const fy = vb.y + (e.clientY - r.top - (r.height - vb.height * scale) / 2) / scale;
       const k = e.deltaY > 0 ? 1.15 : 1 / 1.15;
       set(fx - (fx - vb.x) * k, fy - (fy - vb.y) * k, vb.width * k, vb.height * k);
     }, { passive: false });
-    let drag = null;
-    box.addEventListener("mousedown", e => { drag = [e.clientX, e.clientY, vb.x, vb.y]; });
-    window.addEventListener("mouseup", () => { drag = null; });
+    box.addEventListener("mousedown", e => { if (zoom.svg) zoom.drag = [e.clientX, e.clientY, zoom.vb.x, zoom.vb.y]; });
+    window.addEventListener("mouseup", () => { zoom.drag = null; });
     window.addEventListener("mousemove", e => {
-      if (!drag) return;
+      const drag = zoom.drag, vb = zoom.vb;
+      if (!drag || !zoom.svg) return;
       const r = box.getBoundingClientRect();
       const scale = Math.min(r.width / vb.width, r.height / vb.height);
       set(drag[2] - (e.clientX - drag[0]) / scale, drag[3] - (e.clientY - drag[1]) / scale, vb.width, vb.height);
     });
-    let zoomedOut = false;
-    box.addEventListener("dblclick", () => { zoomedOut = !zoomedOut; set(...(zoomedOut ? whole : home)); });
+    box.addEventListener("dblclick", () => {
+      if (!zoom.svg) return;
+      zoom.zoomedOut = !zoom.zoomedOut;
+      set(...(zoom.zoomedOut ? zoom.whole : zoom.home));
+    });
   }
+  function set(x, y, w, h) { zoom.svg.setAttribute("viewBox", `${x} ${y} ${w} ${h}`); }
 
   function draw(i) {
     net.last = i;
@@ -216,11 +229,17 @@ PF.netPanel = function (view, svg) {
     net.status = status;
   }
 
+  /** The marking shown: `{place: tokens}` of the places drawn, and `{"agent:ID": tokens}`
+   *  of a folded drawing's boxes (the tokens in the places folded into each). */
   function shown() {
     const out = {};
     for (const [p, node] of net.places) {
       const n = parseInt((node.g || node.row).dataset.tokens || "0", 10);
       if (n > 0) out[p] = n;
+    }
+    for (const b of net.boxes || []) {
+      const n = parseInt(b.g.dataset.tokens || "0", 10);
+      if (n > 0) out[b.g.dataset.agent] = n;
     }
     return out;
   }

@@ -51,7 +51,7 @@
         }
         if (withStatus.includes(m)) {
           const st = m in row.paper ? (row.paper_status || {})[m] : null;
-          const td = cell(tr, st ? st.status.replace("-", " ") : "", "text status" + (st ? " st-" + st.status : ""));
+          const td = cell(tr, st ? (st.status.replace("-", " ") + (st.unexplained ? " (no mechanism stated)" : st.declared ? " (declared " + st.declared + ")" : "")) : "", "text status" + (st ? " st-" + st.status : ""));
           if (st && st.because) td.title = st.because;
         }
       }

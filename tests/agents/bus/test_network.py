@@ -187,3 +187,58 @@ def test_an_end_devices_frame_goes_no_further_than_a_parent_with_a_full_table():
     medium = sim.run()
     lost = sorted((loss.module, loss.reason.value) for loss in medium.losses if loss.frame.tag == "up")
     assert lost == [(0, "btt_full"), (2, "btt_full")]
+
+
+# Unicast addressing and the bus's cost per loop iteration -----------------------------------
+
+def test_unicast_reaches_only_its_addressee_and_leaves_no_table_entry():
+    """Each device has its own address: a frame for module 1 is not handed to module 2
+    (its one-frame buffer keeps its own frame), nobody relays it, no table records it;
+    the sniffer overhears it."""
+    sim = BusSimulator(ZigbeeBus(addressing="unicast"), modules=[0, 1, 2], seed=3)
+    sim.medium.sniff(3)
+    sim.send(0.0, frame(0, (1,), tag="to 1"))
+    sim.send(0.05, frame(1, (0, 2), tag="to 0 and 2"))
+    medium = sim.run()
+    assert [t.frame.tag for t in medium.transmissions] == ["to 1", "to 0 and 2", "to 0 and 2"]
+    assert medium.losses == [] and [medium.btt_size(n) for n in range(3)] == [0, 0, 0]
+    assert medium.captured == {3: {0: 1, 1: 1}}  # a frame once, however many unicasts carry it
+    broadcast = BusSimulator(ZigbeeBus(), modules=[0, 1, 2], seed=3)
+    broadcast.send(0.0, frame(0, (1,), tag="to 1"))
+    assert len(broadcast.run().transmissions) == 3  # the default: a broadcast every router relays
+
+
+def test_unicast_to_an_end_device_waits_at_its_parent_and_a_frame_for_nobody_is_retried():
+    sim = BusSimulator(ZigbeeBus(addressing="unicast", roles="end_devices"), modules=[0, 1, 2], seed=4)
+    for module in range(3):
+        sim.reads_every(module, 0.0)
+    sim.send(0.0, frame(1, (2,), tag="1 to 2"))
+    medium = sim.run()
+    assert [t.frame.tag for t in medium.transmissions] == ["1 to 2"]  # up to the parent; 2 polls it
+    assert [f.tag for f in sim.received[2]] == ["1 to 2"] and sim.received.get(0, []) == []
+    nobody = BusSimulator(ZigbeeBus(addressing="unicast", mac_retries=2), modules=[0, 1], seed=4)
+    nobody.send(0.0, frame(1, (), tag="nobody"))
+    assert len(nobody.run().transmissions) == 3  # never acknowledged: sent 1 + mac_retries times
+
+
+def test_a_bad_addressing_is_refused():
+    with pytest.raises(Exception, match="addressing is 'broadcast' or 'unicast'"):
+        ZigbeeBus(addressing="multicast")
+
+
+def test_the_bus_loop_cost_slows_every_iteration_of_the_cpg_loop():
+    """loop_cost adds to each loop iteration of a module that reads the bus (the chain's
+    head reads no mailbox: nobody addresses it): it reads its buffer half as often with
+    a cost of one 20 ms step, so its loop runs fewer iterations in the run."""
+    def run_with(cost):
+        net = build(3, 2, messages=20)
+        config = {"channels": {"bus": {"model": "bus.can", "on_loss": "notify", "loop_cost": cost}},
+                  "dt": 0.002, "until": 300}
+        return run(net, config=config, seed=1, keep_events=True)
+
+    fast, slow = run_with(0.0), run_with(0.02)
+    reads = {e.data["agent"] if "agent" in e.data else k: (f.data["data"]["read_every"], e.data["data"]["read_every"])
+             for k, (f, e) in enumerate(zip(_custom(fast, "bus.addressed"), _custom(slow, "bus.addressed")))}
+    doubled = [after == pytest.approx(2 * before, rel=1e-3) for before, after in reads.values()]
+    assert sorted(doubled) == [False, True, True]
+    assert slow.result.reason == "final" and slow.result.firings < fast.result.firings
