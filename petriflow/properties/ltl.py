@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from petriflow.analysis import components, csr, reachable, shortest_path
+from petriflow.analysis import accepting_lasso, components, csr, reachable, shortest_path
 from petriflow.errors import PetriflowError
 from petriflow.properties.kripke import Kripke
 from petriflow.properties.language import (
@@ -91,28 +91,68 @@ def _guard(spot, formula, values: dict[str, np.ndarray], n: int) -> np.ndarray:
     raise ValueError(f"unexpected guard {formula}")
 
 
-def check_ltl(kripke: Kripke, formula: Formula) -> tuple[bool, dict | None]:
+#: The product searches :func:`check_ltl` knows: ``"on-the-fly"`` (the default) builds
+#: the product's states as its depth-first search reaches them and stops at the first
+#: accepting cycle; ``"whole"`` builds every product edge as arrays, then its components.
+PRODUCTS = ("on-the-fly", "whole")
+
+
+def check_ltl(kripke: Kripke, formula: Formula, product: str = "on-the-fly"
+              ) -> tuple[bool, dict | None]:
     """``(verdict, evidence)`` of an LTL formula at the initial marking.
 
     ``formula`` is ``A ψ``, ``E ψ`` or a bare path formula ``ψ`` (read as ``A ψ``).
     The evidence is a lasso ``{"witness": prefix, "cycle": cycle}`` (firing sequences):
     a run violating ``A ψ``, or a run satisfying ``E ψ``; ``None`` otherwise.
+    ``product`` is one of :data:`PRODUCTS` (both give the same verdicts).
     """
+    if product not in PRODUCTS:
+        raise ValueError(f"unknown product search {product!r}: one of {', '.join(PRODUCTS)}")
     exists = isinstance(formula, ExistsPath)
     body = formula.operand if isinstance(formula, (AllPaths, ExistsPath)) else formula
-    found = _accepting_lasso(kripke, body if exists else Not(body))
+    search = _lasso_on_the_fly if product == "on-the-fly" else _accepting_lasso
+    found = search(kripke, body if exists else Not(body))
     if exists:
         return found is not None, found
     return found is None, found
 
 
-def _accepting_lasso(kripke: Kripke, path: Formula) -> dict | None:
-    """A lasso of the graph that satisfies ``path``, or ``None`` when there is none."""
+def _automaton(kripke: Kripke, path: Formula):
+    """Spot's Büchi automaton of ``path`` and its atoms' values on every state."""
     spot = _spot()
     names = {atom: f"p{k}" for k, atom in enumerate(atoms(path))}
     automaton = spot.translate(to_spot(path, names), "Buchi", "SBAcc")
-    condition = automaton.acc()
     values = {name: kripke.holds(atom) for atom, name in names.items()}
+    return spot, automaton, values
+
+
+def _lasso_on_the_fly(kripke: Kripke, path: Formula) -> dict | None:
+    """:func:`_accepting_lasso` by :func:`~petriflow.analysis.accepting_lasso`: the
+    product explored from ``(M0, q0)`` only as far as its first accepting cycle."""
+    spot, automaton, values = _automaton(kripke, path)
+    condition = automaton.acc()
+    dictionary = automaton.get_dict()
+    edges = sorted(automaton.edges(), key=lambda edge: edge.src)
+    q_count = automaton.num_states()
+    guard = np.empty((max(len(edges), 1), kripke.n), dtype=bool)
+    for j, edge in enumerate(edges):
+        guard[j] = _guard(spot, spot.bdd_to_formula(edge.cond, dictionary), values, kripke.n)
+    automaton_offsets = np.searchsorted([edge.src for edge in edges], np.arange(q_count + 1))
+    automaton_targets = np.array([edge.dst for edge in edges] or [0], dtype=np.int64)
+    accepting = np.array([condition.is_t() or (not condition.is_f() and bool(edge.acc))
+                          for edge in edges] or [False])
+    found = accepting_lasso(kripke.offsets, kripke.targets, guard, automaton_offsets.astype(np.int64),
+                            automaton_targets, accepting, automaton.get_init_state_number())
+    if found is None:
+        return None
+    prefix, cycle, _ = found
+    return {"witness": kripke.names(prefix), "cycle": kripke.names(cycle)}
+
+
+def _accepting_lasso(kripke: Kripke, path: Formula) -> dict | None:
+    """A lasso of the graph that satisfies ``path``, or ``None`` when there is none."""
+    spot, automaton, values = _automaton(kripke, path)
+    condition = automaton.acc()
     n, q_count = kripke.n, automaton.num_states()
     dictionary = automaton.get_dict()
     sources, targets, graph_edges, accepting = [], [], [], []
