@@ -1,9 +1,11 @@
-"""The on-the-fly LTL product and the whole product agree on every contest LTL formula.
+"""The on-the-fly LTL products and the whole product agree on every contest LTL formula.
 
-Both searches of :func:`petriflow.properties.ltl.check_ltl` run on the 8 public contest
+Both searches of :func:`petriflow.properties.ltl.check_ltl`, and
+:func:`~petriflow.properties.ltl.check_ltl_on_net` (markings generated from the net as
+the search goes), run on the 8 public contest
 models' LTLCardinality and LTLFireability formulas (256): the verdicts must be equal
 (and the contest's, which tests/properties/test_mcc_oracle.py checks for the default),
-and every lasso the on-the-fly search gives must replay: its prefix fireable from the
+and every lasso the on-the-fly searches give must replay: its prefix fireable from the
 initial marking, its cycle fireable from there and back to the same marking.
 """
 
@@ -19,7 +21,7 @@ from petriflow.analysis.reachability import reachability_graph
 from petriflow.engine import fire_sequence
 from petriflow.io import load_net
 from petriflow.properties.kripke import Kripke
-from petriflow.properties.ltl import check_ltl
+from petriflow.properties.ltl import check_ltl, check_ltl_on_net
 from petriflow.properties.mcc_xml import load_mcc_properties
 from tests.conftest import ORACLE
 
@@ -37,7 +39,11 @@ def test_both_products_give_the_same_verdicts(model, category):
     for prop in properties:
         fast, lasso = check_ltl(kripke, prop.formula, "on-the-fly")
         whole, _ = check_ltl(kripke, prop.formula, "whole")
-        assert fast == whole, prop.id
+        lazy, lazy_lasso = check_ltl_on_net(net, net.initial_marking, prop.formula, max_states=10 ** 6)
+        assert fast == whole == lazy, prop.id
+        if lazy_lasso is not None:
+            start = fire_sequence(net, net.initial_marking, lazy_lasso["witness"])
+            assert fire_sequence(net, start, lazy_lasso["cycle"]) == start, prop.id
         assert ("TRUE" if fast else "FALSE") == str(expected[prop.id]), prop.id
         if lasso is not None:
             start = fire_sequence(net, net.initial_marking, lasso["witness"])
@@ -65,3 +71,30 @@ def test_the_search_stops_at_the_first_accepting_cycle():
     offsets, targets = np.concatenate([[0], np.arange(n) + 2]), np.concatenate([[0], targets])
     prefix, cycle, explored = accepting_lasso(offsets, targets, everywhere, *one_state, 0)
     assert (prefix, cycle, explored) == ([], [0], 1)
+
+
+def test_the_search_from_the_net_stops_at_its_budget_or_at_a_shallow_counterexample():
+    """An unbounded net has no reachability graph; a counterexample near M0 (a lasso of
+    ``u`` and ``v``, beside ``t`` that pumps tokens into ``b``) is found anyway, and a
+    property that holds on every run runs into the budget."""
+    from petriflow.analysis.exploration import StateSpaceLimit
+    from petriflow.properties.yaml_props import parse_property
+    from petriflow.net import Net
+
+    net = Net()
+    for place in ("a", "b", "c"):
+        net.add_place(place)
+    for transition in ("u", "v", "t"):
+        net.add_transition(transition)
+    for source, target in (("a", "u"), ("u", "c"), ("c", "v"), ("v", "a"), ("a", "t"), ("t", "a"),
+                           ("t", "b")):
+        net.add_arc(source, target)
+    net.set_initial_marking({"a": 1})
+    violated = parse_property({"id": "v", "ltl": "G c == 0"}).formula
+    verdict, lasso = check_ltl_on_net(net, net.initial_marking, violated, max_states=50)
+    assert verdict is False and "u" in lasso["witness"] + lasso["cycle"]
+    start = fire_sequence(net, net.initial_marking, lasso["witness"])
+    assert fire_sequence(net, start, lasso["cycle"]) == start
+    with pytest.raises(StateSpaceLimit):
+        check_ltl_on_net(net, net.initial_marking, parse_property({"id": "s", "ltl": "G a + c == 1"}).formula,
+                         max_states=50)
