@@ -79,6 +79,34 @@ def test_the_search_from_the_net_stops_at_its_budget_or_at_a_shallow_counterexam
     property that holds on every run runs into the budget."""
     from petriflow.analysis.exploration import StateSpaceLimit
     from petriflow.properties.yaml_props import parse_property
+
+    net = _pump_beside_a_cycle()
+    violated = parse_property({"id": "v", "ltl": "F G a == 1"}).formula
+    verdict, lasso = check_ltl_on_net(net, net.initial_marking, violated, max_states=50)
+    assert verdict is False and "u" in lasso["witness"] + lasso["cycle"]
+    start = fire_sequence(net, net.initial_marking, lasso["witness"])
+    assert fire_sequence(net, start, lasso["cycle"]) == start
+    with pytest.raises(StateSpaceLimit):
+        check_ltl_on_net(net, net.initial_marking, parse_property({"id": "s", "ltl": "G F a == 1"}).formula,
+                         max_states=50)
+
+
+def test_check_properties_decides_ltl_on_an_unbounded_net_from_the_net():
+    from petriflow.properties.check import check_properties
+    from petriflow.properties.yaml_props import parse_property
+
+    net = _pump_beside_a_cycle()
+    results = check_properties(net, [parse_property({"id": "v", "ltl": "F G a == 1"}),
+                                     parse_property({"id": "s", "ltl": "G F a == 1"})],
+                               max_states=1000)
+    assert results[0]["verdict"] is False and results[0]["method"].endswith("generated on the fly")
+    start = fire_sequence(net, net.initial_marking, results[0]["witness"])
+    assert fire_sequence(net, start, results[0]["cycle"]) == start
+    assert results[1]["verdict"] is None and results[1]["reason"].startswith("unbounded net")
+
+
+def _pump_beside_a_cycle():
+    """``u`` and ``v`` move a token between ``a`` and ``c``; ``t`` pumps tokens into ``b``."""
     from petriflow.net import Net
 
     net = Net()
@@ -90,11 +118,4 @@ def test_the_search_from_the_net_stops_at_its_budget_or_at_a_shallow_counterexam
                            ("t", "b")):
         net.add_arc(source, target)
     net.set_initial_marking({"a": 1})
-    violated = parse_property({"id": "v", "ltl": "G c == 0"}).formula
-    verdict, lasso = check_ltl_on_net(net, net.initial_marking, violated, max_states=50)
-    assert verdict is False and "u" in lasso["witness"] + lasso["cycle"]
-    start = fire_sequence(net, net.initial_marking, lasso["witness"])
-    assert fire_sequence(net, start, lasso["cycle"]) == start
-    with pytest.raises(StateSpaceLimit):
-        check_ltl_on_net(net, net.initial_marking, parse_property({"id": "s", "ltl": "G a + c == 1"}).formula,
-                         max_states=50)
+    return net
