@@ -10,8 +10,9 @@ costs only the product states up to its counterexample, a satisfied one only the
 product states reachable from ``(s0, q0)``. The lasso is then read off: a shortest path
 to an accepting edge of that component, and a shortest way back around it.
 
-The loops are compiled by numba (:mod:`petriflow.analysis._numba`) and run as plain
-Python without it.
+The loops are compiled by numba (:mod:`petriflow.analysis._numba`) for a product of
+:data:`COMPILED_FROM_EDGES` edges or more, and run as plain Python otherwise (and
+without numba).
 """
 
 from __future__ import annotations
@@ -23,6 +24,18 @@ from petriflow.analysis._numba import njit
 __all__ = ["accepting_lasso"]
 
 _jit = njit(__name__)
+
+#: Below this many product edges (graph edges times automaton edges) the loops run as
+#: plain Python: loading the compiled ones costs more than they save.
+COMPILED_FROM_EDGES = 30_000
+
+
+def _loops(edges: int) -> tuple:
+    """``(search, accepting edge, shortest path)``: compiled, or their Python for a small product."""
+    loops = (_search, _accepting_edge, _shortest)
+    if edges < COMPILED_FROM_EDGES:
+        return tuple(getattr(loop, "py_func", loop) for loop in loops)
+    return loops
 
 
 def accepting_lasso(offsets: np.ndarray, targets: np.ndarray, guard: np.ndarray,
@@ -59,27 +72,31 @@ def accepting_lasso(offsets: np.ndarray, targets: np.ndarray, guard: np.ndarray,
     q_count = len(automaton_offsets) - 1
     size = (len(offsets) - 1) * q_count
     number = np.zeros(size, dtype=np.int64)
-    found = _search(offsets, targets, guard, automaton_offsets, automaton_targets, accepting,
-                    q_count, start, number)
+    edges = len(targets) * len(automaton_targets)
+    search, accepting_edge, shortest = _loops(edges)
+    # plain Python starts with room for every product state: it never grows its stacks
+    capacity = 1024 if edges >= COMPILED_FROM_EDGES else size + 1
+    found = search(offsets, targets, guard, automaton_offsets, automaton_targets, accepting,
+                   q_count, start, number, capacity)
     explored = int(found[1])
     if found[0] < 0:
         return None
     member = number >= found[0]             # the accepting component: still open, numbered late
-    edge = _accepting_edge(offsets, targets, guard, automaton_offsets, automaton_targets,
+    edge = accepting_edge(offsets, targets, guard, automaton_offsets, automaton_targets,
                            accepting, q_count, member)
     u, v, graph_edge = int(edge[0]), int(edge[1]), int(edge[2])
-    prefix = _shortest(offsets, targets, guard, automaton_offsets, automaton_targets, q_count,
+    prefix = shortest(offsets, targets, guard, automaton_offsets, automaton_targets, q_count,
                        start, u, np.ones(size, dtype=np.bool_))
-    back = _shortest(offsets, targets, guard, automaton_offsets, automaton_targets, q_count,
+    back = shortest(offsets, targets, guard, automaton_offsets, automaton_targets, q_count,
                      v, u, member)
     return prefix.tolist(), [graph_edge] + back.tolist(), explored
 
 
 @_jit
-def _search(offsets, targets, guard, a_off, a_dst, accepting, q_count, start, number):
+def _search(offsets, targets, guard, a_off, a_dst, accepting, q_count, start, number, capacity):
     """Couvreur's check: ``[root number of an accepting component or -1, states visited]``;
-    ``number`` keeps each state's depth-first number (``-1``: its component is closed)."""
-    capacity = 1024
+    ``number`` keeps each state's depth-first number (``-1``: its component is closed);
+    the stacks start with room for ``capacity`` states and double when full."""
     stack = np.empty(capacity, dtype=np.int64)      # depth-first path: product states
     cursor = np.empty(capacity, dtype=np.int64)     # and how far each has read its edges
     live = np.empty(capacity, dtype=np.int64)       # states of components not yet closed
