@@ -66,7 +66,7 @@ from petriflow.analysis.reachability import (
     reachability_graph,
     to_networkx,
 )
-from petriflow.analysis._graph import components, csr, reachable, reaching, transpose
+from petriflow.analysis._graph import components, csr, reachable, reaching, shortest_path, transpose
 from petriflow.analysis.check import check_net
 from petriflow.analysis.report import format_report
 from petriflow.analysis.soundness import (
@@ -86,6 +86,6 @@ __all__ = [
     "check_net", "check_soundness", "components", "csr", "coverability_graph", "coverability_search", "dead_transitions",
     "deadlock_witness", "deadlocks", "exit_code", "format_report", "is_covered_by_p_semiflows",
     "is_free_choice", "is_live", "is_reversible", "is_safe", "non_live_transitions",
-    "p_semiflows", "place_bounds", "reachability_graph", "reachable", "reaching", "structural_bounds", "t_semiflows",
+    "p_semiflows", "place_bounds", "reachability_graph", "reachable", "reaching", "shortest_path", "structural_bounds", "t_semiflows",
     "to_networkx", "transpose", "unbounded_places", "workflow_structure",
 ]

@@ -20,8 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["can_reach", "components", "csr", "occurring", "reachable", "reachable_from",
-           "reaching", "strong_components", "terminal_summary", "terminal_summary_csr",
-           "transpose"]
+           "reaching", "shortest_path", "strong_components", "terminal_summary",
+           "terminal_summary_csr", "transpose"]
 
 
 #: Below this many edges the pure-Python versions are used: loading the compiled
@@ -207,7 +207,9 @@ def components(offsets: np.ndarray, neighbours: np.ndarray, *, compiled: bool = 
                ) -> np.ndarray:
     """:func:`strong_components` of a graph in compressed-row form (see :func:`csr`)."""
     n = len(offsets) - 1
-    loops = _compiled(len(neighbours)) if compiled else None
+    # the pure-Python search visits every node: a graph of many nodes and few edges
+    # (a restriction of a large one) is compiled too
+    loops = _compiled(max(len(neighbours), n)) if compiled else None
     if loops is None:
         return _tarjan(n, offsets, neighbours)
     dtype = _node_dtype(n)
@@ -355,15 +357,17 @@ def reachable(offsets: np.ndarray, neighbours: np.ndarray, starts, *,
     """:func:`reachable_from` on a graph in compressed-row form (see :func:`csr`)."""
     n = len(offsets) - 1
     seen = np.zeros(n, dtype=bool)
-    starts = np.unique(np.asarray(starts, dtype=np.int64))
+    starts = _distinct(starts)
     if not starts.size:
         return seen
     if starts[0] < 0 or starts[-1] >= n:
         raise ValueError(f"start nodes must be 0 .. {n - 1}")
-    loops = _compiled(len(neighbours)) if compiled else None
+    loops = _compiled(max(len(neighbours), n)) if compiled else None
     if loops is not None:
-        loops["bfs"](offsets, neighbours, starts, seen, np.empty(n, dtype=_node_dtype(n)))
-        return seen
+        parent = np.full(n, -2, dtype=np.int64)      # the search of shortest_path, no goal
+        loops["parents"](offsets, neighbours, starts, seen, np.ones(n, dtype=bool), parent,
+                         np.empty(n, dtype=np.int64))
+        return parent != -2
     offsets_list, neighbours_list = offsets.tolist(), neighbours.tolist()
     seen_list = [False] * n
     queue = [int(s) for s in starts]
@@ -378,24 +382,71 @@ def reachable(offsets: np.ndarray, neighbours: np.ndarray, starts, *,
     return np.array(seen_list, dtype=bool)
 
 
-def _bfs_loop(offsets, neighbours, starts, seen, queue):
-    """Breadth-first search from ``starts`` (distinct): mark in ``seen`` what it reaches;
-    ``queue`` is scratch space of n entries."""
+def _distinct(nodes) -> np.ndarray:
+    """``nodes`` sorted without repeats (as they come when already so: ``flatnonzero``)."""
+    nodes = np.asarray(nodes, dtype=np.int64)
+    if nodes.size < 2 or bool(np.all(nodes[1:] > nodes[:-1])):
+        return nodes
+    return np.unique(nodes)
+
+
+def shortest_path(offsets: np.ndarray, neighbours: np.ndarray, starts, goal: np.ndarray,
+                  allowed: np.ndarray | None = None, *, compiled: bool = True) -> list[int] | None:
+    """Edge ids (positions in ``neighbours``) of a shortest path from a node of
+    ``starts`` to a ``goal`` node whose inner nodes are all ``allowed`` (the goal itself
+    need not be), or ``None``; a start in ``goal`` gives ``[]``.
+
+    Examples:
+        >>> offsets, neighbours = csr(4, np.array([0, 1, 2, 0]), np.array([1, 2, 3, 3]))
+        >>> goal = np.array([False, False, False, True])
+        >>> shortest_path(offsets, neighbours, [0], goal)
+        [1]
+        >>> shortest_path(offsets, neighbours, [0], goal, np.array([True, True, True, False]), compiled=False)
+        [1]
+    """
+    n = len(offsets) - 1
+    starts = _distinct(starts)
+    allowed = np.ones(n, dtype=bool) if allowed is None else np.asarray(allowed, dtype=bool)
+    parent = np.full(n, -2, dtype=np.int64)
+    loops = _compiled(max(len(neighbours), n)) if compiled else None
+    search = loops["parents"] if loops is not None else _parents_loop
+    found = int(search(offsets, neighbours, starts, np.asarray(goal, dtype=bool), allowed, parent,
+                       np.empty(n, dtype=np.int64)))
+    if found < 0:
+        return None
+    edges = []
+    node = found
+    while parent[node] >= 0:
+        edge = int(parent[node])
+        edges.append(edge)
+        node = int(np.searchsorted(offsets, edge, side="right") - 1)
+    return edges[::-1]
+
+
+def _parents_loop(offsets, neighbours, starts, goal, allowed, parent, queue):
+    """Breadth first from ``starts`` through ``allowed`` nodes: ``parent[v]`` the edge
+    that reached ``v`` (-1: a start, -2: not reached); return the first ``goal`` node
+    taken from the queue, or -1."""
     tail = 0
     for s in starts:
-        seen[s] = True
+        parent[s] = -1
         queue[tail] = s
         tail += 1
     head = 0
     while head < tail:
         node = queue[head]
         head += 1
+        if goal[node]:
+            return node
+        if not allowed[node]:
+            continue
         for edge in range(offsets[node], offsets[node + 1]):
             nxt = neighbours[edge]
-            if not seen[nxt]:
-                seen[nxt] = True
+            if parent[nxt] == -2:
+                parent[nxt] = edge
                 queue[tail] = nxt
                 tail += 1
+    return -1
 
 
 def can_reach(n: int, source, target, goals, *, compiled: bool = True) -> np.ndarray:
@@ -568,7 +619,7 @@ _LOOP_FUNCTIONS = {
     "offsets": _offsets_loop,
     "scatter": _scatter_loop,
     "pearce": _pearce_loop,
-    "bfs": _bfs_loop,
+    "parents": _parents_loop,
     "transpose": _transpose_loop,
     "exits": _exits_loop,
     "presence": _presence_loop,

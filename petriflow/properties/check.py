@@ -11,7 +11,9 @@ and decides every property on it:
   the witness reaches a marking with the bound; with ``at_most`` the verdict is whether
   the bound stays within it;
 * **ctl**: fixpoints (:mod:`~petriflow.properties.ctl`);
-* **ltl**: Spot's Büchi automaton times the graph (:mod:`~petriflow.properties.ltl`).
+* **ltl**: Spot's Büchi automaton times the graph (:mod:`~petriflow.properties.ltl`);
+* **boolean** (``A G F p && A F q``): each quantified operand by its own checker, the
+  verdicts combined (no evidence: each operand's is its own property's).
 
 Each result is ``{"id", "formula", "kind", "verdict", "method", "witness"}`` and, for a
 lasso, ``"cycle"`` (the firings repeated forever; empty: the last marking is a deadlock,
@@ -51,7 +53,7 @@ from petriflow.properties.ctl import ctl_witness, evaluate
 from petriflow.properties.kripke import Kripke
 from petriflow.analysis.stubborn import stubborn_deadlocks
 from petriflow.properties.language import (
-    AllPaths, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Property, names_used
+    AllPaths, And, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Or, Property, names_used
 )
 from petriflow.properties.ltl import check_ltl
 from petriflow.properties.yaml_props import check_property_names
@@ -84,6 +86,7 @@ def check_properties(net: Net, properties: Sequence[Property], *,
         partial = _explored_part(net, start, min(max_states, UNBOUNDED_STATES))
     kripke = Kripke(space) if space is not None else None
     cache: dict = {}
+    quotient: dict = {}            # the symmetry quotient, explored once when needed
     semiflows: list | None = None
     results = []
     for prop in properties:
@@ -105,6 +108,13 @@ def check_properties(net: Net, properties: Sequence[Property], *,
                 _partial_reachability(entry, prop, partial)
             if entry["verdict"] is None and prop.kind == "reachability":
                 _deadlock_by_stubborn_sets(entry, prop, net, start, max_states)
+            if entry["verdict"] is None and prop.kind == "reachability" and space is None \
+                    and reason is not None and reason.startswith("state space over budget"):
+                _by_symmetry(entry, prop, net, start, max_states, quotient)
+        elif prop.kind == "boolean":
+            verdict = _boolean(prop.formula, kripke, cache)
+            entry.update(verdict=verdict, method="Boolean combination: each quantified formula decided"
+                         " on the reachability graph (LTL: Spot Büchi automaton; CTL: fixpoints)")
         else:
             _decide(entry, prop, kripke, cache)
         if entry["verdict"] is None and "reason" not in entry:
@@ -172,6 +182,26 @@ def _decide(entry: dict, prop: Property, kripke: Kripke, cache: dict) -> None:
         entry.update(evidence)
 
 
+def _boolean(formula, kripke: Kripke, cache: dict) -> bool | None:
+    """A Boolean combination of quantified formulas at the initial marking: each operand
+    decided by its own checker, combined (``None``: some operand that matters undecided)."""
+    if isinstance(formula, Not):
+        value = _boolean(formula.operand, kripke, cache)
+        return None if value is None else not value
+    if isinstance(formula, (And, Or)):
+        decisive = isinstance(formula, Or)          # the value that settles the whole
+        values = [_boolean(f, kripke, cache) for f in formula.operands]
+        if decisive in values:
+            return decisive
+        return None if None in values else not decisive
+    sub = Property(id="", formula=formula)
+    if sub.kind == "ctl*":
+        return None
+    entry: dict[str, Any] = {"verdict": None}
+    _decide(entry, sub, kripke, cache)
+    return entry["verdict"]
+
+
 def _partial_reachability(entry: dict, prop: Property, partial: StateSpace) -> None:
     """A state found before the limit can settle ``EF p`` (true) or ``AG p`` (false)."""
     universal, predicate = _reachability_shape(prop.formula)
@@ -200,6 +230,37 @@ def _deadlock_by_stubborn_sets(entry: dict, prop: Property, net: Net, start, max
         return
     entry.update(verdict=found.deadlock != bool(universal), witness=found.witness,
                  method="stubborn sets (every reachable deadlock preserved)")
+
+
+def _by_symmetry(entry: dict, prop: Property, net: Net, start, max_states: int, quotient: dict) -> None:
+    """``AG p`` / ``EF p`` with ``p`` invariant under the agents' permutations, on the
+    quotient (:mod:`~petriflow.properties.symmetric`) when the full space is over budget."""
+    from petriflow.analysis.symmetry import SymmetryUnsupported, find_symmetries, symmetric_graph
+    from petriflow.properties.symmetric import holds_on_quotient, symmetric
+
+    universal, predicate = _reachability_shape(prop.formula)
+    if universal is None:
+        return
+    if "groups" not in quotient:
+        quotient["groups"] = find_symmetries(net)
+    groups = quotient["groups"]
+    if not groups or not symmetric(predicate, groups, net):
+        return
+    if "space" not in quotient:
+        try:
+            quotient["space"] = symmetric_graph(net, start, groups=groups, max_states=max_states)
+        except (StateSpaceLimit, SymmetryUnsupported):
+            quotient["space"] = None
+    space = quotient["space"]
+    if space is None:
+        return
+    holds = holds_on_quotient(space, predicate)
+    bad = np.flatnonzero(~holds if universal else holds)
+    entry.update(verdict=(not bad.size) if universal else bool(bad.size),
+                 method=f"symmetry quotient ({space.num_states} canonical markings; the predicate"
+                        " is invariant under the agents' permutations)")
+    if bad.size:
+        entry["witness"] = space.path(int(bad[0]))
 
 
 def _bound(entry: dict, prop: Property, space: StateSpace | None, proved: int | None,

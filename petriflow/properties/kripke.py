@@ -30,7 +30,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from petriflow.analysis import csr, transpose
+from petriflow.analysis import csr, shortest_path, transpose
 from petriflow.analysis.reachability import StateSpace
 from petriflow.errors import PetriflowError
 from petriflow.properties.language import (
@@ -70,6 +70,7 @@ class Kripke:
         self.labels = label[order]
         self.sources = source[order]
         self._reverse: tuple[np.ndarray, np.ndarray] | None = None
+        self._by_place: np.ndarray | None = None
         self._places = {p: j for j, p in enumerate(space.places)}
         self._origin_ids: dict[str, list[int]] = {}
         for row, origin in enumerate(space.origins):
@@ -96,12 +97,14 @@ class Kripke:
 
     def value(self, expression: Linear) -> np.ndarray:
         """The integer expression's value in every state."""
-        markings = self.space.markings
+        if self._by_place is None:      # one column per place, contiguous: read place by place
+            self._by_place = np.asfortranarray(self.space.markings)
+        markings = self._by_place
         total = np.full(self.n, expression.offset, dtype=np.int64)
         for place, k in expression.terms:
             if place not in self._places:
                 raise PropertyNameError(f"unknown place {place!r}")
-            total += k * markings[:, self._places[place]].astype(np.int64)
+            total += k * markings[:, self._places[place]].astype(np.int64, copy=False)
         return total
 
     def fireable(self, transitions: Sequence[str]) -> np.ndarray:
@@ -156,29 +159,7 @@ class Kripke:
 
         A start that is a goal gives the empty path.
         """
-        parent_edge = np.full(self.n, -2, dtype=np.int64)
-        queue = []
-        for s in starts:
-            if parent_edge[s] == -2:
-                parent_edge[s] = -1
-                queue.append(int(s))
-        offsets, targets = self.offsets, self.targets
-        for state in queue:                       # the list grows while we walk it: FIFO
-            if goal[state]:
-                edges = []
-                while parent_edge[state] >= 0:
-                    edge = int(parent_edge[state])
-                    edges.append(edge)
-                    state = int(self.sources[edge])
-                return edges[::-1]
-            if allowed is not None and not allowed[state]:
-                continue
-            for edge in range(offsets[state], offsets[state + 1]):
-                nxt = int(targets[edge])
-                if parent_edge[nxt] == -2:
-                    parent_edge[nxt] = edge
-                    queue.append(nxt)
-        return None
+        return shortest_path(self.offsets, self.targets, starts, goal, allowed)
 
     def names(self, edges: Sequence[int]) -> list[str]:
         """The transitions a path of edges fires (stutter edges left out)."""

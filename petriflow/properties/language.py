@@ -24,6 +24,10 @@ Examples:
     ('reachability', 'ltl')
     >>> classify(AllPaths(Globally(ExistsPath(Finally(p)))))
     'ctl'
+    >>> classify(Or((AllPaths(Globally(Finally(p))), ExistsPath(Finally(p)))))
+    'boolean'
+    >>> classify(AllPaths(Finally(ExistsPath(Globally(Finally(p))))))
+    'ctl*'
 """
 
 from __future__ import annotations
@@ -299,7 +303,9 @@ def classify(formula: Formula) -> str:
     ``reachability`` (``EF p``/``AG p``, p a state predicate, or a state predicate
     alone), ``ctl`` (every temporal operator directly under a quantifier), ``ltl``
     (``A`` or ``E`` around a quantifier-free path formula, or a path formula alone,
-    read as ``A``), else ``ctl*`` (not decided).
+    read as ``A``), ``boolean`` (``!``, ``&&``, ``||`` of quantified formulas of those
+    kinds, some of them LTL: ``A G F p && A F q``, each decided on its own), else
+    ``ctl*`` (not decided).
     """
     if is_state_formula(formula):
         return "reachability"
@@ -311,6 +317,10 @@ def classify(formula: Formula) -> str:
         return "ctl"
     if _is_path_ltl(formula) or (isinstance(formula, _QUANTIFIERS) and _is_path_ltl(formula.operand)):
         return "ltl"
+    if isinstance(formula, (And, Or, Not)) and all(
+            isinstance(c, (AllPaths, ExistsPath, And, Or, Not)) or is_state_formula(c) for c in formula.children()) \
+            and all(classify(c) != "ctl*" for c in formula.children()):
+        return "boolean"
     return "ctl*"
 
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from petriflow.analysis import components, csr, reachable
+from petriflow.analysis import components, csr, reachable, shortest_path
 from petriflow.errors import PetriflowError
 from petriflow.properties.kripke import Kripke
 from petriflow.properties.language import (
@@ -146,25 +146,12 @@ def _accepting_lasso(kripke: Kripke, path: Formula) -> dict | None:
 
 def _path(offsets, neighbours, start: int, goal: int, allowed: np.ndarray | None) -> list[int] | None:
     """Product edge ids of a shortest path ``start → goal`` through ``allowed`` nodes."""
-    parent = {start: -1}
-    queue = [start]
-    for node in queue:
-        if node == goal:
-            edges = []
-            while parent[node] >= 0:
-                edges.append(parent[node])
-                node = int(_source_of(offsets, parent[node]))
-            return edges[::-1]
-        for edge in range(offsets[node], offsets[node + 1]):
-            nxt = int(neighbours[edge])
-            if nxt not in parent and (allowed is None or allowed[nxt]):
-                parent[nxt] = edge
-                queue.append(nxt)
-    return None
-
-
-def _source_of(offsets: np.ndarray, edge: int) -> int:
-    return int(np.searchsorted(offsets, edge, side="right") - 1)
+    wanted = np.zeros(len(offsets) - 1, dtype=bool)
+    wanted[goal] = True
+    if allowed is not None and not allowed[start]:
+        allowed = allowed.copy()
+        allowed[start] = True               # the start is left whatever it is
+    return shortest_path(offsets, neighbours, [start], wanted, allowed)
 
 
 def _lasso(kripke: Kripke, offsets, neighbours, source, target, graph_edge, labels,

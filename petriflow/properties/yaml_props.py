@@ -292,6 +292,8 @@ def _property(entry: Any, path: str | None, line: int | None) -> Property:
             formula = AllPaths(Finally(_state(value, where)))
         elif kind == "ltl":
             formula = parse_formula(value)
+            if classify(formula) == "boolean":     # A G F p && A F q: each LTL formula quantified
+                return Property(ident, formula, line=line, source=path, description=description)
             if not isinstance(formula, (AllPaths, ExistsPath)):
                 formula = AllPaths(formula)
             if classify(formula) not in ("ltl", "reachability", "ctl") or any(

@@ -178,7 +178,8 @@ def model(events: list[Any], places: list[str] | None = None) -> dict[str, Any]:
         out["d_start"].append(len(change[0]))
         out["bad"].append(1 if event.kind in ("fault", "cancel") or (
             event.kind == "end" and data.get("outcome") != "ok") or (
-            event.kind == "message" and data.get("fate") == "lost") else 0)
+            event.kind == "message" and data.get("fate") == "lost") or (
+            event.kind == "custom" and data.get("name") == "property_violated") else 0)
         kind = event.kind
         if kind == "run":
             wanted = {place(p): n for p, n in data.get("marking", {}).items()}
@@ -303,7 +304,7 @@ SCRIPTS = ["common.js", "trace.js", "replay.js", "panel-net.js", "panel-world.js
 _KEEP = {"run": {"marking", "agents", "net", "seed", "dt"}, "start": {"firing", "consumed"},
          "end": {"firing", "outcome", "produced", "reason"}, "cancel": {"withdrawn", "actions"},
          "message": {"place", "fate", "channel", "receiver", "why", "arrival", "in_flight", "size", "distance"},
-         "pose": {"poses", "outlines"}, "custom": {"name", "firing"},
+         "pose": {"poses", "outlines"}, "custom": {"name", "firing", "property", "event"},
          "control": {"action", "added", "removed", "by", "wall", "spec", "place", "count", "firing", "number",
                      "outcome", "factor", "point", "tokens"}}
 

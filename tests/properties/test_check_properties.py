@@ -154,3 +154,58 @@ def test_deadlock_reachability_beyond_the_budget_by_stubborn_sets():
     assert (got["stuck"]["verdict"], got["free"]["verdict"]) == (False, True)
     assert got["stuck"]["method"].startswith("stubborn sets")
     assert got["other"]["verdict"] is True       # found before the limit
+
+
+def test_an_empty_place_bound_is_zero():
+    """The contest writes ``<place-bound/>`` with no place (Sudoku-PT-AN01): the empty sum, 0."""
+    from petriflow.properties.mcc_xml import parse_mcc_properties
+
+    text = ('<property-set xmlns="http://mcc.lip6.fr/"><property><id>N-UpperBounds-00</id>'
+            '<formula><place-bound/></formula></property></property-set>')
+    result = check_properties(loads_net(PASSAGE), parse_mcc_properties(text, "UpperBounds.xml"))[0]
+    assert (result["verdict"], result["witness"]) == (0, [])
+
+
+def test_ltl_formulas_under_boolean_connectives_are_decided_one_by_one():
+    """`A G F p || A F q`: each quantified LTL (or CTL) operand decided, the verdicts combined."""
+    net = loads_net(PASSAGE)
+    got = decide(net, {"id": "either", "ltl": "A(G(F(red_in >= 1))) || A(F(blue_in == 1))"},
+                 {"id": "both", "ltl": "E(G(F(red_in >= 1))) && A(G(red_in + blue_in <= 1))"},
+                 {"id": "not", "ltl": "!E(F(G(blue_in == 1)))"},
+                 {"id": "alone", "ltl": "G(F(red_in >= 1))"})
+    assert got["alone"]["verdict"] is False        # blue may take the passage forever
+    assert (got["either"]["kind"], got["either"]["verdict"]) == ("boolean", False)
+    assert got["both"]["verdict"] is True
+    assert got["not"]["verdict"] is True
+    with pytest.raises(NetFormatError, match="quantifiers"):
+        parse_property({"id": "nested", "ltl": "G(A(F(red_in >= 1)))"})
+
+
+TEAM = """
+petriflow: 1
+subnets:
+""" + "".join(f"""- {{id: a{k}, state: worker, places: [{{id: a{k}_idle, tokens: 1}}, a{k}_busy], transitions: [
+    {{id: a{k}_go, in: [a{k}_idle, lock], out: [a{k}_busy]}},
+    {{id: a{k}_back, in: [a{k}_busy], out: [a{k}_idle, lock]}}]}}
+""" for k in (1, 2, 3)) + """places: [{id: lock, tokens: 1}]
+"""
+
+
+def test_a_symmetric_safety_property_beyond_the_budget_is_decided_on_the_quotient():
+    """Three interchangeable workers, a budget of 2 markings (the full space has 4, the
+    quotient 2): a predicate every permutation keeps is decided; one naming a worker is not."""
+    net = loads_net(TEAM)
+    got = decide(net, {"id": "mutex", "never": "a1_busy + a2_busy + a3_busy >= 2"},
+                 {"id": "pairs", "always": "a1_busy + a2_busy <= 1 && a2_busy + a3_busy <= 1 && a1_busy + a3_busy <= 1"},
+                 {"id": "first", "always": "a1_busy <= 1"}, max_states=2)
+    assert got["mutex"]["verdict"] is True and "symmetry" in got["mutex"]["method"]
+    assert got["pairs"]["verdict"] is True
+    assert got["first"]["verdict"] is None
+
+
+def test_a_symmetric_violation_on_the_quotient_has_a_concrete_witness():
+    net = loads_net(TEAM.replace("{id: lock, tokens: 1}", "{id: lock, tokens: 2}"))
+    got = decide(net, {"id": "mutex", "never": "a1_busy + a2_busy + a3_busy >= 2"}, max_states=4)
+    assert got["mutex"]["verdict"] is False
+    end = fire_sequence(net, net.initial_marking, got["mutex"]["witness"])
+    assert sum(end.get(f"a{k}_busy", 0) for k in (1, 2, 3)) >= 2

@@ -2,7 +2,8 @@
    data of a page petriflow wrote: `node replay_node.js ASSETS PAGE.html` prints one JSON
    document: per event its record as the page rebuilds it, the marking after it, the transitions
    running, the firings failed in the last 5 s and the messages ended in the last 5 s (as the net
-   and the world panels ask); the messages and the bodies' poses. tests/view/test_replay_js.py
+   and the world panels ask), whether the page marks the event (red) and, for a property
+   violation found by `run --monitor`, the line the events panel shows; the messages and the bodies' poses. tests/view/test_replay_js.py
    compares them with petriflow's own replay. */
 "use strict";
 const fs = require("fs");
@@ -27,6 +28,9 @@ async function main() {
       running: replay.runningAt(i).map(f => f.t),
       failed: Array.from(replay.failedAt(i, 5), ([t, f]) => [t, f.outcome, f.reason]),
       ended: replay.endedWithin(i, 5).map(m => [m.s, m.e]),
+      bad: replay.bad[i] === 1,
+      violation: trace.event(i).kind === "custom" && trace.event(i).data.name === "property_violated"
+        ? PF.violation(trace.event(i)) : null,
     });
   }
   const bodies = {};

@@ -223,3 +223,19 @@ def test_a_big_team_net_is_drawn_folded_and_a_click_opens_one_agents_subnet(brow
     browser.find_element(By.ID, "net-back").click()
     assert len(browser.find_elements(By.CSS_SELECTOR, "#net g.node[data-agent]")) == 12
     assert console_errors(browser) == []
+
+
+def test_a_monitored_violation_leads_the_summary_and_is_red_in_the_events(browser, tmp_path):
+    """`run --monitor` found a violation: the summary names it first, its row is red."""
+    from petriflow.cli import main
+    from tests.properties.test_monitor import RACE
+
+    net = tmp_path / "race.yaml"
+    net.write_text(RACE)
+    trace = tmp_path / "race.jsonl"
+    assert main(["run", str(net), "--monitor", "--trace", str(trace), "--quiet"]) == 1
+    open_page(browser, petriflow.view(trace, out=tmp_path / "race.html"))
+    assert browser.find_element(By.ID, "summary").text.startswith("VIOLATED property exclusive at event ")
+    rows = [r for r in browser.find_elements(By.CSS_SELECTOR, "#events .row") if "VIOLATED" in r.text]
+    assert len(rows) == 1 and "failed" in rows[0].get_attribute("class").split()
+    assert console_errors(browser) == []

@@ -135,3 +135,23 @@ def test_node_rebuilds_awkward_records_exactly(awkward_events, tmp_path):
     trace = written(tmp_path, awkward_events)
     out = replayed(page_of(trace, tmp_path))["events"]
     assert [e["record"] for e in out] == lines(trace)
+
+
+def test_a_monitored_violation_is_marked_on_the_page(tmp_path):
+    """`run --monitor` records a violation as a `custom` event: the page marks it red and
+    its events panel names the property and the event that broke it."""
+    from petriflow.cli import main
+    from tests.properties.test_monitor import RACE
+
+    net = tmp_path / "race.yaml"
+    net.write_text(RACE)
+    trace = tmp_path / "race.jsonl"
+    assert main(["run", str(net), "--monitor", "--trace", str(trace), "--quiet"]) == 1
+    events = replayed(page_of(trace, tmp_path))["events"]
+    marked = [e for e in events if e["violation"]]
+    assert len(marked) == 1 and marked[0]["bad"]
+    violated_at = [e["record"]["seq"] for e in events
+                   if e["record"]["kind"] == "end" and e["record"]["transition"] == "blue_enter"]
+    assert marked[0]["violation"] == f"VIOLATED property exclusive at event {violated_at[0]} (blue_enter)"
+    assert not any(e["bad"] for e in events if not e["violation"])
+

@@ -71,5 +71,11 @@ globalThis.PF = (function () {
 
   function forget(canvas) { sizes.delete(canvas); }
 
-  return { data, inflate, inflateBytes, colour, lastAtMost, fmt, fit, forget, showError };
+  /** The line of a `custom` event `property_violated` (recorded by `run --monitor`). */
+  function violation(ev) {
+    const d = ev.data || {};
+    return `VIOLATED property ${d.property} at event ${d.event}${ev.transition ? " (" + ev.transition + ")" : ""}`;
+  }
+
+  return { data, inflate, inflateBytes, colour, lastAtMost, fmt, fit, forget, showError, violation };
 })();

@@ -10,7 +10,7 @@
   const live = {
     counts: new Array(places.length).fill(0), running: [], failures: [], time: 0, seq: -1,
     events: [], window: 400, control: { paused: false, steps: 0, breakpoints: [] }, stop: null,
-    connected: false, snapshotAt: null, updates: 0, received: 0,
+    connected: false, snapshotAt: null, updates: 0, received: 0, violations: [],
   };
   let socket = null, nextId = 1, panel = null;
   const waiting = new Map();
@@ -42,7 +42,10 @@
 
   function addEvents(events) {
     live.received += events.length;
-    for (const e of events) live.events.push(e);
+    for (const e of events) {
+      live.events.push(e);
+      if (e.kind === "custom" && e.data && e.data.name === "property_violated") live.violations.push(e);
+    }
     if (live.events.length > live.window) live.events.splice(0, live.events.length - live.window);
   }
 
@@ -59,6 +62,7 @@
       }
       case "stop": return `stop   ${d.reason} after ${d.firings} firings`;
       case "run": return `run    ${d.net} seed ${d.seed}`;
+      case "custom": if (d.name === "property_violated") return PF.violation(e);
       default: return `${e.kind} ${e.transition || ""}${who}`;
     }
   }
@@ -70,7 +74,8 @@
     const state = live.stop ? `ended: ${live.stop.reason}` : !live.connected ? "disconnected"
       : c.paused ? (c.steps ? `stepping (${c.steps} left)` : "paused") : "running";
     document.getElementById("status").textContent =
-      `t = ${live.time.toFixed(3)} s · event ${live.seq} · ${live.running.length} running · ${state}`;
+      `t = ${live.time.toFixed(3)} s · event ${live.seq} · ${live.running.length} running · ${state}` +
+      live.violations.map(e => ` · ${PF.violation(e)}`).join("");
     document.body.dataset.state = state.split(":")[0].split(" ")[0];
     document.getElementById("c-breaks").textContent = (c.breakpoints || []).length
       ? "breakpoints: " + c.breakpoints.join("; ") : "";
@@ -94,7 +99,8 @@
     list.textContent = "";
     for (const e of shown) {
       const div = document.createElement("div");
-      div.className = "row k-" + e.kind + (e.data && e.data.outcome && e.data.outcome !== "ok" ? " failed" : "");
+      const violated = e.kind === "custom" && e.data && e.data.name === "property_violated";
+      div.className = "row k-" + e.kind + ((e.data && e.data.outcome && e.data.outcome !== "ok") || violated ? " failed" : "");
       div.textContent = `${String(e.seq).padStart(6)}  t=${e.time.toFixed(3).padStart(9)}  ${describe(e)}`;
       list.appendChild(div);
     }
@@ -174,6 +180,7 @@
     get state() { return live.stop ? "ended" : live.control && live.control.paused ? "paused" : "running"; },
     get time() { return live.time; },
     get stop() { return live.stop; },
+    get violations() { return live.violations.map(e => ({ property: e.data.property, event: e.data.event })); },
     get control() { return live.control; },
     get events() { return live.events.length; },
     get received() { return live.received; },

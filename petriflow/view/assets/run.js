@@ -71,7 +71,11 @@
     const span = times[N - 1] - times[0];
     const stop = replay.kinds[replay.kindOf[N - 1]] === "stop" ? trace.event(N - 1).data.reason : "no stop event";
     const failed = replay.firings.filter(f => f.outcome && f.outcome !== "ok").length;
-    document.getElementById("summary").textContent =
+    const custom = replay.kinds.indexOf("custom"), violations = [];
+    for (let i = 0; custom >= 0 && i < N; i++) {
+      if (replay.kindOf[i] === custom && replay.bad[i]) violations.push(PF.violation(trace.event(i)));
+    }
+    document.getElementById("summary").textContent = violations.map(v => v + " · ").join("") +
       `${[D.trace, D.net_file].filter(Boolean).join(" on ") || D.name} · ${N} events over ${span.toFixed(2)} s simulated · ` +
       `${replay.firings.length} firings (${failed} not ok) · ${replay.messages.length} messages · ${replay.bodies.size} bodies posed · ` +
       `ended: ${stop} · trace ${(D.trace_bytes / 1e6).toFixed(2)} MB, page ${(D.page_bytes / 1e6).toFixed(2)} MB` +
