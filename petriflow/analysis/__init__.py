@@ -66,6 +66,7 @@ from petriflow.analysis.reachability import (
     reachability_graph,
     to_networkx,
 )
+from petriflow.analysis._lasso import accepting_lasso
 from petriflow.analysis._graph import components, csr, reachable, reaching, shortest_path, transpose
 from petriflow.analysis.check import check_net
 from petriflow.analysis.report import format_report
@@ -81,7 +82,7 @@ from petriflow.analysis.verdict import exit_code
 
 __all__ = [
     "DEFAULT_MAX_COVERABILITY", "DEFAULT_MAX_STATES", "OMEGA", "CoverabilityGraph",
-    "CoverabilitySearch", "InvariantLimit", "SoundnessReport",
+    "CoverabilitySearch", "InvariantLimit", "SoundnessReport", "accepting_lasso",
     "StateSpace", "StateSpaceLimit", "UnboundedNetError", "Violation", "WorkflowStructure",
     "check_net", "check_soundness", "components", "csr", "coverability_graph", "coverability_search", "dead_transitions",
     "deadlock_witness", "deadlocks", "exit_code", "format_report", "is_covered_by_p_semiflows",

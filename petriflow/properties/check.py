@@ -11,7 +11,10 @@ and decides every property on it:
   the witness reaches a marking with the bound; with ``at_most`` the verdict is whether
   the bound stays within it;
 * **ctl**: fixpoints (:mod:`~petriflow.properties.ctl`);
-* **ltl**: Spot's Büchi automaton times the graph (:mod:`~petriflow.properties.ltl`);
+* **ltl**: Spot's Büchi automaton times the graph, searched on the fly
+  (:mod:`~petriflow.properties.ltl`); when the graph is over budget or the net
+  unbounded, times markings generated from the net as the search goes (at most
+  :data:`ON_THE_FLY_STATES` of them per formula);
 * **boolean** (``A G F p && A F q``): each quantified operand by its own checker, the
   verdicts combined (no evidence: each operand's is its own property's).
 
@@ -55,7 +58,7 @@ from petriflow.analysis.stubborn import stubborn_deadlocks
 from petriflow.properties.language import (
     AllPaths, And, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Or, Property, names_used
 )
-from petriflow.properties.ltl import check_ltl
+from petriflow.properties.ltl import check_ltl, check_ltl_on_net
 from petriflow.properties.yaml_props import check_property_names
 from petriflow.workflow import workflow_structure
 
@@ -111,6 +114,8 @@ def check_properties(net: Net, properties: Sequence[Property], *,
             if entry["verdict"] is None and prop.kind == "reachability" and space is None \
                     and reason is not None and reason.startswith("state space over budget"):
                 _by_symmetry(entry, prop, net, start, max_states, quotient)
+            if prop.kind == "ltl":
+                _ltl_on_the_fly(entry, prop, net, start, min(max_states, ON_THE_FLY_STATES))
         elif prop.kind == "boolean":
             verdict = _boolean(prop.formula, kripke, cache)
             entry.update(verdict=verdict, method="Boolean combination: each quantified formula decided"
@@ -126,6 +131,11 @@ def check_properties(net: Net, properties: Sequence[Property], *,
 #: How many markings of an unbounded net are still explored, in search of markings that
 #: decide reachability properties (``EF p`` true, ``AG p`` false) or exceed a bound.
 UNBOUNDED_STATES = 100_000
+
+
+#: How many markings the LTL search from the net (no reachability graph: over budget or
+#: unbounded) may generate per formula: about 5 CPU s of Python.
+ON_THE_FLY_STATES = 100_000
 
 
 def _explored_part(net: Net, start, max_states: int) -> StateSpace | None:
@@ -230,6 +240,18 @@ def _deadlock_by_stubborn_sets(entry: dict, prop: Property, net: Net, start, max
         return
     entry.update(verdict=found.deadlock != bool(universal), witness=found.witness,
                  method="stubborn sets (every reachable deadlock preserved)")
+
+
+def _ltl_on_the_fly(entry: dict, prop: Property, net: Net, start, max_states: int) -> None:
+    """LTL beyond the reachability graph: the product searched from the net, markings
+    generated only as far as the search goes (at most ``max_states`` of them)."""
+    try:
+        verdict, lasso = check_ltl_on_net(net, start, prop.formula, max_states=max_states)
+    except StateSpaceLimit:
+        return
+    entry.update(verdict=verdict, method="LTL: Spot Büchi automaton x markings generated on the fly")
+    if lasso is not None:
+        entry.update(lasso)
 
 
 def _by_symmetry(entry: dict, prop: Property, net: Net, start, max_states: int, quotient: dict) -> None:

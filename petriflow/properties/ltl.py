@@ -31,16 +31,23 @@ Examples:
 
 from __future__ import annotations
 
+from collections import deque
+
 import numpy as np
 
-from petriflow.analysis import components, csr, reachable, shortest_path
+from petriflow.analysis import accepting_lasso, components, csr, reachable, shortest_path
+from petriflow.analysis.exploration import StateSpaceLimit
+from petriflow.engine import CompiledNet
 from petriflow.errors import PetriflowError
+from petriflow.marking import Marking
+from petriflow.net import Net
 from petriflow.properties.kripke import Kripke
+from petriflow.properties.monitor import compile_predicate
 from petriflow.properties.language import (
     AllPaths, And, Constant, ExistsPath, Finally, Formula, Globally, Next, Not, Or, Until, atoms
 )
 
-__all__ = ["check_ltl", "to_spot"]
+__all__ = ["PRODUCTS", "check_ltl", "check_ltl_on_net", "to_spot"]
 
 
 def to_spot(formula: Formula, names: dict[Formula, str]) -> str:
@@ -91,28 +98,68 @@ def _guard(spot, formula, values: dict[str, np.ndarray], n: int) -> np.ndarray:
     raise ValueError(f"unexpected guard {formula}")
 
 
-def check_ltl(kripke: Kripke, formula: Formula) -> tuple[bool, dict | None]:
+#: The product searches :func:`check_ltl` knows: ``"on-the-fly"`` (the default) builds
+#: the product's states as its depth-first search reaches them and stops at the first
+#: accepting cycle; ``"whole"`` builds every product edge as arrays, then its components.
+PRODUCTS = ("on-the-fly", "whole")
+
+
+def check_ltl(kripke: Kripke, formula: Formula, product: str = "on-the-fly"
+              ) -> tuple[bool, dict | None]:
     """``(verdict, evidence)`` of an LTL formula at the initial marking.
 
     ``formula`` is ``A ψ``, ``E ψ`` or a bare path formula ``ψ`` (read as ``A ψ``).
     The evidence is a lasso ``{"witness": prefix, "cycle": cycle}`` (firing sequences):
     a run violating ``A ψ``, or a run satisfying ``E ψ``; ``None`` otherwise.
+    ``product`` is one of :data:`PRODUCTS` (both give the same verdicts).
     """
+    if product not in PRODUCTS:
+        raise ValueError(f"unknown product search {product!r}: one of {', '.join(PRODUCTS)}")
     exists = isinstance(formula, ExistsPath)
     body = formula.operand if isinstance(formula, (AllPaths, ExistsPath)) else formula
-    found = _accepting_lasso(kripke, body if exists else Not(body))
+    search = _lasso_on_the_fly if product == "on-the-fly" else _accepting_lasso
+    found = search(kripke, body if exists else Not(body))
     if exists:
         return found is not None, found
     return found is None, found
 
 
-def _accepting_lasso(kripke: Kripke, path: Formula) -> dict | None:
-    """A lasso of the graph that satisfies ``path``, or ``None`` when there is none."""
+def _automaton(kripke: Kripke, path: Formula):
+    """Spot's Büchi automaton of ``path`` and its atoms' values on every state."""
     spot = _spot()
     names = {atom: f"p{k}" for k, atom in enumerate(atoms(path))}
     automaton = spot.translate(to_spot(path, names), "Buchi", "SBAcc")
-    condition = automaton.acc()
     values = {name: kripke.holds(atom) for atom, name in names.items()}
+    return spot, automaton, values
+
+
+def _lasso_on_the_fly(kripke: Kripke, path: Formula) -> dict | None:
+    """:func:`_accepting_lasso` by :func:`~petriflow.analysis.accepting_lasso`: the
+    product explored from ``(M0, q0)`` only as far as its first accepting cycle."""
+    spot, automaton, values = _automaton(kripke, path)
+    condition = automaton.acc()
+    dictionary = automaton.get_dict()
+    edges = sorted(automaton.edges(), key=lambda edge: edge.src)
+    q_count = automaton.num_states()
+    guard = np.empty((max(len(edges), 1), kripke.n), dtype=bool)
+    for j, edge in enumerate(edges):
+        guard[j] = _guard(spot, spot.bdd_to_formula(edge.cond, dictionary), values, kripke.n)
+    automaton_offsets = np.searchsorted([edge.src for edge in edges], np.arange(q_count + 1))
+    automaton_targets = np.array([edge.dst for edge in edges] or [0], dtype=np.int64)
+    accepting = np.array([condition.is_t() or (not condition.is_f() and bool(edge.acc))
+                          for edge in edges] or [False])
+    found = accepting_lasso(kripke.offsets, kripke.targets, guard, automaton_offsets.astype(np.int64),
+                            automaton_targets, accepting, automaton.get_init_state_number())
+    if found is None:
+        return None
+    prefix, cycle, _ = found
+    return {"witness": kripke.names(prefix), "cycle": kripke.names(cycle)}
+
+
+def _accepting_lasso(kripke: Kripke, path: Formula) -> dict | None:
+    """A lasso of the graph that satisfies ``path``, or ``None`` when there is none."""
+    spot, automaton, values = _automaton(kripke, path)
+    condition = automaton.acc()
     n, q_count = kripke.n, automaton.num_states()
     dictionary = automaton.get_dict()
     sources, targets, graph_edges, accepting = [], [], [], []
@@ -163,3 +210,179 @@ def _lasso(kripke: Kripke, offsets, neighbours, source, target, graph_edge, labe
     cycle = [accepting_edge] + back
     return {"witness": kripke.names(graph_edge[prefix].tolist()),
             "cycle": kripke.names(graph_edge[cycle].tolist())}
+
+
+def check_ltl_on_net(net: Net, start: Marking, formula: Formula, *, max_states: int
+                     ) -> tuple[bool, dict | None]:
+    """:func:`check_ltl` without the reachability graph: the markings are generated from
+    the net only as the product's search reaches them.
+
+    The same Couvreur search as :func:`~petriflow.analysis.accepting_lasso`, in Python
+    over markings: a violated ``A ψ`` (a satisfied ``E ψ``) costs only the markings up
+    to its lasso, a satisfied one the product's reachable part. It is what decides LTL
+    when the reachability graph is over budget or the net unbounded; with the graph
+    built, :func:`check_ltl` is faster (compiled, and the graph is shared by all the
+    formulas).
+
+    Raises:
+        StateSpaceLimit: the search stored more than ``max_states`` markings before
+            deciding.
+
+    Examples:
+        >>> from petriflow.classic import dining_philosophers
+        >>> from petriflow.properties.language import Finally, Fireable
+        >>> net = dining_philosophers(3)
+        >>> verdict, lasso = check_ltl_on_net(net, net.initial_marking,
+        ...                                   Finally(Fireable(("release_0",))), max_states=100)
+        >>> verdict, lasso["witness"], lasso["cycle"]
+        (False, [], ['take_1', 'release_1'])
+    """
+    exists = isinstance(formula, ExistsPath)
+    body = formula.operand if isinstance(formula, (AllPaths, ExistsPath)) else formula
+    found = _NetProduct(net, start, body if exists else Not(body), max_states).lasso()
+    if exists:
+        return found is not None, found
+    return found is None, found
+
+
+class _NetProduct:
+    """The product of the net's markings and the Büchi automaton of ``path``, explored
+    lazily (states ``(marking id, q)``; a deadlock stutters, as in the Kripke structure)."""
+
+    def __init__(self, net: Net, start: Marking, path: Formula, max_states: int) -> None:
+        spot = _spot()
+        self.compiled = CompiledNet(net)
+        names = {atom: f"p{k}" for k, atom in enumerate(atoms(path))}
+        automaton = spot.translate(to_spot(path, names), "Buchi", "SBAcc")
+        index = self.compiled.place_index
+        self.atoms = [compile_predicate(net, atom, index) for atom in names]
+        position = {name: k for k, name in enumerate(names.values())}
+        condition, dictionary = automaton.acc(), automaton.get_dict()
+        self.edges: list[list[tuple[object, int, bool]]] = [[] for _ in range(automaton.num_states())]
+        for edge in automaton.edges():
+            guard = _guard_function(spot, spot.bdd_to_formula(edge.cond, dictionary), position)
+            accepting = condition.is_t() or (not condition.is_f() and bool(edge.acc))
+            self.edges[edge.src].append((guard, edge.dst, accepting))
+        self.q0 = automaton.get_init_state_number()
+        self.max_states = max_states
+        self.markings: dict[tuple[int, ...], int] = {}
+        self.vectors: list[tuple[int, ...]] = []
+        self.values: list[tuple[bool, ...]] = []
+        self.moves: list[list[tuple[str | None, int]] | None] = []
+        self.start = self._marking(tuple(self.compiled.vector(start)))
+
+    def _marking(self, vector: tuple[int, ...]) -> int:
+        found = self.markings.get(vector)
+        if found is None:
+            if len(self.vectors) >= self.max_states:
+                raise StateSpaceLimit(self.max_states, len(self.vectors), 0)
+            found = self.markings[vector] = len(self.vectors)
+            self.vectors.append(vector)
+            self.values.append(tuple(bool(atom(vector)) for atom in self.atoms))
+            self.moves.append(None)
+        return found
+
+    def _moves(self, m: int) -> list[tuple[str | None, int]]:
+        """The firings from marking ``m``: ``(row id, target)``; a deadlock's stutter: ``(None, m)``."""
+        moves = self.moves[m]
+        if moves is None:
+            compiled, vector = self.compiled, self.vectors[m]
+            moves = []
+            for t in compiled.enabled(vector):
+                after = list(vector)
+                compiled.consume(after, t)
+                compiled.produce(after, t)
+                moves.append((compiled.transitions[t], self._marking(tuple(after))))
+            self.moves[m] = moves = moves or [(None, m)]
+        return moves
+
+    def successors(self, state: tuple[int, int]):
+        """``(successor, accepting, row id)`` of a product state ``(marking, q)``."""
+        m, q = state
+        values = self.values[m]
+        for guard, target, accepting in self.edges[q]:
+            if guard(values):
+                for name, after in self._moves(m):
+                    yield (after, target), accepting, name
+
+    def lasso(self) -> dict | None:
+        """Couvreur's search from ``(M0, q0)``, then the lasso around the component found."""
+        start = (self.start, self.q0)
+        number = {start: 1}
+        stack = [(start, self.successors(start))]
+        live, roots = [start], [(1, False, False)]      # (number, acceptance inside, entering)
+        while stack:
+            state, moves = stack[-1]
+            for after, accepting, _ in moves:
+                seen = number.get(after, 0)
+                if seen == 0:
+                    number[after] = len(number) + 1
+                    stack.append((after, self.successors(after)))
+                    live.append(after)
+                    roots.append((number[after], False, accepting))
+                    break
+                if seen > 0:                            # a cycle: merge its components
+                    acc = accepting
+                    while roots[-1][0] > seen:
+                        _, inside, entering = roots.pop()
+                        acc = acc or inside or entering
+                    root, inside, entering = roots[-1]
+                    roots[-1] = (root, inside or acc, entering)
+                    if inside or acc:
+                        return self._lasso(start, [s for s in live if number[s] >= root])
+            else:
+                stack.pop()
+                if roots[-1][0] == number[state]:       # the component closes
+                    roots.pop()
+                    while True:
+                        closed = live.pop()
+                        number[closed] = -1
+                        if closed == state:
+                            break
+        return None
+
+    def _lasso(self, start, component: list) -> dict:
+        members = set(component)
+        for u in component:                             # in depth-first order
+            for v, accepting, name in self.successors(u):
+                if accepting and v in members:
+                    prefix = self._shortest(start, u, None)
+                    back = self._shortest(v, u, members)
+                    return {"witness": [n for n in prefix if n is not None],
+                            "cycle": [n for n in [name] + back if n is not None]}
+        raise AssertionError("an accepting component has an accepting edge")  # pragma: no cover
+
+    def _shortest(self, start, goal, allowed: set | None) -> list[str | None]:
+        """Row ids (``None``: a stutter) of a shortest product path ``start → goal``."""
+        parent: dict = {start: None}
+        queue = deque([start])
+        while queue and goal not in parent:
+            state = queue.popleft()
+            for after, _, name in self.successors(state):
+                if after not in parent and (allowed is None or after in allowed):
+                    parent[after] = (state, name)
+                    queue.append(after)
+        path = []
+        while goal != start:
+            goal, name = parent[goal]
+            path.append(name)
+        return path[::-1]
+
+
+def _guard_function(spot, formula, position: dict[str, int]):
+    """A Spot Boolean formula as a function of the atoms' values (a tuple)."""
+    def source(node) -> str:
+        kind = node.kind()
+        if kind == spot.op_tt:
+            return "True"
+        if kind == spot.op_ff:
+            return "False"
+        if kind == spot.op_ap:
+            return f"v[{int(position[node.ap_name()])}]"
+        if kind == spot.op_Not:
+            return f"(not {source(node[0])})"
+        if kind in (spot.op_And, spot.op_Or):
+            return "(" + (" and " if kind == spot.op_And else " or ").join(source(f) for f in node) + ")"
+        raise ValueError(f"unexpected guard {node}")
+
+    return eval(compile(f"lambda v: {source(formula)}", "<guard>", "eval"), {"__builtins__": {}})  # noqa: S307
