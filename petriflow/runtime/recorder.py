@@ -6,6 +6,15 @@ only when an observer is subscribed to its kind (:meth:`Recorder.wants`), so a r
 nobody watches pays one counter increment per event, and one whose metrics read only
 custom events builds no event for the firings.
 
+An observer may also narrow what it hears to the transitions and places it is about
+(``on_event(handler, kinds, transitions=..., places=...)``): an event naming a
+transition (a firing's start or end, a cancellation, a custom event) reaches it only
+when that transition is one of ``transitions``, an event naming a place (a ``message``
+event's ``place``) only when that place is one of ``places``; an event naming neither reaches it always. An event that reaches
+no one is not built (:meth:`Recorder.wants` answers for a transition or a place), so a
+property monitor reading a few places costs nothing on the firings that touch none of
+them. Narrowed handlers receive an event after the handlers of all its events.
+
 Examples:
     >>> from petriflow.runtime.kernel import Kernel
     >>> recorder = Recorder(Kernel(dt=0.5))
@@ -18,6 +27,12 @@ Examples:
     >>> recorder.emit("start", "t", None); recorder.emit("custom", "t", None, name="y")
     >>> [e.seq for e in starts], [e.seq for e in seen], recorder.wants("end")
     ([2], [1, 2, 3], True)
+    >>> narrowed = Recorder(Kernel(dt=0.5)); about = []
+    >>> narrowed.on_event(about.append, kinds=["end", "message"], transitions={"t"}, places={"box"})
+    >>> narrowed.emit("end", "u", None); narrowed.emit("end", "t", None)
+    >>> narrowed.emit("message", None, None, place="other"); narrowed.emit("message", None, None, place="box")
+    >>> [(e.seq, e.kind) for e in about], narrowed.wants("end", "u"), narrowed.wants("message", place="box")
+    ([(1, 'end'), (3, 'message')], False, True)
 """
 
 from __future__ import annotations
@@ -30,6 +45,8 @@ from petriflow.runtime.trace import Event, EventKind
 __all__ = ["Recorder", "EventHandler"]
 
 EventHandler = Callable[[Event], None]
+#: A handler narrowed to transitions and places (``None``: any).
+Narrowed = tuple[EventHandler, "frozenset[str] | None", "frozenset[str] | None"]
 
 
 class Recorder:
@@ -45,21 +62,37 @@ class Recorder:
         #: ``{kind: [handler, ...]}``: who receives an event of each kind (a kind not in it
         #: goes to the handlers of every kind).
         self.by_kind: dict[str, list[EventHandler]] = {kind.value: [] for kind in EventKind}
+        #: ``{kind: [(handler, transitions, places), ...]}``: the narrowed handlers (``None``:
+        #: not narrowed on that name).
+        self.narrow: dict[str, list[Narrowed]] = {kind.value: [] for kind in EventKind}
         self.count = 0
 
     @property
     def active(self) -> bool:
         """Whether anyone listens (event data need only be built then)."""
-        return any(self.by_kind.values())
+        return any(self.by_kind.values()) or any(self.narrow.values())
 
-    def wants(self, kind: str) -> bool:
-        """Whether anyone listens to events of ``kind``."""
-        return bool(self.by_kind.get(kind, self._every))
+    def wants(self, kind: str, transition: str | None = None, place: str | None = None) -> bool:
+        """Whether anyone listens to events of ``kind`` (about ``transition`` or
+        ``place``, when given: a narrowed handler about neither does not count)."""
+        if self.by_kind.get(kind, self._every):
+            return True
+        return any(_about(ts, ps, transition, place) for _, ts, ps in self.narrow.get(kind, ()))
 
-    def on_event(self, handler: EventHandler, kinds: Iterable[str] | None = None) -> None:
+    def on_event(self, handler: EventHandler, kinds: Iterable[str] | None = None, *,
+                 transitions: Iterable[str] | None = None, places: Iterable[str] | None = None) -> None:
         """Call ``handler(event)`` for every event from now on, in order; only for the
         events of ``kinds`` (:class:`~petriflow.runtime.trace.EventKind` values) when
-        given."""
+        given, and only for those about ``transitions`` and ``places`` when given (see
+        the module documentation)."""
+        if transitions is not None or places is not None:
+            narrowed = (handler, None if transitions is None else frozenset(transitions),
+                        None if places is None else frozenset(places))
+            for kind in self.by_kind if kinds is None else kinds:
+                if kind not in self.by_kind:
+                    raise ValueError(f"no event kind {kind!r} (kinds: {', '.join(self.by_kind)})")
+                self.narrow[kind].append(narrowed)
+            return
         if kinds is None:
             self._every.append(handler)
             for handlers in self.by_kind.values():
@@ -79,8 +112,22 @@ class Recorder:
         seq = self.count
         self.count = seq + 1
         handlers = self.by_kind.get(kind, self._every)
-        if handlers:
+        narrow = self.narrow.get(kind)
+        if narrow:
+            place = data.get("place")
+            narrow = [h for h, ts, ps in narrow if _about(ts, ps, transition, place)]
+        if handlers or narrow:
             kernel = self.kernel
             event = Event(seq, round(kernel.tick * kernel.dt, 9), kind, transition, agent, data)
             for handler in handlers:
                 handler(event)
+            if narrow:
+                for handler in narrow:
+                    handler(event)
+
+
+def _about(transitions: frozenset[str] | None, places: frozenset[str] | None, transition: str | None,
+           place: str | None) -> bool:
+    """Whether an event naming ``transition`` and ``place`` concerns a handler narrowed to these."""
+    return ((transition is None or transitions is None or transition in transitions)
+            and (place is None or places is None or place in places))
