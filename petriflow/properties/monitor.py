@@ -24,9 +24,13 @@ action are in neither place). On that sequence of markings:
   not take: not monitored (``null``, with the reason).
 
 ``enabled(t)`` is read structurally (``t``'s input places hold enough tokens), without
-guards. Only the places the properties read are looked at: an event that moves none
-of them is skipped (so the LTL trace's positions are the markings after events that
-change those places). Results: :meth:`PropertyMonitor.results`, one entry per property like ``check``'s
+guards. Only the places the properties read are looked at: the monitor subscribes to
+the starts of the transitions that take from them, the ends of those that put into
+them (but for a channel place, whose tokens come as messages) and the messages that
+arrive in them (``delivered``, ``noticed``) (``Scheduler.on_event(..., transitions=, places=)``),
+so the run builds no event for the other firings and computes no message distance for
+it; an event that moves none of those places is skipped (so the LTL trace's positions
+are the markings after events that change those places). Results: :meth:`PropertyMonitor.results`, one entry per property like ``check``'s
 (``verdict``, ``method``, and ``violation``: ``{"seq", "time", "kind", "transition"}``).
 
 Examples:
@@ -63,6 +67,12 @@ __all__ = ["PropertyMonitor", "compile_predicate", "holds_on_trace"]
 
 #: The event kinds after which the marking may have changed.
 MOVING_KINDS = ("run", "start", "end", "cancel", "message", "fault")
+#: Those the monitor hears whatever they are about (the others: only those about the
+#: transitions and places its properties read).
+WHOLE_KINDS = ("run", "cancel", "fault")
+#: The fates of the messages that put a token into their place (a message sent or
+#: lost moves none).
+ARRIVING = ("delivered", "noticed")  # petriflow.runtime.channel_models.Fate values
 
 def holds_on_trace(formula: Formula, trace: Sequence[Mapping[Formula, bool]], at: int = 0) -> bool:
     """LTLf: whether the path formula holds at position ``at`` of a finite trace, each
@@ -206,8 +216,17 @@ class PropertyMonitor:
         self._atom_checks = [(a, compile_predicate(self.net, a, index)) for a in self._atoms]
         self._bound_columns = {p.id: [index[q] for q in dict.fromkeys(p.bound)] for p in self.properties
                                if p.formula is None}
-        self._relevant = frozenset(self._read)
-        scheduler.on_event(self, MOVING_KINDS)
+        self._relevant = read = frozenset(self._read)
+        net = self.net
+        taking = [t for t in net.transitions if not read.isdisjoint(net.preset(t))]
+        # a channel place's tokens arrive by message, not at the end of the firing that sends
+        giving = list(dict.fromkeys(t for p in read if net.places[p].channel is None for t in net.place_preset(p)))
+        # only what the properties read: the firings that take from or put into their
+        # places, the messages into them (no event is built for the others)
+        scheduler.on_event(self, WHOLE_KINDS)
+        scheduler.on_event(self, ("start",), transitions=taking)
+        scheduler.on_event(self, ("end",), transitions=giving)
+        scheduler.on_event(self, ("message",), places=read, fields={"fate": ARRIVING})
         scheduler.on_instant(self._flush)
 
     def _marking(self) -> dict[str, int]:

@@ -192,7 +192,8 @@ class Channels:
         model, _ = self.model_for(place)
         recorder, kernel = self.recorder, self.kernel
         distance = None  # asked of the world only for a model that reads it or a listener of the event
-        wanted = getattr(model, "needs_distance", True) or recorder.wants("message")
+        wanted = getattr(model, "needs_distance", True) or recorder.wants("message", place=place, fate=Fate.SENT.value) \
+            or recorder.wants("message", place=place, fate=Fate.LOST.value)
         if wanted and sender and receiver and self._distance is not None:
             distance = self._distance(sender, receiver)
         now = kernel.now

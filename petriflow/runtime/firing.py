@@ -159,7 +159,7 @@ class Firer:
         if self._acts[t] or self._sleepers.any:
             self.agents.acted(index.agent[t])
         recorder = self.recorder
-        if recorder.by_kind[_START]:
+        if recorder.by_kind[_START] or recorder.narrow[_START] and recorder.wants(_START, index.ids[t]):
             taken = self.tokens.black(index.row[t]) if inputs is None else inputs
             details: dict[str, Any] = {"firing": number, "consumed": {p: len(v) for p, v in taken.items()}}
             carried = {p: [summarize(d) for d in v] for p, v in taken.items() if any(d is not None for d in v)}
@@ -217,7 +217,7 @@ class Firer:
                                          action=self.net.transitions[tid].action))
         if ctx.emitted:
             for kind, data in ctx.emitted:  # summarized only for someone listening
-                if recorder.wants(_CUSTOM):
+                if recorder.wants(_CUSTOM, tid):
                     recorder.emit(_CUSTOM, tid, ctx.agent, firing=number, name=kind, data=summarize(data))
                 else:
                     recorder.skip()
@@ -246,7 +246,7 @@ class Firer:
                 for p, w in self.index.compiled.post[row]:
                     if channel[p]:
                         sent.extend([(places[p], outputs.get(places[p], result) if outputs else result)] * w)
-        if recorder.by_kind[_END]:
+        if recorder.by_kind[_END] or recorder.narrow[_END] and recorder.wants(_END, self.index.ids[t]):
             produced = {} if row is None else self.tokens.produced(row, self.index.channel)
             details: dict[str, Any] = {"firing": number, "outcome": outcome.value, "produced": produced}
             if shown is not None:

@@ -194,9 +194,13 @@ class Scheduler:
         self._finished: RunResult | None = None
 
     # Observers ----------------------------------------------------------------------
-    def on_event(self, handler: EventHandler, kinds: Iterable[str] | None = None) -> None:
-        """Call ``handler(event)`` for every event, in order (or for those of ``kinds``)."""
-        self.recorder.on_event(handler, kinds)
+    def on_event(self, handler: EventHandler, kinds: Iterable[str] | None = None, *,
+                 transitions: Iterable[str] | None = None, places: Iterable[str] | None = None,
+                 fields: Mapping[str, Iterable[Any]] | None = None) -> None:
+        """Call ``handler(event)`` for every event, in order (or for those of ``kinds``,
+        about ``transitions``, ``places`` and ``fields``: :meth:`Recorder.on_event
+        <petriflow.runtime.recorder.Recorder.on_event>`); an event no one hears is not built."""
+        self.recorder.on_event(handler, kinds, transitions=transitions, places=places, fields=fields)
 
     def on_instant(self, watcher: Any) -> None:
         """Call ``watcher(scheduler)`` after each instant: for displays that need no

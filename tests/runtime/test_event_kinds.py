@@ -51,3 +51,33 @@ def test_a_metric_of_some_kinds_gets_a_run_that_kept_only_those(tmp_path):
     default_registry.register_metric("test.kinds_seen", kinds_seen, events=True, replace=True)
     run_files(path, metrics=["test.kinds_seen"])
     assert seen["kinds"] == ["end", "run", "start", "stop"]
+
+
+TWO = """
+petriflow: 1
+net: narrowed
+places: [{id: a, tokens: 2}, b, {id: c, tokens: 1}, d]
+transitions:
+  - {id: go, action: core.wait, params: {seconds: 1}, in: [a], out: [b]}
+  - {id: other, action: core.wait, params: {seconds: 2}, in: [c], out: [d]}
+"""
+
+
+def test_an_observer_narrowed_to_transitions_and_fields_sees_only_those_numbered_as_the_whole_run():
+    everything, about_go, ok_ends = [], [], []
+    scheduler = Scheduler(loads_net(TWO), seed=0)
+    scheduler.on_event(everything.append)
+    scheduler.on_event(about_go.append, kinds=["start", "end"], transitions=["go"])
+    scheduler.on_event(ok_ends.append, fields={"outcome": ["ok"], "reason": ["no such reason"]})
+    scheduler.run()
+    assert [(e.seq, e.kind, e.transition) for e in about_go] == \
+        [(e.seq, e.kind, e.transition) for e in everything if e.kind in ("start", "end") and e.transition == "go"]
+    assert [e.kind for e in about_go] == ["start", "end", "start", "end"]
+    # every end has outcome ok; the stop event has a reason that is not the one asked for
+    assert [e.kind for e in ok_ends] == [e.kind for e in everything if e.kind != "stop"]
+    assert any(e.kind == "stop" and "reason" in e.data for e in everything)
+
+
+def test_a_narrowed_observer_of_an_unknown_kind_is_refused():
+    with pytest.raises(ValueError, match="no event kind 'ends'"):
+        Scheduler(loads_net(TWO), seed=0).on_event(print, kinds=["ends"], transitions=["go"])
