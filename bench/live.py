@@ -109,6 +109,9 @@ def one(until: float, live: bool, folder: Path, delay: float = 0.0) -> dict:
             follower.join(timeout=60)
     if process.returncode not in (0, 1):
         raise SystemExit(f"the run failed: {stderr.read_text()}")
+    if live and "snapshot_s" not in counts:
+        raise SystemExit("the follower never received the page's snapshot: the run ended before it connected"
+                         " (a longer --until, or a machine less loaded)")
     counts["cpu"] = cpu
     return counts
 
@@ -256,7 +259,7 @@ def main() -> None:
         rows = []
         for k in range(args.pairs):
             plain = one(args.until, False, folder)
-            live = one(args.until, True, folder, delay=1.0 + k)
+            live = one(args.until, True, folder, delay=1.0 + 0.5 * (k % 3))  # opened early, while the run goes on
             rows.append((plain["cpu"], live["cpu"], live))
             print(f"pair {k + 1}: without {plain['cpu']:.2f} s CPU, with --live {live['cpu']:.2f} s"
                   f" ({live['cpu'] / plain['cpu']:.3f}); {live.get('updates', 0)} updates,"
