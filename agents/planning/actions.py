@@ -60,7 +60,7 @@ from petriflow.agents.planning.maps import (
 )
 from petriflow.agents.planning.tracking import check_track
 from petriflow.capabilities import Poses, Positions, provides
-from petriflow.runtime.action import Action, ActionContext, InstantAction, Param, Port, Status
+from petriflow.runtime.action import ActionContext, InstantAction, Param, Port
 from petriflow.runtime.stopwatch import UNTIMED, Timing
 
 __all__ = ["PlanPath", "TrackPath", "plan_world_path", "scene_frame", "find_scene"]

@@ -56,7 +56,7 @@ from petriflow.properties.ctl import ctl_witness, evaluate
 from petriflow.properties.kripke import Kripke
 from petriflow.analysis.stubborn import stubborn_deadlocks
 from petriflow.properties.language import (
-    AllPaths, And, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Or, Property, names_used
+    AllPaths, And, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Or, Property
 )
 from petriflow.properties.ltl import check_ltl, check_ltl_on_net
 from petriflow.properties.yaml_props import check_property_names

@@ -17,7 +17,7 @@ from petriflow.analysis.report import check_net, exit_code
 from petriflow.analysis.structural import structural_soundness
 from petriflow.analysis.stubborn import reaches_marking, stubborn_deadlocks
 from petriflow.analysis.symmetry import find_symmetries, symmetric_graph
-from petriflow.engine import enabled, fire
+from petriflow.engine import enabled
 from petriflow.marking import Marking
 from petriflow.net import Net
 

@@ -1,7 +1,6 @@
 """Runs whose subnets execute on remote agents, over a real broker or router on loopback."""
 
 import json
-import textwrap
 
 import pytest
 
