@@ -31,8 +31,8 @@ Usage::
 
     python bench/mcc.py --sample 12 --seed 2021 --inputs INPUTS --state-space SS \\
         --exclude CircularTrains,Dekker,Eratosthenes,GPPP,HouseConstruction,Philosophers,ResAllocation,RobotManipulation \\
-        --models /tmp/mcc-sample --oracle ORACLE
-    python bench/mcc.py --models /tmp/mcc-sample --oracle ORACLE [--json out.json]
+        --models out/mcc-sample --oracle ORACLE
+    python bench/mcc.py --models out/mcc-sample --oracle ORACLE [--json out.json]
     python bench/mcc.py --models DIR --oracle ORACLE --only LTLCardinality,LTLFireability
 """
 
