@@ -21,7 +21,10 @@ service        method      context method                             served
 ``liveness``   ``alive``   ``ctx.running(agent)``                     yes
 ``settings``               ``ctx.settings``                           on the agent, from
                                                                        its own world file
-``agents``                 ``ctx.state``                              no
+``agents``                 ``ctx.state``                              on the agent, when
+                                                                       its subnet keeps a
+                                                                       state
+                                                                       (:mod:`~.held`)
 ``channels``               ``ctx.link``, ``ctx.medium``               no
 ``resources``              ``ctx.resource``                           no: refused at bind
                                                                        time
@@ -151,9 +154,11 @@ class _Liveness:
 
 
 def calling_services(settings: Mapping[str, Mapping[str, Any]],
-                     call: Callable[[str, str, list], Any]) -> RunServices:
+                     call: Callable[[str, str, list], Any], agents: Any = None) -> RunServices:
     """A remote goal's services: ``settings`` (the agent's own), proxies that ``call``
-    the run for what :data:`SERVED` lists, :class:`Unserved` for the rest.
+    the run for what :data:`SERVED` lists, :class:`Unserved` for the rest; ``agents``
+    (the agent's own, when it holds its subnet's state: :mod:`petriflow.bridge.held`)
+    serves ``ctx.state`` on the agent.
 
     Examples:
         >>> services = calling_services({}, lambda service, method, args: [f"{service}.{method}{args}"])
@@ -164,7 +169,8 @@ def calling_services(settings: Mapping[str, Mapping[str, Any]],
         ...
         petriflow.bridge.calls.CallRefused: ctx.state reaches the run's agent states, which is not served to remote agents (served: tokens.read, liveness.alive; leave this subnet local)
     """
-    return RunServices(agents=Unserved("agent states", "ctx.state"), tokens=_Tokens(call),
+    return RunServices(agents=agents if agents is not None else Unserved("agent states", "ctx.state"),
+                       tokens=_Tokens(call),
                        channels=Unserved("channel places", "ctx.link/ctx.medium"),
                        resources=Unserved("resources", "ctx.resource"), liveness=_Liveness(call),
                        settings=settings)

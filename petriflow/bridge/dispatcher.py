@@ -90,6 +90,11 @@ class GoalState:
     #: On resume, the simulated time the journal shows it ended at (its ending is taken
     #: then, as journaled: :mod:`petriflow.bridge.resume`); ``None``: a live goal.
     at: float | None = None
+    #: The newest values of the goal's subnet's state guards the agent sent (a result's
+    #: or a feedback's), ``(seq, {transition: bool})`` (:mod:`~.held`); ``None``: none.
+    snapshot: tuple[int, dict[str, bool]] | None = None
+    #: The custom events the goal's action emitted on the agent (its result's).
+    events: list[Any] = field(default_factory=list)
 
     @property
     def ended(self) -> bool:
@@ -264,6 +269,11 @@ class Dispatcher:
                     state.data, state.reason, state.answered = message.data, message.reason, now
                 elif isinstance(message, protocol.Cancelled):
                     state.phase, state.answered = Phase.CANCELLED, now
+                if isinstance(message, (protocol.Result, protocol.Feedback)) and message.seq:
+                    if state.snapshot is None or message.seq > state.snapshot[0]:
+                        state.snapshot = (message.seq, message.guards)
+                if isinstance(message, protocol.Result):
+                    state.events = message.events
                 if state.ended:
                     self._ended.notify_all()
         # an answer to a goal or a cancel sent again is expected twice; otherwise an ended goal's

@@ -1,0 +1,194 @@
+"""Agent-held state: a bridged subnet's state lives on its agent, its guards are evaluated
+there and cached by the run (petriflow/bridge/held.py). No network: an in-process hub
+carries the messages between a real agent server (in a thread) and a real run."""
+
+import json
+import sys
+import threading
+import types
+
+import pytest
+
+from petriflow.bridge import protocol
+from petriflow.bridge.agent import AgentServer, announcement
+from petriflow.bridge.spec import DEFAULT_CONNECT
+from petriflow.bridge.transport import TRANSPORTS
+from petriflow.runtime.action import Action, InstantAction, Param, Status
+from petriflow.runtime.agents import AgentState
+from petriflow.runtime.registry import Registry
+from petriflow.runtime.session import run_files
+
+from tests.bridge.test_calls import Hub
+
+
+class Counter(AgentState):
+    """An agent's state: a count, and the keys it touches."""
+
+    def __init__(self):
+        super().__init__()
+        self.n = 0
+
+    def bump(self):
+        self.n += 1
+        self.touch("n")
+
+
+class Make(InstantAction):
+    agent_state = Counter
+
+    def run(self, ctx):
+        ctx.state = Counter()
+
+
+class Bump(InstantAction):
+    agent_state = Counter
+    params = {"limit": Param(int, 3)}
+
+    def run(self, ctx):
+        ctx.state.bump()
+        ctx.emit("demo.bumped", n=ctx.state.n)
+
+
+class Slow(Action):
+    """Bumps the count when it starts, then goes on for ``seconds`` (the state changed mid-action)."""
+
+    agent_state = Counter
+    needs_world = False
+    params = {"seconds": Param(float, 0.3), "limit": Param(int, 0)}
+
+    def start(self, ctx):
+        ctx.state.bump()
+        self.until = ctx.now + self.params["seconds"]
+        self.wake_at = self.until
+
+    def poll(self, ctx):
+        return Status.OK if ctx.now >= self.until - 1e-9 else Status.RUNNING
+
+
+def demo_registry():
+    registry = Registry()
+    registry.register_state("demo.counter", Counter)
+    registry.register("demo.make", Make)
+    registry.register("demo.bump", Bump)
+    registry.register("demo.slow", Slow)
+    registry.predicate("demo.below", reads=("n",))(lambda state, params: state is not None and state.n < params["limit"])
+    registry.predicate("demo.reached", reads=("n",))(lambda state, params: state is not None and state.n >= params["limit"])
+    registry.predicate("demo.none", reads=("n",))(lambda state, params: state is None)
+    return registry
+
+
+NET = """
+petriflow: 1
+net: held
+final: {finished: 2}
+subnets:
+- id: counter
+  agent: robot
+  state: demo.counter
+  places: [{id: start, tokens: 1}, work, {id: side, tokens: 1}, noted, {id: fresh, tokens: 1}, finished]
+  transitions:
+  - {id: before, guard: demo.none, params: {limit: 0}, in: [fresh], out: [noted]}
+  - {id: make, action: demo.make, in: [start], out: [work]}
+  - {id: slow, action: demo.slow, params: {seconds: 0.3, limit: 0}, guard: demo.reached, in: [work, side], out: [work],
+     priority: 2}
+  - {id: note, guard: demo.reached, params: {limit: 1}, in: [noted], out: [finished], priority: 3}
+  - {id: bump, action: demo.bump, guard: demo.below, params: {limit: 3}, in: [work], out: [work]}
+  - {id: done, guard: demo.reached, params: {limit: 3}, in: [work], out: [finished]}
+"""
+
+
+@pytest.fixture
+def hub(monkeypatch):
+    """A transport named ``hub``: one in-process hub for the run and the agent."""
+    shared = Hub()
+    module = types.ModuleType("petriflow_test_hub")
+    module.connect = lambda endpoint, name="": shared
+    monkeypatch.setitem(sys.modules, "petriflow_test_hub", module)
+    monkeypatch.setitem(TRANSPORTS, "hub", "petriflow_test_hub")
+    monkeypatch.setitem(DEFAULT_CONNECT, "hub", "tcp/127.0.0.1:1")
+    return shared
+
+
+@pytest.fixture
+def agent(hub):
+    server = AgentServer(["robot"], hub, registry=demo_registry(), heartbeat=0.05, speed=20)
+    thread = threading.Thread(target=server.serve, daemon=True)
+    thread.start()
+    yield server
+    server.stop()
+    thread.join(timeout=10)
+    assert not thread.is_alive()
+
+
+def starts(path):
+    events = [json.loads(line) for line in path.read_text().splitlines()]
+    return [e["transition"] for e in events if e["kind"] == "start"], events
+
+
+def test_a_bridged_stateful_subnet_fires_as_the_simulated_run(agent, hub, tmp_path):
+    """The state lives on the agent; the run's guards answer from the agent's snapshots:
+    the same firings in the same order as the simulated run, each goal executed once."""
+    (tmp_path / "net.yaml").write_text(NET)
+    registry = demo_registry()
+    simulated = run_files(tmp_path / "net.yaml", registry=registry, trace=tmp_path / "sim.jsonl")
+    spec = {"transport": "hub", "connect": "tcp/127.0.0.1:1", "agents": {"counter": "robot"}, "heartbeat": 0.05, "wait": 5}
+    (tmp_path / "run.yaml").write_text(f"seed: 1\nbridge: {json.dumps(spec)}\n")
+    bridged = run_files(tmp_path / "net.yaml", registry=registry, trace=tmp_path / "bridged.jsonl")
+    assert simulated.reason == bridged.reason == "final"
+    assert bridged.tokens == simulated.tokens
+    order, events = starts(tmp_path / "bridged.jsonl")
+    expected, sim_events = starts(tmp_path / "sim.jsonl")
+    assert order == expected
+    ends = [(e["kind"], e["transition"]) for e in events if e["kind"] in ("start", "end")]
+    assert ends == [(e["kind"], e["transition"]) for e in sim_events if e["kind"] in ("start", "end")]
+    assert ends.index(("start", "note")) < ends.index(("end", "slow"))  # on the snapshot of a feedback
+    # `before` fired on no state, `note` fired while `slow` still ran (a feedback's snapshot)
+    assert order[:3] == ["before", "make", "slow"] and order.index("note") < order.index("bump")
+    assert sorted(order) == sorted(["before", "make", "slow", "note", "bump", "bump", "done"])
+    assert agent.executed == 4  # make, slow, bump, bump: once each
+    # the custom events the agent's action emitted are in the run's trace, as in the simulated one
+    bumped = [e["data"]["data"]["n"] for e in events if e["kind"] == "custom" and e["data"]["name"] == "demo.bumped"]
+    assert bumped == [e["data"]["data"]["n"] for e in sim_events
+                      if e["kind"] == "custom" and e["data"]["name"] == "demo.bumped"] == [2, 3]
+    # the run never held the state: the agent did
+    assert [type(h.state).__name__ for run in agent.memory.runs.values() for h in run.values()] == ["Counter"]
+    goals = [protocol.decode(p) for t, p in hub.published if t == "petriflow/v1/to/robot"]
+    goals = [g for g in goals if isinstance(g, protocol.Goal)]
+    assert {g.transition: g.state["type"] for g in goals} == {"make": "demo.counter", "slow": "demo.counter",
+                                                              "bump": "demo.counter"}
+    assert goals[0].state["guards"]["done"] == ["demo.reached", {"limit": 3}]
+    feedback = [protocol.decode(p) for t, p in hub.published if t == "petriflow/v1/from/robot"]
+    assert any(isinstance(m, protocol.Feedback) and m.guards.get("note") for m in feedback)
+
+
+def test_a_state_of_the_wrong_type_fails_the_goal_on_the_agent(agent, hub, tmp_path):
+    """The agent checks the state an action sets against the type the subnet declares."""
+    class Wrong(InstantAction):
+        def run(self, ctx):
+            ctx.state = 3
+
+    registry = demo_registry()
+    registry.register("demo.wrong", Wrong)
+    agent.registry.register("demo.wrong", Wrong)
+    agent.actions = announcement(agent.registry)
+    (tmp_path / "net.yaml").write_text(NET.replace("action: demo.make", "action: demo.wrong"))
+    spec = {"transport": "hub", "connect": "tcp/127.0.0.1:1", "agents": {"counter": "robot"}, "heartbeat": 0.05, "wait": 5}
+    (tmp_path / "run.yaml").write_text(f"seed: 1\nbridge: {json.dumps(spec)}\n")
+    result = run_files(tmp_path / "net.yaml", registry=registry, trace=tmp_path / "t.jsonl")
+    assert result.reason == "failed"
+    events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+    end = next(e for e in events if e["kind"] == "end" and e["transition"] == "make")
+    assert "its state must be a Counter, not int" in json.dumps(end)
+
+
+def test_messages_without_the_extensions_are_the_bytes_they_were():
+    """Agent-held state extends version 1 compatibly: empty extension fields are left out."""
+    goal = protocol.Goal("r/1/1", "red", "core.wait", {"seconds": 1.0})
+    assert b"state" not in protocol.encode(goal)
+    result = protocol.Result("r/1/1", "red", "ok")
+    assert protocol.encode(result) == b'{"v":1,"type":"result","id":"r/1/1","agent":"red","outcome":"ok",' \
+                                      b'"data":null,"reason":""}'
+    held = protocol.Result("r/1/1", "red", "ok", None, "", {"t": True}, 4, [["x", {"a": 1}]])
+    assert protocol.decode(protocol.encode(held)) == held
+    with pytest.raises(protocol.Refused, match="guards maps transitions"):
+        protocol.decode(b'{"v":1,"type":"result","id":"x","agent":"a","outcome":"ok","guards":{"t":1}}')
