@@ -465,9 +465,9 @@ class AgentServer:
                 status, reason = Status.FAILED, str(exc)
         if status is Status.OK:
             data = ctx.result
-            if ctx.per_place and isinstance(data, dict):
-                data = None
-            answer = protocol.Result(goal.id, goal.agent, "ok", protocol.to_data(data), "", values, seq, events)
+            per_place = bool(ctx.per_place and isinstance(data, dict))
+            answer = protocol.Result(goal.id, goal.agent, "ok", protocol.to_data(data), "", values, seq, events,
+                                     protocol.to_data(ctx.outputs or {}), per_place)
         else:
             answer = protocol.Result(goal.id, goal.agent, "failed", None, reason or ctx.reason or "failed", values,
                                      seq, events)

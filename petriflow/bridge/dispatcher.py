@@ -93,8 +93,11 @@ class GoalState:
     #: The newest values of the goal's subnet's state guards the agent sent (a result's
     #: or a feedback's), ``(seq, {transition: bool})`` (:mod:`~.held`); ``None``: none.
     snapshot: tuple[int, dict[str, bool]] | None = None
-    #: The custom events the goal's action emitted on the agent (its result's).
+    #: The custom events the goal's action emitted on the agent, the data of its output
+    #: places given apart (``ctx.put``), and whether its data is per output place (its result's).
     events: list[Any] = field(default_factory=list)
+    outputs: dict[str, Any] = field(default_factory=dict)
+    per_place: bool = False
 
     @property
     def ended(self) -> bool:
@@ -273,7 +276,7 @@ class Dispatcher:
                     if state.snapshot is None or message.seq > state.snapshot[0]:
                         state.snapshot = (message.seq, message.guards)
                 if isinstance(message, protocol.Result):
-                    state.events = message.events
+                    state.events, state.outputs, state.per_place = message.events, message.outputs, message.per_place
                 if state.ended:
                     self._ended.notify_all()
         # an answer to a goal or a cancel sent again is expected twice; otherwise an ended goal's

@@ -63,7 +63,7 @@ MAX_MESSAGE = 1 << 20
 MAX_DEPTH = 32
 #: Fields added to version 1 compatibly (agent-held state): left out of a message
 #: when empty, so a message that does not use them is the bytes it always was.
-EXTENSIONS = frozenset({"state", "guards", "seq", "events"})
+EXTENSIONS = frozenset({"state", "guards", "seq", "events", "outputs", "per_place"})
 
 
 class Kind(Name):
@@ -216,6 +216,8 @@ class Result(About):
     guards: dict[str, bool] = field(default_factory=dict)
     seq: int = 0
     events: list[Any] = field(default_factory=list)
+    outputs: dict[str, Any] = field(default_factory=dict)
+    per_place: bool = False
 
 
 def _bare(name: str, kind: Kind, doc: str) -> type[About]:
@@ -325,7 +327,7 @@ def _depth(value: Any, depth: int = 0) -> int:
     return depth
 
 
-_FIELD_TYPES = {"str": str, "dict[str, Any]": dict, "dict[str, bool]": dict, "dict[str, dict[str, Any]]": dict,
+_FIELD_TYPES = {"str": str, "dict[str, Any]": dict, "dict[str, bool]": dict, "bool": bool, "dict[str, dict[str, Any]]": dict,
                 "dict[str, list[Any]]": dict, "list[str]": list,
                 "int": int, "list[Any]": list}
 

@@ -88,7 +88,9 @@ class RemoteAction(Action):
         if state is not None and state.ended:
             self._record(ctx, state)
             if state.phase == Phase.OK:
-                ctx.result = state.data
+                ctx.result, ctx.per_place = state.data, state.per_place
+                for place, data in state.outputs.items():  # ctx.put on the agent
+                    ctx.put(place, data)
                 return Status.OK
             ctx.reason = f"{self.remote_agent}: {state.reason or state.phase}"
             return Status.FAILED

@@ -47,6 +47,7 @@ class Bump(InstantAction):
     def run(self, ctx):
         ctx.state.bump()
         ctx.emit("demo.bumped", n=ctx.state.n)
+        ctx.put("work", {"n": ctx.state.n})  # an output place's own data
 
 
 class Slow(Action):
@@ -136,6 +137,7 @@ def test_a_bridged_stateful_subnet_fires_as_the_simulated_run(agent, hub, tmp_pa
     bridged = run_files(tmp_path / "net.yaml", registry=registry, trace=tmp_path / "bridged.jsonl")
     assert simulated.reason == bridged.reason == "final"
     assert bridged.tokens == simulated.tokens
+    assert {"n": 3} in bridged.tokens["finished"]  # bump's ctx.put on the agent, passed on by done
     order, events = starts(tmp_path / "bridged.jsonl")
     expected, sim_events = starts(tmp_path / "sim.jsonl")
     assert order == expected
