@@ -1,0 +1,154 @@
+"""Agent-held state over each real transport: three robots, each a subnet that keeps its state
+(a counter, changed by its actions, read by its guards), bridged to `petriflow agent`
+processes (robot1 alone, robot2 and robot3 sharing one), against the simulated run with
+the same seed."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+pytestmark = pytest.mark.slow
+
+ROBOTS = ("robot1", "robot2", "robot3")
+
+ACTIONS = '''
+from petriflow.runtime.registry import default_registry as registry
+from petriflow.runtime.action import Action, InstantAction, Param, Status
+from petriflow.runtime.agents import AgentState
+
+
+class Tally(AgentState):
+    def __init__(self):
+        super().__init__()
+        self.n = 0
+
+    def bump(self):
+        self.n += 1
+        self.touch("n")
+
+
+class Make(InstantAction):
+    agent_state = Tally
+
+    def run(self, ctx):
+        ctx.state = Tally()
+
+
+class Step(Action):
+    """Counts one when it starts (a guard may then fire mid-action), ends after `seconds`."""
+
+    agent_state = Tally
+    needs_world = False
+    params = {"seconds": Param(float, 0.2), "limit": Param(int, 3)}
+
+    def start(self, ctx):
+        ctx.state.bump()
+        ctx.emit("held.step", n=ctx.state.n)
+        self.until = ctx.now + self.params["seconds"]
+        self.wake_at = self.until
+
+    def poll(self, ctx):
+        if ctx.now < self.until - 1e-9:
+            return Status.RUNNING
+        ctx.put(ctx.agent + "_work", {"n": ctx.state.n})
+        return Status.OK
+
+
+registry.register_state("held.tally", Tally)
+registry.register("held.make", Make)
+registry.register("held.step", Step)
+registry.predicate("held.below", reads=("n",))(lambda s, p: s is not None and s.n < p["limit"])
+registry.predicate("held.reached", reads=("n",))(lambda s, p: s is not None and s.n >= p["limit"])
+'''
+
+
+def robot(name, seconds):
+    return f"""\
+- id: {name}
+  agent: {name}
+  state: held.tally
+  places: [{{id: {name}_start, tokens: 1}}, {name}_work, {name}_seen, {{id: {name}_eye, tokens: 1}}, {name}_done]
+  transitions:
+  - {{id: {name}_make, action: held.make, in: [{name}_start], out: [{name}_work]}}
+  - {{id: {name}_step, action: held.step, params: {{seconds: {seconds}, limit: 3}}, guard: held.below,
+     in: [{name}_work], out: [{name}_work]}}
+  - {{id: {name}_first, guard: held.reached, params: {{limit: 1}}, priority: 2, in: [{name}_eye],
+     out: [{name}_seen]}}
+  - {{id: {name}_finish, guard: held.reached, params: {{limit: 3}}, in: [{name}_work], out: [{name}_done]}}
+"""
+
+
+NET = "petriflow: 1\nnet: held3\nfinal: {robot1_done: 1, robot2_done: 1, robot3_done: 1, robot1_seen: 1," \
+      " robot2_seen: 1, robot3_seen: 1}\nsubnets:\n" + "".join(
+          robot(name, seconds) for name, seconds in zip(ROBOTS, (0.3, 0.2, 0.4)))
+
+
+def per_robot(events):
+    order = {}
+    for event in events:
+        if event["kind"] in ("start", "end") and event["agent"] in ROBOTS:
+            order.setdefault(event["agent"], []).append((event["kind"], event["transition"]))
+    return order
+
+
+def load(path):
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+def petriflow(*args, **options):
+    return subprocess.run([sys.executable, "-m", "petriflow.cli", *args], capture_output=True, text=True,
+                          timeout=300, **options)
+
+
+def test_three_robots_with_agent_held_state_fire_as_the_simulated_run(middleware, tmp_path):
+    """Exit 0, the final marking, each robot's starts and ends in the simulated run's order
+    (a guard made true mid-action fires before the action ends), the same output tokens and
+    custom events, each goal executed once."""
+    kind, server = middleware
+    (tmp_path / "held_actions.py").write_text(ACTIONS)
+    (tmp_path / "net.yaml").write_text(NET)
+    (tmp_path / "sim.yaml").write_text("seed: 1\nuntil: 60\nactions: [held_actions.py]\n")
+    simulated = petriflow("run", str(tmp_path / "net.yaml"), "--config", str(tmp_path / "sim.yaml"), "--trace",
+                          str(tmp_path / "sim.jsonl"))
+    assert simulated.returncode == 0, simulated.stdout + simulated.stderr
+    bridge = {"transport": kind, "connect": server.connect, "agents": {r: r for r in ROBOTS}, "heartbeat": 0.2,
+              "wait": 20}
+    (tmp_path / "run.yaml").write_text(f"seed: 1\nuntil: 60\nactions: [held_actions.py]\nbridge: {json.dumps(bridge)}\n")
+    agents = []
+    try:
+        for names, log in ((["robot1"], "a1.log"), (["robot2", "robot3"], "a23.log")):
+            agents.append(subprocess.Popen(
+                [sys.executable, "-m", "petriflow.cli", "agent", *[a for n in names for a in ("--name", n)],
+                 "--transport", kind, "--connect", server.connect, "--actions", str(tmp_path / "held_actions.py"),
+                 "--heartbeat", "0.2", "--log", str(tmp_path / log)],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        run = petriflow("run", str(tmp_path / "net.yaml"), "--config", str(tmp_path / "run.yaml"), "--trace",
+                        str(tmp_path / "bridged.jsonl"))
+    finally:
+        for agent in agents:
+            agent.terminate()
+        for agent in agents:
+            agent.wait(timeout=20)
+    assert all(agent.poll() is not None for agent in agents)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "held3: final" in run.stdout
+    sim, bridged = load(tmp_path / "sim.jsonl"), load(tmp_path / "bridged.jsonl")
+    assert per_robot(bridged) == per_robot(sim)
+    for name in ROBOTS:
+        order = per_robot(bridged)[name]
+        assert order.index(("start", f"{name}_first")) < order.index(("end", f"{name}_step"))
+    assert [e for e in bridged if e["kind"] == "stop"][0]["data"]["marking"] == \
+        [e for e in sim if e["kind"] == "stop"][0]["data"]["marking"]
+
+    def steps(events):
+        return sorted((e["agent"], e["data"]["data"]["n"]) for e in events
+                      if e["kind"] == "custom" and e["data"]["name"] == "held.step")
+
+    assert steps(bridged) == steps(sim) == sorted((r, n) for r in ROBOTS for n in (1, 2, 3))
+    ends = {e["transition"]: e["data"].get("result") for e in bridged if e["kind"] == "end"}
+    executed = [json.loads(line) for log in ("a1.log", "a23.log") for line in (tmp_path / log).read_text().splitlines()]
+    assert len(executed) == len({e["goal"] for e in executed}) == 12  # make + 3 steps per robot, once each
+    assert {e["agent"] for e in executed} == set(ROBOTS)
+    assert ends  # every firing ended in the trace
