@@ -38,7 +38,6 @@ Examples:
 from __future__ import annotations
 
 import dataclasses
-import logging
 from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -53,7 +52,6 @@ from petriflow.runtime.registry import Registry, UnknownActionError
 __all__ = ["HeldGuards", "RemoteGuard", "guard_key", "state_spec", "held_guards", "AgentMemory", "Held",
            "HeldStates", "check_spec"]
 
-log = logging.getLogger("petriflow.bridge.agent")
 #: Runs whose states an agent keeps (the oldest are forgotten).
 KEPT_RUNS = 8
 
