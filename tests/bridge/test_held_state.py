@@ -112,7 +112,7 @@ def hub(monkeypatch):
 
 @pytest.fixture
 def agent(hub):
-    server = AgentServer(["robot"], hub, registry=demo_registry(), heartbeat=0.05, speed=20)
+    server = AgentServer(["robot"], hub, registry=demo_registry(), heartbeat=0.05)
     thread = threading.Thread(target=server.serve, daemon=True)
     thread.start()
     yield server

@@ -82,7 +82,7 @@ def robot(name, seconds):
 
 NET = "petriflow: 1\nnet: held3\nfinal: {robot1_done: 1, robot2_done: 1, robot3_done: 1, robot1_seen: 1," \
       " robot2_seen: 1, robot3_seen: 1}\nsubnets:\n" + "".join(
-          robot(name, seconds) for name, seconds in zip(ROBOTS, (0.3, 0.2, 0.4)))
+          robot(name, seconds) for name, seconds in zip(ROBOTS, (0.6, 0.5, 0.7)))
 
 
 def per_robot(events):
