@@ -29,6 +29,7 @@ from petriflow.net import Net
 from petriflow.runtime.action import Action, ActionContext, Param, Port, Status
 from petriflow.runtime.binding import Binding, BoundTransition
 from petriflow.runtime.registry import Registry, UnknownActionError
+from petriflow.runtime.resources import LIVENESS
 
 __all__ = ["RemoteAction", "bind_remote", "check_announced", "remote_transitions", "bridged_subnets",
            "firing_number"]
@@ -249,9 +250,11 @@ def _check_places(net: Net, tid: str, path: str | None, name: str, local: type[A
     read through the bridge, :mod:`petriflow.bridge.calls`); an action that declares
     resources cannot run on a remote agent (they are not served)."""
     resources = getattr(local, "resources", None) or {}
-    if resources:
-        raise _at(net, tid, path, f"action {name} takes the run's resource(s) {', '.join(sorted(resources))},"
-                  " which are not served to remote agents (leave its subnet out of bridge: agents)")
+    unserved = sorted(r for r, kind in resources.items() if kind != LIVENESS)  # liveness is served by calls
+    if unserved:
+        raise _at(net, tid, path, f"action {name} takes the run's resource(s) {', '.join(unserved)},"
+                  f" which are not served to remote agents (only {LIVENESS} is; leave its subnet out of bridge:"
+                  " agents)")
     for pname, declared in getattr(local, "params", {}).items():
         for place in declared.place_names(params.get(pname)):
             if not isinstance(place, str) or place not in net.places:

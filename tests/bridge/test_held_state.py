@@ -194,3 +194,50 @@ def test_messages_without_the_extensions_are_the_bytes_they_were():
     assert protocol.decode(protocol.encode(held)) == held
     with pytest.raises(protocol.Refused, match="guards maps transitions"):
         protocol.decode(b'{"v":1,"type":"result","id":"x","agent":"a","outcome":"ok","guards":{"t":1}}')
+
+
+class Team(InstantAction):
+    """Reads the run's core.liveness resource: which agents run."""
+
+    resources = {"live": "core.liveness"}
+
+    def run(self, ctx):
+        live = ctx.resource("live")
+        return {"running": live.running(), "other": live.alive("other")}
+
+
+TEAM_NET = """
+petriflow: 1
+net: team
+final: {seen: 1, idle: 1}
+subnets:
+- id: counter
+  agent: robot
+  places: [{id: start, tokens: 1}, seen]
+  transitions:
+  - {id: look, action: demo.team, in: [start], out: [seen]}
+- id: other
+  agent: other
+  places: [{id: rest, tokens: 1}, idle]
+  transitions:
+  - {id: sit, in: [rest], out: [idle]}
+"""
+
+
+def test_the_runs_liveness_resource_is_served_to_a_remote_action(agent, hub, tmp_path):
+    """core.liveness (which agents run) is answered by the run through calls, as a local
+    action reads it; any other resource stays refused at bind time (test_bridged_run.py)."""
+    registry = demo_registry()
+    registry.register("demo.team", Team)
+    agent.registry.register("demo.team", Team)
+    agent.actions = announcement(agent.registry)
+    (tmp_path / "net.yaml").write_text(TEAM_NET)
+    simulated = run_files(tmp_path / "net.yaml", registry=registry)
+    spec = {"transport": "hub", "agents": {"counter": "robot"}, "heartbeat": 0.05, "wait": 5}
+    (tmp_path / "run.yaml").write_text(f"seed: 1\nbridge: {json.dumps(spec)}\n")
+    bridged = run_files(tmp_path / "net.yaml", registry=registry)
+    assert simulated.reason == bridged.reason == "final"
+    assert bridged.tokens["seen"] == simulated.tokens["seen"] == [{"running": ["robot", "other"], "other": True}]
+    calls = [protocol.decode(p) for t, p in hub.published if t == "petriflow/v1/from/robot"]
+    assert [(c.service, c.method) for c in calls if isinstance(c, protocol.Call)] == [
+        ("liveness", "running"), ("liveness", "alive")]
