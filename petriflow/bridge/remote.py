@@ -145,6 +145,8 @@ class RemoteAction(Action):
         """The journaled ending of a resumed run's firing, at its journaled time."""
         if ctx.now < state.at - 1e-9:
             return Status.RUNNING
+        if state.snapshot is not None:
+            self._held(ctx, state.snapshot)
         if state.answered is not None or state.resent:
             self._record(ctx, state)
         if state.phase == Phase.OK:
@@ -162,8 +164,10 @@ class RemoteAction(Action):
         for name, data in state.events:  # what the action emitted on the agent, as a local one's
             ctx.emit(name, **data)
         trip = state.round_trip
+        held = {} if state.snapshot is None else {"seq": state.snapshot[0], "guards": state.snapshot[1]}
         ctx.emit("remote", agent=self.remote_agent, goal=state.goal.id, phase=state.phase, resent=state.resent,
-                 round_trip_ms=None if trip is None else round(trip * 1e3, 3), calls=state.answered_calls)
+                 round_trip_ms=None if trip is None else round(trip * 1e3, 3), calls=state.answered_calls,
+                 **held)
 
 
 def bridged_subnets(net: Net, spec: BridgeSpec) -> dict[str, str]:

@@ -42,6 +42,7 @@ class Replay:
         self.until = events[-1].time if events else 0.0
         self.ends: dict[int, Event] = {}
         self.records: dict[int, dict[str, Any]] = {}
+        self.emitted: dict[int, list[list[Any]]] = {}  # firing -> the custom events its agent's action emitted
         self.faults: list[tuple[float, str, str, str]] = []  # (time, lost|back, agent, why)
         for event in events:
             firing = event.data.get("firing")
@@ -49,6 +50,8 @@ class Replay:
                 self.ends[firing] = event
             elif event.kind == "custom" and event.data.get("name") == "remote":
                 self.records[firing] = event.data.get("data") or {}
+            elif event.kind == "custom" and event.transition in remote:
+                self.emitted.setdefault(firing, []).append([event.data.get("name"), event.data.get("data") or {}])
             elif event.kind == "fault" and event.data.get("fault") in ("lost", "back"):
                 self.faults.append((event.time, event.data["fault"], event.agent, event.data.get("why", "")))
 
@@ -64,6 +67,9 @@ class Replay:
                           answered=None if trip is None else trip / 1e3, resent=record.get("resent", 0),
                           data=end.data.get("result"), reason=end.data.get("reason", ""))
         state.answered_calls = record.get("calls", 0)
+        state.events = self.emitted.get(firing, [])
+        if record.get("seq"):  # the agent-held state's guards as the goal's result gave them
+            state.snapshot = (record["seq"], record.get("guards") or {})
         state.at = end.time
         return state
 
