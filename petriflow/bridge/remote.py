@@ -89,9 +89,7 @@ class RemoteAction(Action):
         if state is not None and state.ended:
             self._record(ctx, state)
             if state.phase == Phase.OK:
-                ctx.result, ctx.per_place = state.data, state.per_place
-                for place, data in state.outputs.items():  # ctx.put on the agent
-                    ctx.put(place, data)
+                self._ok(ctx, state)
                 return Status.OK
             ctx.reason = f"{self.remote_agent}: {state.reason or state.phase}"
             return Status.FAILED
@@ -119,6 +117,13 @@ class RemoteAction(Action):
             self._record(ctx, state)
             return True
         return False
+
+    @staticmethod
+    def _ok(ctx: ActionContext, state: Any) -> None:
+        """The output tokens' data of a goal ended ``ok`` (its places given apart: ``ctx.put`` on the agent)."""
+        ctx.result, ctx.per_place = state.data, state.per_place
+        for place, data in state.outputs.items():
+            ctx.put(place, data)
 
     def _held(self, ctx: ActionContext, snapshot: tuple[int, dict[str, bool]]) -> None:
         """The agent's newest values of the subnet's state guards into the run's cache
@@ -150,7 +155,7 @@ class RemoteAction(Action):
         if state.answered is not None or state.resent:
             self._record(ctx, state)
         if state.phase == Phase.OK:
-            ctx.result = state.data
+            self._ok(ctx, state)
             return Status.OK
         ctx.reason = state.reason
         return Status.FAILED
@@ -165,6 +170,8 @@ class RemoteAction(Action):
             ctx.emit(name, **data)
         trip = state.round_trip
         held = {} if state.snapshot is None else {"seq": state.snapshot[0], "guards": state.snapshot[1]}
+        if state.outputs or state.per_place:  # journaled, so a resume replays them
+            held.update(outputs=state.outputs, per_place=state.per_place)
         ctx.emit("remote", agent=self.remote_agent, goal=state.goal.id, phase=state.phase, resent=state.resent,
                  round_trip_ms=None if trip is None else round(trip * 1e3, 3), calls=state.answered_calls,
                  **held)

@@ -68,6 +68,7 @@ class Replay:
                           data=end.data.get("result"), reason=end.data.get("reason", ""))
         state.answered_calls = record.get("calls", 0)
         state.events = self.emitted.get(firing, [])
+        state.outputs, state.per_place = record.get("outputs") or {}, bool(record.get("per_place"))
         if record.get("seq"):  # the agent-held state's guards as the goal's result gave them
             state.snapshot = (record["seq"], record.get("guards") or {})
         state.at = end.time

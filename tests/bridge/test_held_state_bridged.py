@@ -152,3 +152,64 @@ def test_three_robots_with_agent_held_state_fire_as_the_simulated_run(middleware
     assert len(executed) == len({e["goal"] for e in executed}) == 12  # make + 3 steps per robot, once each
     assert {e["agent"] for e in executed} == set(ROBOTS)
     assert ends  # every firing ended in the trace
+
+
+ONE = """\
+petriflow: 1
+net: held1
+final: {robot1_finished: 1}
+subnets:
+- id: robot1
+  agent: robot1
+  state: held.tally
+  places: [{id: robot1_start, tokens: 1}, robot1_work, robot1_finished]
+  transitions:
+  - {id: robot1_make, action: held.make, in: [robot1_start], out: [robot1_work]}
+  - {id: robot1_step, action: held.step, params: {seconds: 0.5, limit: 4}, guard: held.below,
+     in: [robot1_work], out: [robot1_work]}
+  - {id: robot1_finish, guard: held.reached, params: {limit: 4}, in: [robot1_work], out: [robot1_finished]}
+"""
+
+
+def test_an_orchestrator_killed_mid_run_resumes_with_the_agent_held_state(broker, tmp_path):
+    """The run process is killed (SIGKILL) while a step runs: --resume replays the journaled steps
+    with their guard snapshots, re-attaches to the running goal, and the agent, which kept the
+    robot's state under the run's name, finishes the count: every firing once, every goal once."""
+    import os
+    import signal
+    import time
+
+    (tmp_path / "held_actions.py").write_text(ACTIONS)
+    (tmp_path / "net.yaml").write_text(ONE)
+    bridge = {"transport": "mqtt", "connect": broker.connect, "agents": {"robot1": "robot1"}, "heartbeat": 0.1,
+              "heartbeat_timeout": 5, "wait": 20}
+    (tmp_path / "run.yaml").write_text(f"seed: 1\nuntil: 60\nactions: [held_actions.py]\nbridge: {json.dumps(bridge)}\n")
+    db = tmp_path / "run.sqlite"
+    agent = subprocess.Popen([sys.executable, "-m", "petriflow.cli", "agent", "--name", "robot1", "--transport", "mqtt",
+                              "--connect", broker.connect, "--actions", str(tmp_path / "held_actions.py"),
+                              "--heartbeat", "0.1", "--log", str(tmp_path / "agent.log")],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        run = subprocess.Popen([sys.executable, "-m", "petriflow.cli", "run", str(tmp_path / "net.yaml"), "--config",
+                                str(tmp_path / "run.yaml"), "--db", str(db), "--quiet"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not (tmp_path / "agent.log").exists() or \
+                len((tmp_path / "agent.log").read_text().splitlines()) < 3:  # make and two steps sent
+            assert time.monotonic() < deadline and run.poll() is None
+            time.sleep(0.02)
+        os.kill(run.pid, signal.SIGKILL)
+        run.wait(timeout=10)
+        resumed = petriflow("run", "--resume", "--db", str(db), "--trace", str(tmp_path / "t.jsonl"))
+    finally:
+        agent.terminate()
+        agent.wait(timeout=20)
+    assert agent.poll() is not None
+    assert resumed.returncode == 0, resumed.stdout + resumed.stderr
+    events = load(tmp_path / "t.jsonl")
+    assert [e["transition"] for e in events if e["kind"] == "end"] == \
+        ["robot1_make"] + ["robot1_step"] * 4 + ["robot1_finish"]
+    assert [e["data"]["data"]["n"] for e in events if e["kind"] == "custom" and e["data"]["name"] == "held.step"] \
+        == [1, 2, 3, 4]
+    executed = [json.loads(line) for line in (tmp_path / "agent.log").read_text().splitlines()]
+    assert len(executed) == len({e["goal"] for e in executed}) == 5
