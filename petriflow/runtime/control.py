@@ -67,9 +67,10 @@ __all__ = ["Command", "Intervention", "Breakpoint", "parse_breakpoint", "Control
 _CONTROL = EventKind.CONTROL.value
 
 #: Seconds a paused run whose time goes on (remote agents) lets pass at a time: its
-#: :attr:`Control.idle` advances the run that far, and the control waits out what is
-#: left of it in wall-clock time (cut short by an intervention), so a pause neither
-#: spins the CPU nor races ahead of the agents.
+#: :attr:`Control.idle` advances the run that far; a paced clock waits for the wall
+#: clock as it goes, and for an unpaced one the control waits out what is left of the
+#: step (cut short by an intervention), so a pause neither spins the CPU nor races
+#: ahead of the agents.
 PAUSED_STEP = 0.05
 
 #: The breakpoint language, as the errors and the docs say it.
@@ -209,6 +210,10 @@ class Steerable(Protocol):
     def now(self) -> float:
         """Simulated time."""
 
+    @property
+    def paced(self) -> bool:
+        """Whether the run's clock waits for the wall clock itself (real-time pacing)."""
+
 
 @dataclass
 class Reply:
@@ -340,9 +345,10 @@ class Control:
         #: Called (in the run's thread) over and over while paused by a run whose time
         #: goes on during a pause (remote agents): it lets up to :data:`PAUSED_STEP`
         #: seconds of the run pass, takes in what happens meanwhile and fires nothing;
-        #: ``True`` when something happened. The control waits out the rest of
-        #: :data:`PAUSED_STEP` in wall-clock time after each call (a paced clock has
-        #: already waited it; an unpaced one has not), or until an intervention comes.
+        #: ``True`` when something happened. When the run is not paced
+        #: (:attr:`Steerable.paced`), the control waits out the rest of
+        #: :data:`PAUSED_STEP` in wall-clock time after each call, or until an
+        #: intervention comes (a paced clock has waited for the wall clock itself).
         self.idle: Any = None
 
     # Any thread -------------------------------------------------------------------
@@ -442,7 +448,8 @@ class Control:
                 if self.idle is not None:  # the run's time goes on: take in what comes
                     began = wallclock.monotonic()
                     changed |= self.idle()
-                    self._rest(PAUSED_STEP - (wallclock.monotonic() - began))
+                    if not self._run.paced:
+                        self._rest(PAUSED_STEP - (wallclock.monotonic() - began))
                 else:
                     with self._wakeup:
                         if not self._queue and not self.closed:

@@ -368,9 +368,9 @@ class Scheduler:
         ``end`` recorded now; an agent lost, its firings ended ``failed``) and let the
         watchers look, but fire nothing (a pause stops dispatching). ``True`` if
         something happened. The control calls it while it waits
-        (:attr:`Control.idle <petriflow.runtime.control.Control.idle>`) and waits out
-        the wall-clock rest of the step itself: a paced clock waits here, an unpaced one
-        does not.
+        (:attr:`Control.idle <petriflow.runtime.control.Control.idle>`): a paced clock
+        waits for the wall clock here, and for an unpaced one (:attr:`paced`) the
+        control waits out the rest of the step itself.
         """
         kernel, seen = self.kernel, self.recorder.count
         tick = kernel.peek()
@@ -384,6 +384,11 @@ class Scheduler:
         for watcher in self._watchers:
             watcher(self)
         return self.recorder.count != seen
+
+    @property
+    def paced(self) -> bool:
+        """Whether the run's clock waits for the wall clock itself (a real-time clock)."""
+        return getattr(self.clock, "rebase", None) is not None
 
     def rebase_clock(self) -> None:
         """The run stood still: a paced run goes on from now, without rushing to catch up."""
