@@ -45,6 +45,7 @@ class ReportingRobot:
         self.transport = open_transport(kind, Endpoint(connect), "reporting-robot")
         self.stop = threading.Event()
         self.goals: list[protocol.Goal] = []
+        self.results: dict[str, protocol.Result] = {}  # answered again to a goal sent again
         self.transport.subscribe(to_agent(self.name), self.receive)
         self.beat = threading.Thread(target=self.heartbeats, daemon=True)
         self.beat.start()
@@ -55,12 +56,18 @@ class ReportingRobot:
     def heartbeats(self) -> None:
         while not self.stop.is_set():
             self.send(protocol.Announce(self.name, {"robot.walk": {}}, "one"))
-            self.send(protocol.Heartbeat(self.name, [g.id for g in self.goals]))
+            self.send(protocol.Heartbeat(self.name, [g.id for g in self.goals if g.id not in self.results]))
             self.stop.wait(0.1)
 
     def receive(self, topic, payload) -> None:
         message = protocol.decode(payload)
-        if isinstance(message, protocol.Goal) and not self.goals:
+        if not isinstance(message, protocol.Goal):
+            return
+        if message.id in self.results:
+            self.send(self.results[message.id])
+        elif any(g.id == message.id for g in self.goals):
+            self.send(protocol.Accepted(message.id, self.name))
+        else:
             self.goals.append(message)
             threading.Thread(target=self.walk, args=(message,), daemon=True).start()
 
@@ -70,7 +77,8 @@ class ReportingRobot:
             time.sleep(0.15)
             self.send(protocol.Feedback(goal.id, self.name, data))
         time.sleep(0.15)
-        self.send(protocol.Result(goal.id, self.name, "ok", {"walked": 1}))
+        self.results[goal.id] = protocol.Result(goal.id, self.name, "ok", {"walked": 1})
+        self.send(self.results[goal.id])
 
     def close(self) -> None:
         self.stop.set()
@@ -115,3 +123,50 @@ def test_feedback_is_traced_shown_and_heard(middleware, tmp_path):
     # the run's page carries them, as every other event
     page = petriflow.view(tmp_path / "t.jsonl", net=path, out=tmp_path / "run.html")
     assert [r for r in page_records(page) if r["kind"] == "feedback"] == feedback
+
+
+CHAIN3 = NET.replace("""      - {id: go, action: robot.walk, params: {}, in: [a], out: [b]}
+places: [b]""", """      - {id: go, action: robot.walk, params: {}, in: [a], out: [p1]}
+      - {id: go2, action: robot.walk, params: {}, in: [p1], out: [p2]}
+      - {id: go3, action: robot.walk, params: {}, in: [p2], out: [b]}
+places: [p1, p2, b]""")
+
+
+def test_journaled_feedback_is_replayed_when_a_killed_run_resumes(broker, tmp_path):
+    """The orchestrator is killed (SIGKILL) after some feedback was journaled: ``--resume``
+    replays those ``feedback`` events at their journaled place (the journal's check passes),
+    re-attaches, and completes with every firing once."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    from petriflow.runtime.journal import Journal
+    from petriflow.runtime.session import resume
+
+    robot = ReportingRobot("mqtt", broker.connect)
+    try:
+        net = write(tmp_path, "mqtt", broker.connect, net=CHAIN3, heartbeat=0.1, heartbeat_timeout=5)
+        db = tmp_path / "run.sqlite"
+        run = subprocess.Popen([sys.executable, "-m", "petriflow.cli", "run", str(net), "--db", str(db), "--quiet"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            deadline = time.monotonic() + 60
+            while len(robot.goals) < 2 and time.monotonic() < deadline:  # go ended, go2 runs
+                time.sleep(0.01)
+            time.sleep(0.2)  # go2's first feedback
+        finally:
+            os.kill(run.pid, signal.SIGKILL)
+            run.wait(timeout=10)
+        with Journal(db) as journal:
+            journaled = [e for e in journal.events() if e.kind == "feedback"]
+            assert not journal.finished and len(journaled) >= 3
+        result = resume(db, trace=tmp_path / "t.jsonl")
+    finally:
+        robot.close()
+    assert result.reason == "final" and result.firings == 3
+    events = [json.loads(line) for line in (tmp_path / "t.jsonl").read_text().splitlines()]
+    feedback = [e for e in events if e["kind"] == "feedback"]
+    assert feedback[:len(journaled)] == [json.loads(e.to_json()) for e in journaled]
+    assert sorted(e["transition"] for e in events if e["kind"] == "end") == ["go", "go2", "go3"]
+    assert len(robot.goals) == 3  # each walked once
