@@ -242,7 +242,10 @@ class Dispatcher:
         call is refused, an expected second answer dropped, anything else dropped and
         counted as a replay; nothing is recorded."""
         if isinstance(message, protocol.Call):
-            if not check_call(message):
+            why = check_call(message)
+            if why:
+                self.drop(Drop.UNKNOWN_CALL, f"from {sender!r} for goal {message.id[:80]!r}: {why}")
+            else:
                 self.transport.publish(to_agent(sender), protocol.encode(protocol.Reply(
                     message.id, sender, message.call, None,
                     f"the goal ended ({phase}): the run answers no more calls for it")))

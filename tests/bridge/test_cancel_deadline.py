@@ -21,20 +21,18 @@ HEARTBEAT, HEARTBEAT_TIMEOUT, CANCEL_TIMEOUT = 0.1, 1.0, 0.5
 NET = """\
 petriflow: 1
 net: stubborn
+places: [b, broken, late, stopped, o]
+final: {o: 1}
 subnets:
+  - id: here
+    agent: here
+    transitions: [{id: recover, action: core.wait, params: {seconds: 2.5}, in: [broken], out: [o]}]
   - id: r1
     agent: r1
-    places: [{id: a, tokens: 1}]
     transitions:
       - {id: go, action: demo.stubborn, params: {stop_after: STOP}, in: [a], out: [b]TIMEOUT,
          outcomes: {failed: [broken], timeout: [late], cancelled: [stopped]}}
-  - id: here
-    agent: here
-    places: []
-    transitions:
-      - {id: recover, action: core.wait, params: {seconds: 2.5}, in: [broken], out: [o]}
-places: [b, broken, late, stopped, o]
-final: {o: 1}
+    places: [{id: a, tokens: 1}]
 """
 
 
@@ -115,6 +113,7 @@ def test_a_kill_whose_cancel_is_never_acknowledged_ends_the_firing_failed(broker
     agent, result, events = run_stubborn("mqtt", broker, serve, tmp_path, faults="faults: [{kill: r1, at: 0.3}]\n")
     check_given_up(result, events, 0.3)
     assert not [e for e in events if e["kind"] == "start" and e["transition"] == "go"][1:]
+    assert [e["data"]["fault"] for e in events if e["kind"] == "fault"] == ["kill", "lost"]  # never revived
     assert agent.server.executed == 1
 
 
@@ -126,3 +125,36 @@ def test_a_cancel_acknowledged_within_the_deadline_still_ends_with_its_outcome(b
     assert [e["data"]["outcome"] for e in ends] == ["timeout"]
     assert not [e for e in events if e["kind"] == "fault"]
     assert result.marking.to_dict() == {"late": 1} and result.metrics["bridge.dropped"] == 0
+
+
+def test_an_operators_forced_end_whose_cancel_is_never_acknowledged_ends_the_firing_failed(broker, serve,
+                                                                                          tmp_path, capsys):
+    """``petriflow ctl force go cancelled`` on a live bridged run: the agent ignores the cancel for
+    2 s, so after cancel_timeout the firing ends ``failed`` (the failure route), not ``cancelled``."""
+    pytest.importorskip("websockets")
+    from tests.live.conftest import LiveRun
+    from tests.live.test_steered_runs import ctl
+
+    agent = serve("mqtt", broker.connect, ["robot1"], heartbeat=HEARTBEAT, registry=registry())
+    folder = tmp_path / "run"
+    folder.mkdir()
+    net = write(folder, "mqtt", broker.connect, net=NET.replace("STOP", "2.0").replace("TIMEOUT", ""),
+                heartbeat=HEARTBEAT, heartbeat_timeout=HEARTBEAT_TIMEOUT, cancel_timeout=CANCEL_TIMEOUT)
+    run = LiveRun(folder, net=net.read_text())
+    try:
+        deadline = time.monotonic() + 60
+        while "'go'" not in ctl(capsys, run.url, "status")[1]:
+            assert time.monotonic() < deadline, "go never started"
+            time.sleep(0.1)
+        assert ctl(capsys, run.url, "force", "go", "cancelled")[0] == 0
+        run.finish()
+        assert run.process.returncode == 0
+    finally:
+        run.stop()
+    events = [json.loads(line) for line in run.trace.read_text().splitlines()]
+    force = next(e for e in events if e["kind"] == "control" and e["data"]["action"] == "force")
+    ends = [e for e in events if e["kind"] == "end" and e["transition"] == "go"]
+    assert len(ends) == 1 and ends[0]["data"]["outcome"] == "failed" and "cancel_timeout" in ends[0]["data"]["reason"]
+    assert force["time"] + CANCEL_TIMEOUT - 0.05 <= ends[0]["time"]
+    assert events[-1]["data"]["marking"] == {"o": 1}
+    assert agent.server.executed == 1 and len(Stubborn.cancels) == 1
