@@ -161,6 +161,7 @@ def test_a_bridged_stateful_subnet_fires_as_the_simulated_run(agent, hub, tmp_pa
     assert goals[0].state["guards"]["done"] == ["demo.reached", {"limit": 3}]
     feedback = [protocol.decode(p) for t, p in hub.published if t == "petriflow/v1/from/robot"]
     assert any(isinstance(m, protocol.Feedback) and m.guards.get("note") for m in feedback)
+    assert not [e for e in events if e["kind"] == "feedback"]  # a state report, not progress: no trace event
 
 
 def test_a_state_of_the_wrong_type_fails_the_goal_on_the_agent(agent, hub, tmp_path):
