@@ -13,69 +13,16 @@ from petriflow.bridge import protocol
 from petriflow.bridge.agent import AgentServer, announcement
 from petriflow.bridge.spec import DEFAULT_CONNECT
 from petriflow.bridge.transport import TRANSPORTS
-from petriflow.runtime.action import Action, InstantAction, Param, Status
-from petriflow.runtime.agents import AgentState
+from petriflow.runtime.action import InstantAction
 from petriflow.runtime.registry import Registry
 from petriflow.runtime.session import run_files
 
+from tests.bridge.held_actions import register
 from tests.bridge.test_calls import Hub
 
 
-class Counter(AgentState):
-    """An agent's state: a count, and the keys it touches."""
-
-    def __init__(self):
-        super().__init__()
-        self.n = 0
-
-    def bump(self):
-        self.n += 1
-        self.touch("n")
-
-
-class Make(InstantAction):
-    agent_state = Counter
-
-    def run(self, ctx):
-        ctx.state = Counter()
-
-
-class Bump(InstantAction):
-    agent_state = Counter
-    params = {"limit": Param(int, 3)}
-
-    def run(self, ctx):
-        ctx.state.bump()
-        ctx.emit("demo.bumped", n=ctx.state.n)
-        ctx.put("work", {"n": ctx.state.n})  # an output place's own data
-
-
-class Slow(Action):
-    """Bumps the count when it starts, then goes on for ``seconds`` (the state changed mid-action)."""
-
-    agent_state = Counter
-    needs_world = False
-    params = {"seconds": Param(float, 0.3), "limit": Param(int, 0)}
-
-    def start(self, ctx):
-        ctx.state.bump()
-        self.until = ctx.now + self.params["seconds"]
-        self.wake_at = self.until
-
-    def poll(self, ctx):
-        return Status.OK if ctx.now >= self.until - 1e-9 else Status.RUNNING
-
-
 def demo_registry():
-    registry = Registry()
-    registry.register_state("demo.counter", Counter)
-    registry.register("demo.make", Make)
-    registry.register("demo.bump", Bump)
-    registry.register("demo.slow", Slow)
-    registry.predicate("demo.below", reads=("n",))(lambda state, params: state is not None and state.n < params["limit"])
-    registry.predicate("demo.reached", reads=("n",))(lambda state, params: state is not None and state.n >= params["limit"])
-    registry.predicate("demo.none", reads=("n",))(lambda state, params: state is None)
-    return registry
+    return register(Registry())
 
 
 NET = """

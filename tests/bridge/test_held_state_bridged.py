@@ -4,6 +4,7 @@ processes (robot1 alone, robot2 and robot3 sharing one), against the simulated r
 the same seed."""
 
 import json
+from pathlib import Path
 import subprocess
 import sys
 
@@ -13,70 +14,24 @@ pytestmark = pytest.mark.slow
 
 ROBOTS = ("robot1", "robot2", "robot3")
 
-ACTIONS = '''
-from petriflow.runtime.registry import default_registry as registry
-from petriflow.runtime.action import Action, InstantAction, Param, Status
-from petriflow.runtime.agents import AgentState
-
-
-class Tally(AgentState):
-    def __init__(self):
-        super().__init__()
-        self.n = 0
-
-    def bump(self):
-        self.n += 1
-        self.touch("n")
-
-
-class Make(InstantAction):
-    agent_state = Tally
-
-    def run(self, ctx):
-        ctx.state = Tally()
-
-
-class Step(Action):
-    """Counts one when it starts (a guard may then fire mid-action), ends after `seconds`."""
-
-    agent_state = Tally
-    needs_world = False
-    params = {"seconds": Param(float, 0.2), "limit": Param(int, 3)}
-
-    def start(self, ctx):
-        ctx.state.bump()
-        ctx.emit("held.step", n=ctx.state.n)
-        self.until = ctx.now + self.params["seconds"]
-        self.wake_at = self.until
-
-    def poll(self, ctx):
-        if ctx.now < self.until - 1e-9:
-            return Status.RUNNING
-        ctx.put(ctx.agent + "_work", {"n": ctx.state.n})
-        return Status.OK
-
-
-registry.register_state("held.tally", Tally)
-registry.register("held.make", Make)
-registry.register("held.step", Step)
-registry.predicate("held.below", reads=("n",))(lambda s, p: s is not None and s.n < p["limit"])
-registry.predicate("held.reached", reads=("n",))(lambda s, p: s is not None and s.n >= p["limit"])
-'''
+#: The actions module `petriflow run` and `petriflow agent` import (--actions).
+ACTIONS = (Path(__file__).parent / "held_actions.py").read_text() + \
+    "\nfrom petriflow.runtime.registry import default_registry\nregister(default_registry)\n"
 
 
 def robot(name, seconds):
     return f"""\
 - id: {name}
   agent: {name}
-  state: held.tally
+  state: demo.counter
   places: [{{id: {name}_start, tokens: 1}}, {name}_work, {name}_seen, {{id: {name}_eye, tokens: 1}}, {name}_done]
   transitions:
-  - {{id: {name}_make, action: held.make, in: [{name}_start], out: [{name}_work]}}
-  - {{id: {name}_step, action: held.step, params: {{seconds: {seconds}, limit: 3}}, guard: held.below,
+  - {{id: {name}_make, action: demo.make, in: [{name}_start], out: [{name}_work]}}
+  - {{id: {name}_step, action: demo.slow, params: {{seconds: {seconds}, limit: 3, put: true}}, guard: demo.below,
      in: [{name}_work], out: [{name}_work]}}
-  - {{id: {name}_first, guard: held.reached, params: {{limit: 1}}, priority: 2, in: [{name}_eye],
+  - {{id: {name}_first, guard: demo.reached, params: {{limit: 1}}, priority: 2, in: [{name}_eye],
      out: [{name}_seen]}}
-  - {{id: {name}_finish, guard: held.reached, params: {{limit: 3}}, in: [{name}_work], out: [{name}_done]}}
+  - {{id: {name}_finish, guard: demo.reached, params: {{limit: 3}}, in: [{name}_work], out: [{name}_done]}}
 """
 
 
@@ -144,7 +99,7 @@ def test_three_robots_with_agent_held_state_fire_as_the_simulated_run(middleware
 
     def steps(events):
         return sorted((e["agent"], e["data"]["data"]["n"]) for e in events
-                      if e["kind"] == "custom" and e["data"]["name"] == "held.step")
+                      if e["kind"] == "custom" and e["data"]["name"] == "demo.step")
 
     assert steps(bridged) == steps(sim) == sorted((r, n) for r in ROBOTS for n in (1, 2, 3))
     ends = {e["transition"]: e["data"].get("result") for e in bridged if e["kind"] == "end"}
@@ -161,13 +116,13 @@ final: {robot1_finished: 1}
 subnets:
 - id: robot1
   agent: robot1
-  state: held.tally
+  state: demo.counter
   places: [{id: robot1_start, tokens: 1}, robot1_work, robot1_finished]
   transitions:
-  - {id: robot1_make, action: held.make, in: [robot1_start], out: [robot1_work]}
-  - {id: robot1_step, action: held.step, params: {seconds: 0.5, limit: 4}, guard: held.below,
+  - {id: robot1_make, action: demo.make, in: [robot1_start], out: [robot1_work]}
+  - {id: robot1_step, action: demo.slow, params: {seconds: 0.5, limit: 4, put: true}, guard: demo.below,
      in: [robot1_work], out: [robot1_work]}
-  - {id: robot1_finish, guard: held.reached, params: {limit: 4}, in: [robot1_work], out: [robot1_finished]}
+  - {id: robot1_finish, guard: demo.reached, params: {limit: 4}, in: [robot1_work], out: [robot1_finished]}
 """
 
 
@@ -209,7 +164,7 @@ def test_an_orchestrator_killed_mid_run_resumes_with_the_agent_held_state(broker
     events = load(tmp_path / "t.jsonl")
     assert [e["transition"] for e in events if e["kind"] == "end"] == \
         ["robot1_make"] + ["robot1_step"] * 4 + ["robot1_finish"]
-    assert [e["data"]["data"]["n"] for e in events if e["kind"] == "custom" and e["data"]["name"] == "held.step"] \
+    assert [e["data"]["data"]["n"] for e in events if e["kind"] == "custom" and e["data"]["name"] == "demo.step"] \
         == [1, 2, 3, 4]
     executed = [json.loads(line) for line in (tmp_path / "agent.log").read_text().splitlines()]
     assert len(executed) == len({e["goal"] for e in executed}) == 5
