@@ -1,0 +1,174 @@
+"""CTL and LTL on the symmetry quotient give the full state space's verdicts.
+
+On small shipped nets with interchangeable agents, every property of the net and
+generated formulas (symmetric atoms: the agents' places summed, shared places,
+``enabled`` of whole transition orbits, ``deadlock``; and atoms of one agent, which the
+quotient only bounds) are decided on the quotient and on the full reachability graph:
+a verdict of the quotient is the full graph's, every formula with symmetric atoms only
+is decided, and its witnesses and cycles fire from the initial marking.
+"""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+
+from petriflow.analysis.check_result import explored_marking
+from petriflow.analysis.symmetry import find_symmetries, transition_orbits
+from petriflow.engine import CompiledNet, fire_sequence, enabled
+from petriflow.io import load_net
+from petriflow.properties.check import check_properties
+from petriflow.properties.language import (
+    AllPaths, And, Compare, Constant, Deadlock, ExistsPath, Finally, Fireable, Globally, Linear,
+    Next, Not, Or, Property, Until, atoms
+)
+from petriflow.properties.symmetric import decide_on_quotient, symmetric
+from petriflow.properties.yaml_props import parse_formula
+from petriflow.workflow import workflow_structure
+from tests.conftest import NETS
+
+SMALL = ["passage/passage.yaml", "swarm/swarm-3.yaml", "bidding/bidding-autonomous-2.yaml",
+         "bus/bus-algorithm1-3.yaml", "comm/comm-centralised-2.yaml"]
+
+
+def atom_pool(net):
+    """``(symmetric atoms, atoms of one agent)`` of the net."""
+    compiled = CompiledNet(net)
+    groups = find_symmetries(net)
+    in_block = {int(p) for g in groups for p in g.blocks.reshape(-1)}
+    same, one = [Deadlock(), Constant(True)], []
+    for group in groups:
+        for column in range(group.blocks.shape[1]):
+            places = [compiled.places[p] for p in group.blocks[:, column]]
+            for bound in range(group.size + 1):
+                same.append(Compare(">=", Linear.of_places(places), Linear.constant(bound)))
+            one.append(Compare(">=", Linear.of_places(places[:1]), Linear.constant(1)))
+            one.append(Compare("==", Linear.of_places(places[-1:]), Linear.constant(0)))
+    for p, place in enumerate(compiled.places):
+        if p not in in_block:
+            same.append(Compare(">=", Linear.of_places([place]), Linear.constant(1)))
+    orbit = transition_orbits(compiled, groups)
+    origins = [o for o, _ in compiled.origin]
+    for root in sorted(set(orbit.tolist())):
+        names = tuple(dict.fromkeys(origins[r] for r in range(len(origins)) if orbit[r] == root))
+        same.append(Fireable(names))
+        if len(names) > 1:
+            one.append(Fireable(names[:1]))
+    return same, one
+
+
+def random_ctl(rng, pool, depth):
+    if depth == 0 or rng.random() < 0.2:
+        return rng.choice(pool)
+    kind = rng.randrange(10)
+    sub = lambda: random_ctl(rng, pool, depth - 1)    # noqa: E731
+    if kind == 0:
+        return Not(sub())
+    if kind == 1:
+        return And((sub(), sub()))
+    if kind == 2:
+        return Or((sub(), sub()))
+    quantifier = AllPaths if rng.random() < 0.5 else ExistsPath
+    if kind == 3:
+        return quantifier(Until(sub(), sub()))
+    return quantifier(rng.choice([Next, Finally, Globally])(sub()))
+
+
+def random_ltl(rng, pool, depth):
+    if depth == 0 or rng.random() < 0.25:
+        return rng.choice(pool)
+    kind = rng.randrange(6)
+    sub = lambda: random_ltl(rng, pool, depth - 1)    # noqa: E731
+    if kind == 0:
+        return Not(sub())
+    if kind == 1:
+        return And((sub(), sub()))
+    if kind == 2:
+        return Until(sub(), sub())
+    return rng.choice([Next, Finally, Globally])(sub())
+
+
+def formulas(net, seed):
+    rng = random.Random(seed)
+    same, one = atom_pool(net)
+    found = [p.formula for p in net.properties if p.formula is not None]
+    found += [random_ctl(rng, same, 3) for _ in range(40)]
+    found += [random_ctl(rng, same + one, 3) for _ in range(40)]
+    found += [AllPaths(random_ltl(rng, same, 3)) for _ in range(6)]
+    found += [ExistsPath(random_ltl(rng, same + one, 3)) for _ in range(6)]
+    return found
+
+
+def replays(net, start, result):
+    """The witness fires from the start; a cycle comes back to the marking it starts in."""
+    reached = fire_sequence(net, start, result.get("witness") or [])
+    if "cycle" in result:
+        if result["cycle"]:
+            assert fire_sequence(net, reached, result["cycle"]) == reached
+        else:
+            assert not enabled(net, reached)
+
+
+@pytest.mark.parametrize("relative", SMALL)
+def test_the_quotient_gives_the_full_graphs_verdicts(relative):
+    """Every verdict on the quotient is the full graph's; symmetric formulas are all decided."""
+    net = load_net(NETS / relative)
+    start = explored_marking(net, workflow_structure(net))
+    groups = find_symmetries(net)
+    assert groups
+    cases = [f for f in formulas(net, seed=len(relative))
+             if Property(id="x", formula=f).kind in ("reachability", "ctl", "ltl")]
+    full = check_properties(net, [Property(id=str(k), formula=f) for k, f in enumerate(cases)])
+    store: dict = {}
+    decided_by_bounds = 0
+    for formula, expected in zip(cases, full):
+        kind = Property(id="x", formula=formula).kind
+        got = decide_on_quotient(net, formula, kind, start, max_states=100_000, store=store)
+        exact = all(symmetric(atom, groups, net) for atom in atoms(formula))
+        if exact:
+            assert got is not None, formula
+        if got is None:
+            continue
+        decided_by_bounds += not exact
+        assert got["verdict"] == expected["verdict"], (formula, got, expected)
+        assert "symmetry quotient" in got["method"]
+        replays(net, start, got)
+    assert store["space"].num_states < full[0].get("states", float("inf"))
+    assert decided_by_bounds > 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("relative", ["bidding/bidding-autonomous-3.yaml", "bidding/bidding-autonomous-4.yaml",
+                                      "comm/comm-centralised-3.yaml"])
+def test_the_quotient_gives_the_full_graphs_verdicts_on_larger_teams(relative):
+    """As above, with three and four agents."""
+    test_the_quotient_gives_the_full_graphs_verdicts(relative)
+
+
+def test_a_formula_the_bounds_do_not_settle_is_left_to_the_other_methods():
+    """An atom of one agent whose orbit bounds prove nothing: the quotient says nothing,
+    and over budget the verdict stays undecided, while a symmetric one is decided."""
+    net = load_net(NETS / "bidding/bidding-autonomous-2.yaml")
+    start = explored_marking(net, workflow_structure(net))
+    place = next(p for p in net.places if p.startswith("box_robot1"))
+    lonely = parse_formula(f"EF({place} >= 1 && EX({place} == 0))")
+    assert decide_on_quotient(net, lonely, "ctl", start, max_states=10_000, store={}) is None
+    both = parse_formula(f"AG(EF(o == 1)) && EF({place} + {place.replace('robot1', 'robot2')} >= 1)")
+    results = {r["id"]: r for r in check_properties(net, [
+        Property(id="lonely", formula=lonely), Property(id="both", formula=both)], max_states=400)}
+    assert results["lonely"]["verdict"] is None and results["lonely"]["reason"].startswith("state space over")
+    assert results["both"]["verdict"] is True and "symmetry quotient" in results["both"]["method"]
+
+
+def test_a_cycle_on_the_quotient_becomes_a_concrete_lasso():
+    """EG on a net whose quotient cycle permutes the agents: the concrete cycle closes."""
+    net = load_net(NETS / "swarm/swarm-3.yaml")
+    start = explored_marking(net, workflow_structure(net))
+    result = decide_on_quotient(net, parse_formula("EG(!deadlock)"), "ctl", start,
+                                max_states=10_000, store={})
+    full = check_properties(net, [Property(id="eg", formula=parse_formula("EG(!deadlock)"))])[0]
+    assert result["verdict"] == full["verdict"]
+    if result["verdict"]:
+        assert result["cycle"]
+    replays(net, start, result)
