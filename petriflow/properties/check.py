@@ -18,6 +18,11 @@ and decides every property on it:
 * **boolean** (``A G F p && A F q``): each quantified operand by its own checker, the
   verdicts combined (no evidence: each operand's is its own property's).
 
+When the graph is over budget and the net has interchangeable agents, reachability, CTL
+and LTL formulas are decided on the symmetry quotient instead
+(:func:`~petriflow.properties.symmetric.decide_on_quotient`: exact when every atom is
+invariant under the agents' permutations, else bounded by formulas whose atoms are).
+
 Each result is ``{"id", "formula", "kind", "verdict", "method", "witness"}`` and, for a
 lasso, ``"cycle"`` (the firings repeated forever; empty: the last marking is a deadlock,
 which repeats); ``verdict`` is ``true``/``false``, the bound (an integer), or ``null``

@@ -72,8 +72,13 @@ import numpy as np
 from petriflow.analysis.exploration import StateSpaceLimit, row_origins
 from petriflow.analysis.reachability import StateSpace
 from petriflow.analysis.symmetry import (
-    SymmetricSpace, SymmetryGroup, SymmetryUnsupported, concrete_path, find_symmetries,
-    symmetric_graph, transition_orbits
+    SymmetricSpace,
+    SymmetryGroup,
+    SymmetryUnsupported,
+    concrete_path,
+    find_symmetries,
+    symmetric_graph,
+    transition_orbits,
 )
 from petriflow.engine import CompiledNet
 from petriflow.marking import Marking
@@ -81,8 +86,23 @@ from petriflow.net import Net
 from petriflow.properties.ctl import ctl_witness, evaluate
 from petriflow.properties.kripke import Kripke
 from petriflow.properties.language import (
-    AllPaths, And, Compare, Constant, Deadlock, ExistsPath, Finally, Fireable, Formula, Globally,
-    Linear, Next, Not, Or, Until, atoms, is_state_formula
+    AllPaths,
+    And,
+    Compare,
+    Constant,
+    Deadlock,
+    ExistsPath,
+    Finally,
+    Fireable,
+    Formula,
+    Globally,
+    Linear,
+    Next,
+    Not,
+    Or,
+    Until,
+    atoms,
+    is_state_formula,
 )
 from petriflow.properties.ltl import check_ltl
 

@@ -16,12 +16,26 @@ import pytest
 
 from petriflow.analysis.check_result import explored_marking
 from petriflow.analysis.symmetry import find_symmetries, transition_orbits
-from petriflow.engine import CompiledNet, fire_sequence, enabled
+from petriflow.engine import CompiledNet, enabled, fire_sequence
 from petriflow.io import load_net
 from petriflow.properties.check import check_properties
 from petriflow.properties.language import (
-    AllPaths, And, Compare, Constant, Deadlock, ExistsPath, Finally, Fireable, Globally, Linear,
-    Next, Not, Or, Property, Until, atoms
+    AllPaths,
+    And,
+    Compare,
+    Constant,
+    Deadlock,
+    ExistsPath,
+    Finally,
+    Fireable,
+    Globally,
+    Linear,
+    Next,
+    Not,
+    Or,
+    Property,
+    Until,
+    atoms,
 )
 from petriflow.properties.symmetric import decide_on_quotient, symmetric
 from petriflow.properties.yaml_props import parse_formula
@@ -62,7 +76,7 @@ def random_ctl(rng, pool, depth):
     if depth == 0 or rng.random() < 0.2:
         return rng.choice(pool)
     kind = rng.randrange(10)
-    sub = lambda: random_ctl(rng, pool, depth - 1)    # noqa: E731
+    sub = lambda: random_ctl(rng, pool, depth - 1)
     if kind == 0:
         return Not(sub())
     if kind == 1:
@@ -79,7 +93,7 @@ def random_ltl(rng, pool, depth):
     if depth == 0 or rng.random() < 0.25:
         return rng.choice(pool)
     kind = rng.randrange(6)
-    sub = lambda: random_ltl(rng, pool, depth - 1)    # noqa: E731
+    sub = lambda: random_ltl(rng, pool, depth - 1)
     if kind == 0:
         return Not(sub())
     if kind == 1:
