@@ -351,7 +351,9 @@ def decide_on_quotient(net: Net, formula: Formula, kind: str, start: Marking, *,
         store["groups"] = find_symmetries(net, compiled=store["compiled"])
     if not store["groups"]:
         return None
-    orbits = _Orbits(store["groups"], store["compiled"])
+    if "orbits" not in store:
+        store["orbits"] = _Orbits(store["groups"], store["compiled"])
+    orbits = store["orbits"]
     exact = all(orbits.invariant(atom) for atom in atoms(formula))
     lower, upper = (formula, formula) if exact else orbits.bounds(formula, ORBIT_LIMIT)
     if not all(orbits.invariant(atom) for f in (lower, upper) for atom in atoms(f)):
