@@ -18,25 +18,9 @@ from petriflow.analysis.check_result import explored_marking
 from petriflow.analysis.symmetry import find_symmetries, transition_orbits
 from petriflow.engine import CompiledNet, enabled, fire_sequence
 from petriflow.io import load_net
+from petriflow.properties import language as lang
 from petriflow.properties.check import check_properties
-from petriflow.properties.language import (
-    AllPaths,
-    And,
-    Compare,
-    Constant,
-    Deadlock,
-    ExistsPath,
-    Finally,
-    Fireable,
-    Globally,
-    Linear,
-    Next,
-    Not,
-    Or,
-    Property,
-    Until,
-    atoms,
-)
+from petriflow.properties.language import Compare, Constant, Deadlock, Fireable, Linear, Not, Property
 from petriflow.properties.symmetric import decide_on_quotient, symmetric
 from petriflow.properties.yaml_props import parse_formula
 from petriflow.workflow import workflow_structure
@@ -72,45 +56,27 @@ def atom_pool(net):
     return same, one
 
 
-def random_ctl(rng, pool, depth):
+def random_formula(rng, pool, depth, ctl=True):
+    """A CTL formula (each temporal operator under ``A``/``E``), or an LTL path formula."""
     if depth == 0 or rng.random() < 0.2:
         return rng.choice(pool)
     kind = rng.randrange(10)
-    sub = lambda: random_ctl(rng, pool, depth - 1)
-    if kind == 0:
-        return Not(sub())
-    if kind == 1:
-        return And((sub(), sub()))
-    if kind == 2:
-        return Or((sub(), sub()))
-    quantifier = AllPaths if rng.random() < 0.5 else ExistsPath
-    if kind == 3:
-        return quantifier(Until(sub(), sub()))
-    return quantifier(rng.choice([Next, Finally, Globally])(sub()))
-
-
-def random_ltl(rng, pool, depth):
-    if depth == 0 or rng.random() < 0.25:
-        return rng.choice(pool)
-    kind = rng.randrange(6)
-    sub = lambda: random_ltl(rng, pool, depth - 1)
-    if kind == 0:
-        return Not(sub())
-    if kind == 1:
-        return And((sub(), sub()))
-    if kind == 2:
-        return Until(sub(), sub())
-    return rng.choice([Next, Finally, Globally])(sub())
+    operands = [random_formula(rng, pool, depth - 1, ctl) for _ in range(2)]
+    if kind < 3:
+        return [Not(operands[0]), lang.And(tuple(operands)), lang.Or(tuple(operands))][kind]
+    path = lang.Until(*operands) if kind == 3 else \
+        rng.choice([lang.Next, lang.Finally, lang.Globally])(operands[0])
+    return rng.choice([lang.AllPaths, lang.ExistsPath])(path) if ctl else path
 
 
 def formulas(net, seed):
     rng = random.Random(seed)
     same, one = atom_pool(net)
     found = [p.formula for p in net.properties if p.formula is not None]
-    found += [random_ctl(rng, same, 3) for _ in range(40)]
-    found += [random_ctl(rng, same + one, 3) for _ in range(40)]
-    found += [AllPaths(random_ltl(rng, same, 3)) for _ in range(6)]
-    found += [ExistsPath(random_ltl(rng, same + one, 3)) for _ in range(6)]
+    found += [random_formula(rng, same, 3) for _ in range(40)]
+    found += [random_formula(rng, same + one, 3) for _ in range(40)]
+    found += [lang.AllPaths(random_formula(rng, same, 3, ctl=False)) for _ in range(6)]
+    found += [lang.ExistsPath(random_formula(rng, same + one, 3, ctl=False)) for _ in range(6)]
     return found
 
 
@@ -139,7 +105,7 @@ def test_the_quotient_gives_the_full_graphs_verdicts(relative):
     for formula, expected in zip(cases, full):
         kind = Property(id="x", formula=formula).kind
         got = decide_on_quotient(net, formula, kind, start, max_states=100_000, store=store)
-        exact = all(symmetric(atom, groups, net) for atom in atoms(formula))
+        exact = all(symmetric(atom, groups, net) for atom in lang.atoms(formula))
         if exact:
             assert got is not None, formula
         if got is None:
