@@ -184,18 +184,13 @@ class _Orbits:
 
     def orbit(self, atom: Compare, limit: int) -> list[Formula] | None:
         """The images of ``atom`` under the groups (``None``: more than ``limit``)."""
-        def renamed(c: Compare, mapping: dict[str, str]) -> Compare:
-            def side(linear: Linear) -> Linear:
-                return Linear(tuple((mapping.get(p, p), k) for p, k in linear.terms), linear.offset)
-            return Compare(c.op, side(c.left), side(c.right))
-
         seen: dict[Any, Formula] = {_shape(atom, {}): atom}
-        frontier = [atom]
+        frontier: list[Formula] = [atom]
         while frontier:
             found = []
             for f in frontier:
                 for swap in self.swaps:
-                    image = renamed(f, swap)
+                    image = self.renamed(f, swap)
                     key = _shape(image, {})
                     if key not in seen:
                         seen[key] = image
@@ -204,6 +199,67 @@ class _Orbits:
                             return None
             frontier = found
         return list(seen.values())
+
+    def renamed(self, node: Formula, mapping: dict[str, str]) -> Formula | None:
+        """``node`` with its places renamed (``None``: an ``enabled`` not closed)."""
+        if isinstance(node, Compare):
+            def side(linear: Linear) -> Linear:
+                return Linear(tuple((mapping.get(p, p), k) for p, k in linear.terms), linear.offset)
+            return Compare(node.op, side(node.left), side(node.right))
+        if isinstance(node, Fireable):
+            return node if self.closed(node) else None
+        if isinstance(node, (Constant, Deadlock)):
+            return node
+        children = [self.renamed(c, mapping) for c in node.children()]
+        if any(c is None for c in children):
+            return None
+        if isinstance(node, (And, Or)):
+            return type(node)(tuple(children))
+        return type(node)(*children)
+
+    def representatives(self, formula: Formula) -> Formula:
+        """``AG(c1 && ... && cn)`` with one conjunct per orbit of the groups (the rest
+        follow: ``AG c`` holds at the initial marking exactly when ``AG π(c)`` does, for
+        every permutation ``π`` of the agents, which fixes that marking)."""
+        if not (isinstance(formula, AllPaths) and isinstance(formula.operand, Globally)
+                and isinstance(formula.operand.operand, And)):
+            return formula
+        covered: set[Formula] = set()
+        kept = []
+        for conjunct in formula.operand.operand.operands:
+            if conjunct in covered:
+                continue
+            kept.append(conjunct)
+            seen, frontier = {conjunct}, [conjunct]
+            while frontier and len(seen) <= ORBIT_LIMIT:
+                images = [self.renamed(f, swap) for f in frontier for swap in self.swaps]
+                frontier = [f for f in dict.fromkeys(images) if f is not None and f not in seen]
+                seen.update(frontier)
+            covered |= seen
+        return AllPaths(Globally(And(tuple(kept)))) if len(kept) > 1 else AllPaths(Globally(kept[0]))
+
+    def fixing(self, formula: Formula) -> list[SymmetryGroup] | None:
+        """The groups less every agent whose places the formula's moved atoms read (a
+        group left with one agent dropped); ``None``: a moved ``enabled``."""
+        owner = {int(p): (g, a) for g, group in enumerate(self.groups)
+                 for a, row in enumerate(group.blocks) for p in row}
+        index = self.compiled.place_index
+        named: set[tuple[int, int]] = set()
+        for atom in atoms(formula):
+            if self.invariant(atom):
+                continue
+            for node in atom.walk():
+                if isinstance(node, Fireable) and not self.closed(node):
+                    return None
+                if isinstance(node, Compare):
+                    named |= {owner[index[p]] for p, _ in node.left.terms + node.right.terms
+                              if index[p] in owner}
+        groups = []
+        for g, group in enumerate(self.groups):
+            keep = [a for a in range(group.size) if (g, a) not in named]
+            if len(keep) > 1:
+                groups.append(SymmetryGroup([group.agents[a] for a in keep], group.blocks[keep]))
+        return groups
 
     def bounds(self, node: Formula, limit: int) -> tuple[Formula, Formula]:
         """``(lower, upper)``: see the module documentation."""
@@ -342,18 +398,18 @@ def decide_on_quotient(net: Net, formula: Formula, kind: str, start: Marking, *,
                        max_states: int, store: dict) -> dict | None:
     """Decide a ``reachability``, ``ctl`` or ``ltl`` formula on the symmetry quotient:
     ``{"verdict", "method", "witness"?, "cycle"?}``, or ``None`` when the net has no
-    symmetric agents, the quotient is over ``max_states``, or neither bound settles
-    the formula. ``store`` keeps the groups and the quotient between calls."""
+    symmetric agents, the quotient is over ``max_states``, or nothing settles the
+    formula (neither bound, nor the quotient by the agents it leaves unnamed). ``store``
+    keeps the groups and the quotients between calls."""
     if kind not in ("reachability", "ctl", "ltl"):
         return None
     if "groups" not in store:
         store["compiled"] = CompiledNet(net)
         store["groups"] = find_symmetries(net, compiled=store["compiled"])
+        store["orbits"] = _Orbits(store["groups"], store["compiled"])
     if not store["groups"]:
         return None
-    if "orbits" not in store:
-        store["orbits"] = _Orbits(store["groups"], store["compiled"])
-    orbits = store["orbits"]
+    orbits: _Orbits = store["orbits"]
     exact = all(orbits.invariant(atom) for atom in atoms(formula))
     lower, upper = (formula, formula) if exact else orbits.bounds(formula, ORBIT_LIMIT)
     if not all(orbits.invariant(atom) for f in (lower, upper) for atom in atoms(f)):
@@ -363,17 +419,11 @@ def decide_on_quotient(net: Net, formula: Formula, kind: str, start: Marking, *,
         return None
     states = f"{kripke.n:,} canonical markings"
     for candidate, wanted in ((lower, True), (upper, False)):
-        if kind == "ltl":
-            value, evidence = check_ltl(kripke, candidate)
-            checker = "LTL: Spot Büchi automaton x the quotient"
-        else:
-            value = bool(evaluate(kripke, candidate, store["cache"])[0])
-            evidence = ctl_witness(kripke, candidate, value, store["cache"])
-            checker = "CTL fixpoints on the quotient"
+        (value, evidence), checker = _run(kripke, candidate, kind, store["cache"])
         if value == wanted or exact:
             break
     else:
-        return None
+        return _on_sub_quotient(net, formula, kind, start, max_states, store)
     if exact:
         method = (f"symmetry quotient: {checker} ({states}; every atom invariant under the"
                   " agents' permutations, the quotient bisimilar to the reachability graph)")
@@ -382,6 +432,20 @@ def decide_on_quotient(net: Net, formula: Formula, kind: str, start: Marking, *,
                   f" ({states}) {'proves' if wanted else 'refutes'} it with each atom the agents'"
                   " permutations move replaced by its orbit's "
                   f"{'conjunction (disjunction where negated)' if wanted else 'disjunction (conjunction where negated)'}")
+    return _entry(kripke, kind, candidate, value, evidence, method)
+
+
+def _run(kripke: QuotientKripke, formula: Formula, kind: str, cache: dict
+         ) -> tuple[tuple[bool, dict | None], str]:
+    """``((verdict, quotient evidence), checker)`` of ``formula`` on ``kripke``."""
+    if kind == "ltl":
+        return check_ltl(kripke, formula), "LTL: Spot Büchi automaton x the quotient"
+    value = bool(evaluate(kripke, formula, cache)[0])
+    return (value, ctl_witness(kripke, formula, value, cache)), "CTL fixpoints on the quotient"
+
+
+def _entry(kripke: QuotientKripke, kind: str, formula: Formula, value: bool,
+           evidence: dict | None, method: str) -> dict:
     entry: dict[str, Any] = {"verdict": value, "method": method, "witness": None}
     if evidence is not None:
         concrete = concrete_evidence(kripke.quotient, evidence)
@@ -389,6 +453,33 @@ def decide_on_quotient(net: Net, formula: Formula, kind: str, start: Marking, *,
             entry["method"] += "; its cycle was not closed concretely (no evidence)"
         else:
             entry.update(concrete)
-    elif kind != "ltl" and not is_state_formula(candidate):
+    elif kind != "ltl" and not is_state_formula(formula):
         entry["method"] += "; no single path shows this verdict"
     return entry
+
+
+def _on_sub_quotient(net: Net, formula: Formula, kind: str, start: Marking, max_states: int,
+                     store: dict) -> dict | None:
+    """The formula decided exactly on the quotient by the agents none of its moved atoms
+    names (after ``AG`` of a conjunction keeps one conjunct per orbit), or ``None``."""
+    orbits: _Orbits = store["orbits"]
+    reduced = orbits.representatives(formula) if kind != "ltl" else formula
+    groups = orbits.fixing(reduced)
+    if not groups:
+        return None
+    sub = _Orbits(groups, store["compiled"])
+    if not all(sub.invariant(atom) for atom in atoms(reduced)):
+        return None
+    key = tuple(tuple(g.agents) for g in groups)
+    inner = store.setdefault("sub", {}).setdefault(key, {"groups": groups, "compiled": store["compiled"]})
+    kripke = _quotient(net, start, max_states, inner)
+    if kripke is None:
+        return None
+    (value, evidence), checker = _run(kripke, reduced, kind, inner["cache"])
+    fixed = sorted({a for g in store["groups"] for a in g.agents} - {a for g in groups for a in g.agents})
+    method = (f"symmetry quotient by the agents the formula leaves unnamed: {checker} ({kripke.n:,}"
+              f" canonical markings, {', '.join(fixed)} kept apart; every atom invariant under the"
+              " other agents' permutations"
+              + ("; of AG's conjuncts, one per orbit of the agents' permutations" if reduced != formula
+                 else "") + ")")
+    return _entry(kripke, kind, reduced, value, evidence, method)

@@ -152,3 +152,29 @@ def test_a_cycle_on_the_quotient_becomes_a_concrete_lasso():
     if result["verdict"]:
         assert result["cycle"]
     replays(net, start, result)
+
+
+TEAM = "petriflow: 1\nplaces: [{id: lock, tokens: 1}]\nsubnets:\n" + "".join(
+    f"- {{id: a{k}, state: worker, places: [{{id: a{k}_idle, tokens: 1}}, a{k}_busy], transitions: ["
+    f"{{id: a{k}_go, in: [a{k}_idle, lock], out: [a{k}_busy]}}, "
+    f"{{id: a{k}_back, in: [a{k}_busy], out: [a{k}_idle, lock]}}]}}\n" for k in (1, 2, 3))
+
+
+@pytest.mark.parametrize("text", [
+    "AG(a1_busy == 0)",
+    ("AG((a1_busy <= 0 || EX(a1_busy == 0 && lock == 0)) && (a2_busy <= 0 || EX(a2_busy == 0 && lock == 0))"
+     " && (a3_busy <= 0 || EX(a3_busy == 0 && lock == 0)))"),
+])
+def test_what_the_bounds_leave_is_decided_on_the_quotient_by_the_other_agents(text):
+    """Three workers, one lock: false, and neither bound says so; the quotient that
+    keeps the named worker apart (one conjunct per orbit under AG) does, with the firing."""
+    from petriflow.io.yaml import loads_net
+
+    net = loads_net(TEAM)
+    formula = parse_formula(text)
+    got = decide_on_quotient(net, formula, "ctl", net.initial_marking, max_states=100, store={})
+    full = check_properties(net, [Property(id="x", formula=formula)])[0]
+    assert full["verdict"] is False and got["verdict"] is False
+    assert "leaves unnamed" in got["method"] and "a1 kept apart" in got["method"]
+    assert got["witness"] == ["a1_go"]
+    assert ("one per orbit" in got["method"]) == ("&&" in text)
