@@ -113,8 +113,8 @@ __all__ = ["ORBIT_LIMIT", "QuotientKripke", "concrete_evidence", "decide_on_quot
 #: (beyond: ``false``/``true``).
 ORBIT_LIMIT = 256
 
-#: The most times a quotient cycle is replayed in search of a concrete cycle (the
-#: order of the permutation one pass applies: at most a few hundred for 20 agents).
+#: The most times a quotient cycle is replayed in search of a concrete cycle (each pass
+#: is a function of the concrete marking it starts in, all of one orbit, so they repeat).
 CYCLE_ROUNDS = 10_000
 
 
