@@ -178,3 +178,20 @@ def test_what_the_bounds_leave_is_decided_on_the_quotient_by_the_other_agents(te
     assert "leaves unnamed" in got["method"] and "a1 kept apart" in got["method"]
     assert got["witness"] == ["a1_go"]
     assert ("one per orbit" in got["method"]) == ("&&" in text)
+
+
+def test_a_quotient_cycle_that_swaps_the_agents_is_replayed_until_it_closes():
+    """Two workers pass one job back and forth: on the quotient one step is a cycle; the
+    concrete lasso needs two passes of it, and fires back to where it starts."""
+    from petriflow.io.yaml import loads_net
+
+    net = loads_net("petriflow: 1\nplaces: [{id: lock, tokens: 1}]\nsubnets:\n" + "".join(
+        f"- {{id: a{k}, state: worker, places: [{{id: a{k}_idle, tokens: 1}}, a{k}_busy], transitions: ["
+        f"{{id: a{k}_go, in: [a{k}_idle, lock], out: [a{k}_busy]}}, "
+        f"{{id: a{k}_pass_a{j}, in: [a{k}_busy, a{j}_idle], out: [a{k}_idle, a{j}_busy]}}]}}\n"
+        for k, j in ((1, 2), (2, 1))))
+    got = decide_on_quotient(net, parse_formula("E(F(G(lock == 0)))"), "ltl", net.initial_marking,
+                             max_states=100, store={})
+    assert got["verdict"] is True and len(got["cycle"]) == 2
+    assert set(got["cycle"]) == {"a1_pass_a2", "a2_pass_a1"}
+    replays(net, net.initial_marking, got)
