@@ -112,7 +112,7 @@ class PropertyStubbornSets:
         self.preset = {t: [(index[p], w) for p, w in net.preset(t).items()] for t in net.transitions}
         self.enabled_rows = self.compiled.enabled
         self._checks: dict[Formula, object] = {}
-        self._slopes: dict[Formula, np.ndarray] = {}
+        self._slopes: dict[Formula, tuple] = {}
 
     def holds(self, formula: Formula, m) -> bool:
         """The state predicate in marking ``m`` (compiled once per formula)."""
@@ -186,22 +186,25 @@ class PropertyStubbornSets:
 
     def _up_compare(self, op: str, node: Compare, m) -> set[int]:
         """Up-set of ``left op right`` (false in ``m``)."""
-        slope = self._slopes.get(node)
-        if slope is None:
+        known = self._slopes.get(node)
+        if known is None:
             index = self.compiled.place_index
             expression = node.left.plus(node.right, -1)
             slope = np.zeros(len(self.compiled.transitions), dtype=np.int64)
             for place, k in expression.terms:
                 slope += k * self.effect[:, index[place]]
-            self._slopes[node] = slope
-        index = self.compiled.place_index
-        expression = node.left.plus(node.right, -1)
-        value = sum(k * m[index[p]] for p, k in expression.terms) + expression.offset
-        if op in ("<=", "<") or (op == "==" and value > 0):
-            return set(np.flatnonzero(slope < 0).tolist())
-        if op in (">=", ">") or op == "==":
-            return set(np.flatnonzero(slope > 0).tolist())
-        return set(np.flatnonzero(slope != 0).tolist())
+            terms = [(index[p], k) for p, k in expression.terms]
+            known = self._slopes[node] = (terms, expression.offset, set(np.flatnonzero(slope < 0).tolist()),
+                                          set(np.flatnonzero(slope > 0).tolist()),
+                                          set(np.flatnonzero(slope != 0).tolist()))
+        terms, offset, lowering, raising, changing = known
+        if op in ("<=", "<"):
+            return lowering
+        if op in (">=", ">"):
+            return raising
+        if op == "==":
+            return lowering if sum(k * m[p] for p, k in terms) + offset > 0 else raising
+        return changing
 
     def reach_set(self, goal: Formula, m) -> list[int]:
         """The enabled rows to explore from ``m`` (where ``goal`` is false)."""
@@ -220,11 +223,14 @@ class PropertyStubbornSets:
         inside = set(seeds)
         todo = list(seeds)
         conflicts, producers, scapegoat = self.sets.conflicts, self.sets.producers, self.sets.scapegoat
+        met = len(on.intersection(inside))        # enabled members met so far
         while todo:
             t = todo.pop()
             if t in on:
                 if visible is not None and visible[t]:
                     return None
+                if visible is None and met == len(on):
+                    return enabled                # every enabled row is in: no reduction
                 nxt = conflicts[t]
             else:
                 nxt = producers[scapegoat(m, t)]
@@ -232,6 +238,7 @@ class PropertyStubbornSets:
                 if u not in inside:
                     inside.add(u)
                     todo.append(u)
+                    met += u in on
         return [t for t in enabled if t in inside]
 
     # -- LTL without X ------------------------------------------------------------------
