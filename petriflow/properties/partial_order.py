@@ -222,8 +222,9 @@ class PropertyStubbornSets:
         on = set(enabled)
         inside = set(seeds)
         todo = list(seeds)
-        conflicts, producers, scapegoat = self.sets.conflicts, self.sets.producers, self.sets.scapegoat
+        conflicts, producers, pre = self.sets.conflicts, self.sets.producers, self.compiled.pre
         met = len(on.intersection(inside))        # enabled members met so far
+        add, push = inside.add, todo.append
         while todo:
             t = todo.pop()
             if t in on:
@@ -232,13 +233,17 @@ class PropertyStubbornSets:
                 if visible is None and met == len(on):
                     return enabled                # every enabled row is in: no reduction
                 nxt = conflicts[t]
-            else:
-                nxt = producers[scapegoat(m, t)]
+            else:                                 # D2: the raisers of its first place short of tokens
+                for p, w in pre[t]:
+                    if m[p] < w:
+                        nxt = producers[p]
+                        break
             for u in nxt:
                 if u not in inside:
-                    inside.add(u)
-                    todo.append(u)
-                    met += u in on
+                    add(u)
+                    push(u)
+                    if u in on:
+                        met += 1
         return [t for t in enabled if t in inside]
 
     # -- LTL without X ------------------------------------------------------------------
