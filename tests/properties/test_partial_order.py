@@ -174,3 +174,23 @@ def test_reset_arcs_are_explored_in_full():
     found = reach_stubborn(net, net.initial_marking,
                            Compare("==", Linear.of_places(["b"]), Linear.constant(0)), max_states=10)
     assert (found.found, found.reduced, found.witness, found.states) == (True, False, ["t"], 2)
+
+
+def test_cli_method_chooses_the_reduction(tmp_path, capsys):
+    """`check --properties --method stubborn` decides by stubborn sets and names them in
+    `method`; `--method explicit` on the reachability graph; the verdicts agree."""
+    import json
+
+    from petriflow.cli import main
+
+    path = tmp_path / "split.yaml"
+    path.write_text(IGNORING + "properties:\n  - {id: b_done, reachable: 'b2 == 1'}\n"
+                    "  - {id: b_stays, ltl: 'G b2 == 0'}\n")
+    methods = {}
+    for method in ("stubborn", "explicit"):
+        assert main(["check", str(path), "--properties", "--json", "--method", method]) == 1
+        data = json.loads(capsys.readouterr().out)["properties"]
+        assert [p["verdict"] for p in data] == [True, False]
+        methods[method] = [p["method"] for p in data]
+    assert all("stubborn sets" in m for m in methods["stubborn"])
+    assert not any("stubborn" in m for m in methods["explicit"])
