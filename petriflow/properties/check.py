@@ -5,7 +5,10 @@ and decides every property on it:
 
 * **reachability** (``EF p``, ``AG p``, a state predicate alone): the states are
   numbered breadth first, so the first state satisfying ``p`` (or violating it) gives
-  a shortest firing sequence as witness (counterexample);
+  a shortest firing sequence as witness (counterexample); when the graph is over
+  budget or the net unbounded, ``EF p``/``AG p`` by a stubborn-set search from the net
+  (:mod:`~petriflow.properties.partial_order`, at most :data:`ON_THE_FLY_STATES`
+  markings per formula);
 * **bound** (the places' token total): P-semiflows first
   (:func:`~petriflow.properties.bounds.invariant_bound`), the explored markings second;
   the witness reaches a marking with the bound; with ``at_most`` the verdict is whether
@@ -14,7 +17,8 @@ and decides every property on it:
 * **ltl**: Spot's Büchi automaton times the graph, searched on the fly
   (:mod:`~petriflow.properties.ltl`); when the graph is over budget or the net
   unbounded, times markings generated from the net as the search goes (at most
-  :data:`ON_THE_FLY_STATES` of them per formula);
+  :data:`ON_THE_FLY_STATES` of them per formula), reduced by stubborn sets when the
+  formula has no ``X``;
 * **boolean** (``A G F p && A F q``): each quantified operand by its own checker, the
   verdicts combined (no evidence: each operand's is its own property's).
 
