@@ -133,6 +133,19 @@ def test_the_stack_proviso_keeps_a_postponed_transition():
     assert verdict is False
 
 
+def test_the_up_set_goes_straight_to_the_goal():
+    """Reaching ``b2 == 1`` needs ``tb``: the up-set holds only it, so the invisible cycle
+    is never explored (2 markings of the 4), and the witness is ``tb`` alone; ``a2 >= 1
+    && b2 == 1`` needs both parts (3 markings)."""
+    net = loads_net(IGNORING)
+    b2 = Compare("==", Linear.of_places(["b2"]), Linear.constant(1))
+    found = reach_stubborn(net, net.initial_marking, b2, max_states=10)
+    assert (found.found, found.witness, found.states) == (True, ["tb"], 2)
+    both = And((Compare(">=", Linear.of_places(["a2"]), Linear.constant(1)), b2))
+    found = reach_stubborn(net, net.initial_marking, both, max_states=10)
+    assert found.found and sorted(found.witness) == ["go", "tb"] and found.states == 3
+
+
 def test_formulas_with_next_keep_the_full_search():
     net = loads_net(IGNORING)
     stats: dict = {}
