@@ -22,6 +22,11 @@ and decides every property on it:
 * **boolean** (``A G F p && A F q``): each quantified operand by its own checker, the
   verdicts combined (no evidence: each operand's is its own property's).
 
+When the graph is over budget and the net has interchangeable agents, reachability, CTL
+and LTL formulas are decided on the symmetry quotient instead
+(:func:`~petriflow.properties.symmetric.decide_on_quotient`: exact when every atom is
+invariant under the agents' permutations, else bounded by formulas whose atoms are).
+
 Each result is ``{"id", "formula", "kind", "verdict", "method", "witness"}`` and, for a
 lasso, ``"cycle"`` (the firings repeated forever; empty: the last marking is a deadlock,
 which repeats); ``verdict`` is ``true``/``false``, the bound (an integer), or ``null``
@@ -64,6 +69,7 @@ from petriflow.properties.language import (
 )
 from petriflow.properties.ltl import check_ltl, check_ltl_on_net
 from petriflow.properties.partial_order import has_next, reach_stubborn
+from petriflow.properties.symmetric import decide_on_quotient
 from petriflow.properties.yaml_props import check_property_names
 from petriflow.workflow import workflow_structure
 
@@ -136,12 +142,12 @@ def check_properties(net: Net, properties: Sequence[Property], *,
                 _deadlock_by_stubborn_sets(entry, prop, net, start, max_states)
                 if entry["verdict"] is None:
                     _by_stubborn_sets(entry, prop, net, start, min(max_states, ON_THE_FLY_STATES))
-            if entry["verdict"] is None and prop.kind == "reachability" and space is None \
-                    and reason is not None and reason.startswith("state space over budget"):
-                _by_symmetry(entry, prop, net, start, max_states, quotient)
             if prop.kind == "ltl":
                 _ltl_on_the_fly(entry, prop, net, start, min(max_states, ON_THE_FLY_STATES),
                                 reduction == "auto" and LTL_STUBBORN_OVER_BUDGET)
+            if entry["verdict"] is None and space is None and reason is not None \
+                    and reason.startswith("state space over budget"):
+                _by_symmetry(entry, prop, net, start, max_states, quotient)
         elif prop.kind == "boolean":
             verdict = _boolean(prop.formula, kripke, cache)
             entry.update(verdict=verdict, method="Boolean combination: each quantified formula decided"
@@ -309,34 +315,14 @@ def _by_stubborn_sets(entry: dict, prop: Property, net: Net, start, max_states: 
 
 
 def _by_symmetry(entry: dict, prop: Property, net: Net, start, max_states: int, quotient: dict) -> None:
-    """``AG p`` / ``EF p`` with ``p`` invariant under the agents' permutations, on the
-    quotient (:mod:`~petriflow.properties.symmetric`) when the full space is over budget."""
-    from petriflow.analysis.symmetry import SymmetryUnsupported, find_symmetries, symmetric_graph
-    from petriflow.properties.symmetric import holds_on_quotient, symmetric
-
-    universal, predicate = _reachability_shape(prop.formula)
-    if universal is None:
-        return
-    if "groups" not in quotient:
-        quotient["groups"] = find_symmetries(net)
-    groups = quotient["groups"]
-    if not groups or not symmetric(predicate, groups, net):
-        return
-    if "space" not in quotient:
-        try:
-            quotient["space"] = symmetric_graph(net, start, groups=groups, max_states=max_states)
-        except (StateSpaceLimit, SymmetryUnsupported):
-            quotient["space"] = None
-    space = quotient["space"]
-    if space is None:
-        return
-    holds = holds_on_quotient(space, predicate)
-    bad = np.flatnonzero(~holds if universal else holds)
-    entry.update(verdict=(not bad.size) if universal else bool(bad.size),
-                 method=f"symmetry quotient ({space.num_states} canonical markings; the predicate"
-                        " is invariant under the agents' permutations)")
-    if bad.size:
-        entry["witness"] = space.path(int(bad[0]))
+    """Reachability, CTL or LTL on the symmetry quotient (its atoms invariant under the
+    agents' permutations, or the formula bounded by such;
+    :mod:`~petriflow.properties.symmetric`) when the full space is over budget."""
+    found = decide_on_quotient(net, prop.formula, prop.kind, start, max_states=max_states,
+                               store=quotient)
+    if found is not None:
+        entry.pop("reason", None)
+        entry.update(found)
 
 
 def _bound(entry: dict, prop: Property, space: StateSpace | None, proved: int | None,
