@@ -539,7 +539,10 @@ def _check_properties(args: argparse.Namespace, net) -> int:
         if not properties:
             raise PetriflowError(f"{args.net}: the net declares no properties (a 'properties:' list);"
                                  " name a properties file: --properties FILE")
-    results = check_properties(net, properties, max_states=args.max_states or DEFAULT_MAX_STATES)
+    # --method stubborn forces the stubborn-set searches, explicit forbids them
+    reduction = {"stubborn": "stubborn", "explicit": "none"}.get(args.method, "auto")
+    results = check_properties(net, properties, max_states=args.max_states or DEFAULT_MAX_STATES,
+                               reduction=reduction)
     if args.json:
         _print_json({"net": net.id, "properties": results})
     else:
@@ -688,7 +691,8 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--method", choices=("auto", "explicit", "symmetry", "stubborn", "structural"),
                        default="auto", help="how to answer (docs/analysis.md): the full state space"
                        " (explicit), up to permutations of interchangeable agents (symmetry),"
-                       " deadlocks by stubborn sets (stubborn), soundness of free-choice WF-nets"
+                       " deadlocks by stubborn sets (stubborn; with --properties: EF/AG and LTL"
+                       " without X by stubborn sets), soundness of free-choice WF-nets"
                        " by the Rank Theorem (structural); auto (default) picks and reports which")
     check.add_argument("--invariant-budget", type=limits.integer_argument, default=None, metavar="N",
                        help="work budget of each of the P- and T-semiflow computations (0: skip"

@@ -428,12 +428,15 @@ def concrete_path(compiled: CompiledNet, groups: list[SymmetryGroup], start_row,
     """Replay a quotient path (rows fired in canonical markings) from the concrete
     initial marking: ``(transition ids fired, the concrete marking reached)``.
 
-    The initial marking is fixed by every permutation, so it is its own canonical
-    form; after each step the concrete marking is mapped onto its canonical form by
-    sorting each group's blocks, and that order renames the next transition."""
+    ``start_row`` may be any concrete marking (the initial marking, fixed by every
+    permutation, is its own canonical form): before each step the concrete marking is
+    mapped onto its canonical form by sorting each group's blocks, and that order
+    renames the next transition."""
     rename = _renamers(compiled, groups)
     vector = [int(x) for x in start_row]
-    order = [list(range(g.size)) for g in groups]     # canonical agent j = concrete order[j]
+    start = np.asarray(vector, dtype=np.int64)
+    # canonical agent j = concrete agent order[j]
+    order = [np.lexsort(start[g.blocks].T[::-1]).tolist() for g in groups]
     fired: list[str] = []
     for row in rows:
         mapping = {g.agents[j]: g.agents[order[gi][j]] for gi, g in enumerate(groups)
