@@ -45,6 +45,7 @@ from typing import Any, Callable, TextIO
 
 from petriflow.bridge import protocol
 from petriflow.bridge.calls import CallRefused, calling_services
+from petriflow.bridge.held import AgentMemory, Held, HeldStates, check_spec, memory_error
 from petriflow.bridge.protocol import Refused
 from petriflow.bridge.transport import Transport, agent_of, from_agent, to_agent
 from petriflow.errors import NetFormatError
@@ -94,6 +95,8 @@ class _Running:
     ctx: ActionContext
     ends_at: float | None = None  # an action that only waits: when it ends
     cancelling: bool = False
+    held: Held | None = None  # its agent's state, when the agent holds it (:mod:`~.held`)
+    seen: int = 0  # the state's changes when it was last polled (an action asleep on it wakes)
 
 
 class AgentServer:
@@ -132,6 +135,7 @@ class AgentServer:
         self.running: dict[str, _Running] = {}
         self.ended: dict[str, protocol.BridgeMessage] = {}
         self.instances: dict[tuple[str, str, str], Action] = {}
+        self.memory = AgentMemory(self.registry)  # the agent states it holds (:mod:`petriflow.bridge.held`)
         self.executed = 0
         self.dropped = 0
         self._stop = threading.Event()
@@ -338,6 +342,16 @@ class AgentServer:
         except (UnknownActionError, NetFormatError) as exc:
             self._remember(goal.id, protocol.Rejected(goal.id, goal.agent, str(exc)))
             return
+        held = None
+        if goal.state:  # the subnet's state lives here: made on its first goal, given as ctx.state
+            why = check_spec(goal.state)
+            try:
+                held = None if why else self.memory.held(goal.id.partition("/")[0], goal.agent, goal.state)
+            except Exception as exc:
+                why = memory_error(exc)
+            if why:
+                self._remember(goal.id, protocol.Rejected(goal.id, goal.agent, why))
+                return
         key = (goal.agent, goal.transition, json.dumps(protocol.to_data(params), sort_keys=True))
         action = self.instances.get(key)
         setup_error = None
@@ -357,7 +371,8 @@ class AgentServer:
         now = self.now
         ctx = ActionContext(goal.transition or goal.action, goal.agent, params, dict(goal.inputs), self.world,
                             goal.seed or goal.id, now, now, action=cls,
-                            services=calling_services(settings, lambda *asked: self.call(goal, *asked)))
+                            services=calling_services(settings, lambda *asked: self.call(goal, *asked),
+                                                      None if held is None else HeldStates(held)))
         self.executed += 1
         if self.log_file is not None:
             self.log_file.write(json.dumps({"goal": goal.id, "agent": goal.agent, "action": goal.action,
@@ -365,9 +380,9 @@ class AgentServer:
             self.log_file.flush()
         self._send(goal.agent, protocol.Accepted(goal.id, goal.agent))
         if setup_error is not None:
-            self._end(goal, ctx, Status.FAILED, setup_error)
+            self._end(goal, ctx, Status.FAILED, setup_error, held)
             return
-        running = _Running(goal, action, ctx)
+        running = _Running(goal, action, ctx, held=held)
         self._hold(running)
         try:
             seconds = action.delay()
@@ -381,11 +396,13 @@ class AgentServer:
             action.start(ctx)
         except Exception as exc:
             self._release(goal.id)
-            self._end(goal, ctx, Status.FAILED, f"{type(exc).__name__}: {exc}")
+            self._end(goal, ctx, Status.FAILED, f"{type(exc).__name__}: {exc}", held)
             return
         wake = action.wake_at
         if action.needs_world or wake is None or wake <= now:
             self._poll(running)
+        else:
+            self._changed(running)
 
     def _poll_all(self) -> None:
         for running in list(self.running.values()):
@@ -394,8 +411,9 @@ class AgentServer:
                 continue
             action = running.action
             if running.ends_at is None and not action.needs_world and action.wake_at is not None \
-                    and action.wake_at > self.now:
-                continue
+                    and action.wake_at > self.now and not (action.wake_on and running.held is not None
+                                                           and running.held.changes != running.seen):
+                continue  # asleep until its time, or (wake_on) until its agent's state changes
             self._poll(running)
 
     def _poll(self, running: _Running) -> None:
@@ -413,17 +431,44 @@ class AgentServer:
                 ctx.reason = f"{type(exc).__name__}: {exc}"
                 status = Status.FAILED
         if status is Status.RUNNING:
+            self._changed(running)
             return
         self._release(running.goal.id)
         self._end(running.goal, ctx, status if status in (Status.OK, Status.FAILED) else Status.FAILED,
-                  ctx.reason or ("" if status in (Status.OK, Status.FAILED) else f"poll() returned {status!r}"))
+                  ctx.reason or ("" if status in (Status.OK, Status.FAILED) else f"poll() returned {status!r}"),
+                  running.held)
 
-    def _end(self, goal: protocol.Goal, ctx: ActionContext, status: Status, reason: str = "") -> None:
+    def _changed(self, running: _Running) -> None:
+        """A goal goes on: when its agent's state changed since the last snapshot, the
+        guards' values go to the run now (a ``feedback``)."""
+        held = running.held
+        if held is None:
+            return
+        running.seen = held.changes
+        if held.changes == held.sent_at:
+            return
+        try:
+            seq, values = held.snapshot()
+        except Exception as exc:
+            log.warning("goal %s: %s", running.goal.id, exc)
+            return
+        self._send(running.goal.agent, protocol.Feedback(running.goal.id, running.goal.agent, None, values, seq))
+
+    def _end(self, goal: protocol.Goal, ctx: ActionContext, status: Status, reason: str = "",
+             held: Held | None = None) -> None:
+        events = [[kind, protocol.to_data(data)] for kind, data in ctx.emitted or ()]
+        seq, values = 0, {}
+        if held is not None:  # the subnet's state guards, evaluated where the state is
+            try:
+                seq, values = held.snapshot()
+            except Exception as exc:
+                status, reason = Status.FAILED, str(exc)
         if status is Status.OK:
             data = ctx.result
-            if ctx.per_place and isinstance(data, dict):
-                data = None
-            answer = protocol.Result(goal.id, goal.agent, "ok", protocol.to_data(data))
+            per_place = bool(ctx.per_place and isinstance(data, dict))
+            answer = protocol.Result(goal.id, goal.agent, "ok", protocol.to_data(data), "", values, seq, events,
+                                     protocol.to_data(ctx.outputs or {}), per_place)
         else:
-            answer = protocol.Result(goal.id, goal.agent, "failed", None, reason or ctx.reason or "failed")
+            answer = protocol.Result(goal.id, goal.agent, "failed", None, reason or ctx.reason or "failed", values,
+                                     seq, events)
         self._remember(goal.id, answer)

@@ -19,11 +19,18 @@ service        method      context method                             served
                                                                        the action's ports
                                                                        name
 ``liveness``   ``alive``   ``ctx.running(agent)``                     yes
+``liveness``   ``running`` ``ctx.resource(...)`` of type              yes
+                           ``core.liveness``: ``.running()``
 ``settings``               ``ctx.settings``                           on the agent, from
                                                                        its own world file
-``agents``                 ``ctx.state``                              no
+``agents``                 ``ctx.state``                              on the agent, when
+                                                                       its subnet keeps a
+                                                                       state
+                                                                       (:mod:`~.held`)
 ``channels``               ``ctx.link``, ``ctx.medium``               no
-``resources``              ``ctx.resource``                           no: refused at bind
+``resources``              ``ctx.resource``                           ``core.liveness``
+                                                                       only; others
+                                                                       refused at bind
                                                                        time
 =============  ==========  =========================================  =================
 
@@ -40,7 +47,7 @@ Examples:
     >>> answer(Call("r/3/1", "red", 2, "tokens", "read", ["P9"]), RunServices(tokens=Board()), {"S"}).error
     "tokens.read: place 'P9' is named by none of the action's ports"
     >>> check_call(Call("r/3/1", "red", 1, "agents", "state", [None]))
-    'agents.state is not served to remote agents (served: tokens.read, liveness.alive)'
+    'agents.state is not served to remote agents (served: tokens.read, liveness.alive, liveness.running)'
 """
 
 from __future__ import annotations
@@ -49,6 +56,7 @@ from typing import Any, Callable, Mapping
 
 from petriflow.bridge import protocol
 from petriflow.errors import PetriflowError
+from petriflow.runtime.resources import LIVENESS
 from petriflow.runtime.services import RunServices
 
 __all__ = ["SERVED", "check_call", "answer", "calling_services", "Unserved", "CallRefused"]
@@ -57,6 +65,7 @@ __all__ = ["SERVED", "check_call", "answer", "calling_services", "Unserved", "Ca
 SERVED: dict[tuple[str, str], tuple[tuple[type, ...], ...]] = {
     ("tokens", "read"): ((str,),),
     ("liveness", "alive"): ((str, type(None)),),
+    ("liveness", "running"): (),
 }
 
 
@@ -100,6 +109,10 @@ def answer(call: protocol.Call, services: RunServices, ports: set[str]) -> proto
         if services.tokens is None:
             return refuse("tokens.read: the run has no tokens to read")
         value: Any = services.tokens.read(place)
+    elif call.method == "running":  # the run's core.liveness resource: the agents running now
+        resources = services.resources
+        live = None if resources is None else resources.get(LIVENESS)
+        value = [] if live is None else list(live.running())
     else:
         value = True if services.liveness is None else bool(services.liveness.alive(call.args[0]))
     try:
@@ -140,6 +153,8 @@ class _Tokens:
 
 
 class _Liveness:
+    """``ctx.running`` and the ``core.liveness`` resource on an agent: the run's answers."""
+
     def __init__(self, call: Callable[[str, str, list], Any]) -> None:
         self._call = call
 
@@ -149,11 +164,32 @@ class _Liveness:
             raise CallRefused(f"liveness.alive: the run replied with a {type(value).__name__}, not a bool")
         return value
 
+    def running(self) -> list[str]:
+        value = self._call("liveness", "running", [])
+        if not isinstance(value, list) or not all(isinstance(a, str) for a in value):
+            raise CallRefused("liveness.running: the run replied with no list of agent names")
+        return value
+
+
+class _Resources:
+    """``ctx.resource`` on an agent: the run's ``core.liveness`` (served by calls); any
+    other resource is refused when the net is bound."""
+
+    def __init__(self, live: _Liveness) -> None:
+        self._live = live
+
+    def get(self, kind: str) -> Any:
+        if kind == LIVENESS:
+            return self._live
+        raise CallRefused(f"resource {kind!r} is not served to remote agents (served: {LIVENESS})")
+
 
 def calling_services(settings: Mapping[str, Mapping[str, Any]],
-                     call: Callable[[str, str, list], Any]) -> RunServices:
+                     call: Callable[[str, str, list], Any], agents: Any = None) -> RunServices:
     """A remote goal's services: ``settings`` (the agent's own), proxies that ``call``
-    the run for what :data:`SERVED` lists, :class:`Unserved` for the rest.
+    the run for what :data:`SERVED` lists, :class:`Unserved` for the rest; ``agents``
+    (the agent's own, when it holds its subnet's state: :mod:`petriflow.bridge.held`)
+    serves ``ctx.state`` on the agent.
 
     Examples:
         >>> services = calling_services({}, lambda service, method, args: [f"{service}.{method}{args}"])
@@ -162,9 +198,10 @@ def calling_services(settings: Mapping[str, Mapping[str, Any]],
         >>> services.agents.state("red")
         Traceback (most recent call last):
         ...
-        petriflow.bridge.calls.CallRefused: ctx.state reaches the run's agent states, which is not served to remote agents (served: tokens.read, liveness.alive; leave this subnet local)
+        petriflow.bridge.calls.CallRefused: ctx.state reaches the run's agent states, which is not served to remote agents (served: tokens.read, liveness.alive, liveness.running; leave this subnet local)
     """
-    return RunServices(agents=Unserved("agent states", "ctx.state"), tokens=_Tokens(call),
+    live = _Liveness(call)
+    return RunServices(agents=agents if agents is not None else Unserved("agent states", "ctx.state"),
+                       tokens=_Tokens(call),
                        channels=Unserved("channel places", "ctx.link/ctx.medium"),
-                       resources=Unserved("resources", "ctx.resource"), liveness=_Liveness(call),
-                       settings=settings)
+                       resources=_Resources(live), liveness=live, settings=settings)

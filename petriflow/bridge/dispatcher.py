@@ -118,6 +118,14 @@ class GoalState:
     #: On resume, the simulated time the journal shows it ended at (its ending is taken
     #: then, as journaled: :mod:`petriflow.bridge.resume`); ``None``: a live goal.
     at: float | None = None
+    #: The newest values of the goal's subnet's state guards the agent sent (a result's
+    #: or a feedback's), ``(seq, {transition: bool})`` (:mod:`~.held`); ``None``: none.
+    snapshot: tuple[int, dict[str, bool]] | None = None
+    #: The custom events the goal's action emitted on the agent, the data of its output
+    #: places given apart (``ctx.put``), and whether its data is per output place (its result's).
+    events: list[Any] = field(default_factory=list)
+    outputs: dict[str, Any] = field(default_factory=dict)
+    per_place: bool = False
 
     @property
     def ended(self) -> bool:
@@ -312,8 +320,8 @@ class Dispatcher:
                 replayed = False
                 if isinstance(message, protocol.Accepted):
                     state.phase = Phase.ACCEPTED
-                elif isinstance(message, protocol.Feedback):
-                    state.feedback = message.data
+                elif isinstance(message, protocol.Feedback) and (message.data is not None or not message.guards):
+                    state.feedback = message.data  # progress (one with guards only reports a state: held.py)
                     state.feedbacks.append(message.data)
                     if len(state.feedbacks) > KEPT_FEEDBACK:
                         del state.feedbacks[0]
@@ -326,6 +334,11 @@ class Dispatcher:
                     state.data, state.reason, state.answered = message.data, message.reason, now
                 elif isinstance(message, protocol.Cancelled):
                     state.phase, state.answered = Phase.CANCELLED, now
+                if isinstance(message, (protocol.Result, protocol.Feedback)) and message.seq:
+                    if state.snapshot is None or message.seq > state.snapshot[0]:
+                        state.snapshot = (message.seq, message.guards)
+                if isinstance(message, protocol.Result):
+                    state.events, state.outputs, state.per_place = message.events, message.outputs, message.per_place
                 if state.ended:
                     self._ended.notify_all()
         # an answer to a goal or a cancel sent again is expected twice; otherwise an ended goal's

@@ -61,6 +61,9 @@ VERSION = 1
 MAX_MESSAGE = 1 << 20
 #: The deepest nesting of lists and mappings accepted in a message.
 MAX_DEPTH = 32
+#: Fields added to version 1 compatibly (agent-held state): left out of a message
+#: when empty, so a message that does not use them is the bytes it always was.
+EXTENSIONS = frozenset({"state", "guards", "seq", "events", "outputs", "per_place"})
 
 
 class Kind(Name):
@@ -154,6 +157,10 @@ class Goal(BridgeMessage):
     ``id`` is idempotent: the same goal sent again (after a reconnect) carries the same
     id, and an agent that has it already answers as for the first one, never running
     the action twice. ``seed`` seeds the firing's random generator as a local run would.
+    ``state`` (not empty: the goal's subnet keeps an agent state, held by the agent) is
+    ``{"type": NAME, "guards": {transition: [guard, params]}}``: the state type the
+    subnet declares (``""``: none) and the subnet's guards over that state, which the
+    agent evaluates and sends back with its results (:mod:`petriflow.bridge.held`).
     """
 
     kind: ClassVar[Kind] = Kind.GOAL
@@ -164,6 +171,7 @@ class Goal(BridgeMessage):
     transition: str = ""
     inputs: dict[str, list[Any]] = field(default_factory=dict)
     seed: str = ""
+    state: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -184,21 +192,32 @@ class Rejected(About):
 
 @dataclass(frozen=True)
 class Feedback(About):
-    """Progress of the goal ``id``."""
+    """Progress of the goal ``id``; ``guards`` (with their snapshot number ``seq``): the
+    values of its subnet's state guards after the agent's state changed mid-action."""
 
     kind: ClassVar[Kind] = Kind.FEEDBACK
     data: Any = None
+    guards: dict[str, bool] = field(default_factory=dict)
+    seq: int = 0
 
 
 @dataclass(frozen=True)
 class Result(About):
     """The goal ``id`` ended: ``outcome`` ``ok`` (``data``: the output tokens' data) or
-    ``failed`` (``reason``)."""
+    ``failed`` (``reason``). For a goal whose subnet's state the agent holds,
+    ``guards`` are the values of the subnet's state guards when it ended, ``seq`` their
+    snapshot's number (a newer snapshot replaces an older one); ``events`` are the
+    custom events its action emitted, ``[[name, data], ...]``."""
 
     kind: ClassVar[Kind] = Kind.RESULT
     outcome: str
     data: Any = None
     reason: str = ""
+    guards: dict[str, bool] = field(default_factory=dict)
+    seq: int = 0
+    events: list[Any] = field(default_factory=list)
+    outputs: dict[str, Any] = field(default_factory=dict)
+    per_place: bool = False
 
 
 def _bare(name: str, kind: Kind, doc: str) -> type[About]:
@@ -287,7 +306,10 @@ def encode(message: BridgeMessage) -> bytes:
     """
     body = {"v": VERSION, "type": message.kind.value}
     for item in dataclasses.fields(message):
-        body[item.name] = to_data(getattr(message, item.name))
+        value = getattr(message, item.name)
+        if item.name in EXTENSIONS and not value:
+            continue  # left out when empty: a peer that predates it reads the message unchanged
+        body[item.name] = to_data(value)
     data = json.dumps(body, separators=(",", ":"), allow_nan=False).encode()
     if len(data) > MAX_MESSAGE:
         raise ValueError(f"a {message.kind.value} message of {len(data):,} bytes is over the limit of"
@@ -305,7 +327,7 @@ def _depth(value: Any, depth: int = 0) -> int:
     return depth
 
 
-_FIELD_TYPES = {"str": str, "dict[str, Any]": dict, "dict[str, dict[str, Any]]": dict,
+_FIELD_TYPES = {"str": str, "dict[str, Any]": dict, "dict[str, bool]": dict, "bool": bool, "dict[str, dict[str, Any]]": dict,
                 "dict[str, list[Any]]": dict, "list[str]": list,
                 "int": int, "list[Any]": list}
 
@@ -355,6 +377,13 @@ def decode(data: bytes | bytearray | memoryview | str) -> BridgeMessage:
         raise Refused(Drop.MALFORMED, "goal: inputs maps places to lists of token data")
     if cls in (Call, Reply) and (isinstance(values["call"], bool) or values["call"] < 1):
         raise Refused(Drop.MALFORMED, f"{kind}: call numbers a goal's calls from 1")
+    if cls in (Result, Feedback) and not all(isinstance(v, bool) for v in values.get("guards", {}).values()):
+        raise Refused(Drop.MALFORMED, f"{kind}: guards maps transitions to true or false")
+    if cls in (Result, Feedback) and (isinstance(values.get("seq", 0), bool) or values.get("seq", 0) < 0):
+        raise Refused(Drop.MALFORMED, f"{kind}: seq numbers the guards' snapshots from 1")
+    if cls is Result and not all(isinstance(e, list) and len(e) == 2 and isinstance(e[0], str)
+                                 and isinstance(e[1], dict) for e in values.get("events", [])):
+        raise Refused(Drop.MALFORMED, "result: events lists [name, data] pairs")
     if cls is Announce and not all(isinstance(v, dict) for v in values["actions"].values()):
         raise Refused(Drop.MALFORMED, "announce: actions maps each action to its parameters")
     return cls(**values)

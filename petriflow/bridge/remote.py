@@ -22,15 +22,17 @@ from typing import Any, ClassVar
 from petriflow.bridge import protocol
 from petriflow.bridge.calls import answer
 from petriflow.bridge.dispatcher import Dispatcher, Phase
+from petriflow.bridge.held import HeldGuards, held_guards, state_spec
 from petriflow.bridge.spec import BridgeSpec
 from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, ActionContext, Param, Port, Status
 from petriflow.runtime.binding import Binding, BoundTransition
 from petriflow.runtime.registry import Registry, UnknownActionError
+from petriflow.runtime.resources import LIVENESS
 
 __all__ = ["RemoteAction", "RemoteCancelFailed", "bind_remote", "check_announced", "remote_transitions",
-           "firing_number"]
+           "bridged_subnets", "firing_number"]
 
 
 class RemoteCancelFailed(PetriflowError):
@@ -53,6 +55,8 @@ class RemoteAction(Action):
     needs_world: ClassVar[bool] = False
     remote_agent: ClassVar[str] = ""
     remote_action: ClassVar[str] = ""
+    #: What the goals carry of the subnet's agent-held state (:mod:`~.held`; ``{}``: none).
+    remote_state: ClassVar[dict[str, Any]] = {}
     params: ClassVar[dict[str, Param]] = {}
 
     def __init__(self, params: dict[str, Any] | None = None) -> None:
@@ -75,7 +79,8 @@ class RemoteAction(Action):
         self.cancel_asked = False
         inputs = {place: [protocol.to_data(d) for d in data] for place, data in ctx.inputs.items()}
         dispatcher.send(protocol.Goal(self.goal_id, self.remote_agent, self.remote_action,
-                                      protocol.to_data(dict(ctx.params)), ctx.transition, inputs, str(ctx.seed)))
+                                      protocol.to_data(dict(ctx.params)), ctx.transition, inputs, str(ctx.seed),
+                                      self.remote_state))
         self.wake_at = None
 
     def poll(self, ctx: ActionContext) -> Status:
@@ -84,11 +89,13 @@ class RemoteAction(Action):
         state = dispatcher.goal(self.goal_id)
         if state is not None and state.at is not None:  # a resume replays the journaled ending
             return self._replayed(ctx, state)
+        if state is not None and state.snapshot is not None:
+            self._held(ctx, state.snapshot)
         if state is not None and state.ended:
             self._record(ctx, state)
             dispatcher.done(self.goal_id)
             if state.phase == Phase.OK:
-                ctx.result = state.data
+                self._ok(ctx, state)
                 return Status.OK
             ctx.reason = f"{self.remote_agent}: {state.reason or state.phase}"
             return Status.FAILED
@@ -120,6 +127,23 @@ class RemoteAction(Action):
             return True
         return False
 
+    @staticmethod
+    def _ok(ctx: ActionContext, state: Any) -> None:
+        """The output tokens' data of a goal ended ``ok`` (its places given apart: ``ctx.put`` on the agent)."""
+        ctx.result, ctx.per_place = state.data, state.per_place
+        for place, data in state.outputs.items():
+            ctx.put(place, data)
+
+    def _held(self, ctx: ActionContext, snapshot: tuple[int, dict[str, bool]]) -> None:
+        """The agent's newest values of the subnet's state guards into the run's cache
+        of its state (:class:`~petriflow.bridge.held.HeldGuards`), on the kernel's thread."""
+        agents = ctx.services.agents
+        held = agents.state(ctx.agent)
+        if not isinstance(held, HeldGuards):
+            held = HeldGuards(ctx.agent or self.remote_agent)
+            agents.set_state(ctx.agent, held, HeldGuards)
+        held.update(*snapshot)
+
     def _answer(self, ctx: ActionContext, dispatcher: Any) -> None:
         """Answer the goal's calls from the run's services, now: on the kernel's thread,
         at this firing's poll (:mod:`petriflow.bridge.calls`)."""
@@ -135,10 +159,12 @@ class RemoteAction(Action):
         """The journaled ending of a resumed run's firing, at its journaled time."""
         if ctx.now < state.at - 1e-9:
             return Status.RUNNING
+        if state.snapshot is not None:
+            self._held(ctx, state.snapshot)
         if state.answered is not None or state.resent:
             self._record(ctx, state)
         if state.phase == Phase.OK:
-            ctx.result = state.data
+            self._ok(ctx, state)
             return Status.OK
         ctx.reason = state.reason
         return Status.FAILED
@@ -148,13 +174,19 @@ class RemoteAction(Action):
 
     def _record(self, ctx: ActionContext, state: Any) -> None:
         """Which agent executed the firing, and the goal's round trip (a custom event)."""
+        for name, data in state.events:  # what the action emitted on the agent, as a local one's
+            ctx.emit(name, **data)
         trip = state.round_trip
+        held = {} if state.snapshot is None else {"seq": state.snapshot[0], "guards": state.snapshot[1]}
+        if state.outputs or state.per_place:  # journaled, so a resume replays them
+            held.update(outputs=state.outputs, per_place=state.per_place)
         ctx.emit("remote", agent=self.remote_agent, goal=state.goal.id, phase=state.phase, resent=state.resent,
-                 round_trip_ms=None if trip is None else round(trip * 1e3, 3), calls=state.answered_calls)
+                 round_trip_ms=None if trip is None else round(trip * 1e3, 3), calls=state.answered_calls,
+                 **held)
 
 
-def remote_transitions(net: Net, spec: BridgeSpec) -> dict[str, str]:
-    """``{transition: remote agent}`` of the transitions in the subnets ``spec`` lists.
+def bridged_subnets(net: Net, spec: BridgeSpec) -> dict[str, str]:
+    """``{subnet id: remote agent}`` of the subnets ``spec`` lists (by id or agent).
 
     Raises:
         NetFormatError: ``spec`` names a subnet the net lacks.
@@ -167,10 +199,19 @@ def remote_transitions(net: Net, spec: BridgeSpec) -> dict[str, str]:
             names = sorted({*net.subnets, *by_agent})
             raise NetFormatError(f"bridge: agents: {subnet!r} is no subnet of net {net.id!r}"
                                  f"{did_you_mean(subnet, names)}", path=net.path)
-        for transition in net.transitions.values():
-            if transition.subnet == found.id and transition.action is not None:
-                out[transition.id] = agent
+        out[found.id] = agent
     return out
+
+
+def remote_transitions(net: Net, spec: BridgeSpec) -> dict[str, str]:
+    """``{transition: remote agent}`` of the transitions in the subnets ``spec`` lists.
+
+    Raises:
+        NetFormatError: ``spec`` names a subnet the net lacks.
+    """
+    subnets = bridged_subnets(net, spec)
+    return {t.id: subnets[t.subnet] for t in net.transitions.values()
+            if t.subnet in subnets and t.action is not None}
 
 
 def bind_remote(net: Net, spec: BridgeSpec, registry: Registry, bind_local: Any, path: str | None) -> Binding:
@@ -184,7 +225,7 @@ def bind_remote(net: Net, spec: BridgeSpec, registry: Registry, bind_local: Any,
     remote = remote_transitions(net, spec)
     local_net = net.copy()
     for tid in remote:
-        local_net.transitions[tid] = dataclasses.replace(local_net.transitions[tid], action=None, params={})
+        local_net.transitions[tid] = dataclasses.replace(local_net.transitions[tid], action=None)
     binding: Binding = bind_local(local_net)
     transitions = dict(binding.transitions)
     classes: dict[tuple[str, str], type[RemoteAction]] = {}
@@ -210,6 +251,9 @@ def bind_remote(net: Net, spec: BridgeSpec, registry: Registry, bind_local: Any,
                                                "__module__": __name__})
         old = transitions[tid]
         transitions[tid] = BoundTransition(tid, cls, params, old.guard, None, old.reads)
+    held = held_guards(net, transitions, bridged_subnets(net, spec), path)  # the subnets' agent-held states
+    for (agent, _), cls in classes.items():
+        cls.remote_state = state_spec(held, agent)
     return dataclasses.replace(binding, net=net, transitions=transitions)
 
 
@@ -225,9 +269,11 @@ def _check_places(net: Net, tid: str, path: str | None, name: str, local: type[A
     read through the bridge, :mod:`petriflow.bridge.calls`); an action that declares
     resources cannot run on a remote agent (they are not served)."""
     resources = getattr(local, "resources", None) or {}
-    if resources:
-        raise _at(net, tid, path, f"action {name} takes the run's resource(s) {', '.join(sorted(resources))},"
-                  " which are not served to remote agents (leave its subnet out of bridge: agents)")
+    unserved = sorted(r for r, kind in resources.items() if kind != LIVENESS)  # liveness is served by calls
+    if unserved:
+        raise _at(net, tid, path, f"action {name} takes the run's resource(s) {', '.join(unserved)},"
+                  f" which are not served to remote agents (only {LIVENESS} is; leave its subnet out of bridge:"
+                  " agents)")
     for pname, declared in getattr(local, "params", {}).items():
         for place in declared.place_names(params.get(pname)):
             if not isinstance(place, str) or place not in net.places:

@@ -43,6 +43,7 @@ class Replay:
         self.until = events[-1].time if events else 0.0
         self.ends: dict[int, Event] = {}
         self.records: dict[int, dict[str, Any]] = {}
+        self.emitted: dict[int, list[list[Any]]] = {}  # firing -> the custom events its agent's action emitted
         self.faults: list[tuple[float, str, str, str]] = []  # (time, lost|back, agent, why)
         #: The journal's faults (as :attr:`faults`) and ``feedback`` events, in its order.
         self.outside: list[tuple[float, str, str, str] | Event] = []
@@ -52,6 +53,8 @@ class Replay:
                 self.ends[firing] = event
             elif event.kind == "custom" and event.data.get("name") == "remote":
                 self.records[firing] = event.data.get("data") or {}
+            elif event.kind == "custom" and event.transition in remote:
+                self.emitted.setdefault(firing, []).append([event.data.get("name"), event.data.get("data") or {}])
             elif event.kind == "fault" and event.data.get("fault") in ("lost", "back"):
                 self.faults.append((event.time, event.data["fault"], event.agent, event.data.get("why", "")))
                 self.outside.append(self.faults[-1])
@@ -70,6 +73,10 @@ class Replay:
                           answered=None if trip is None else trip / 1e3, resent=record.get("resent", 0),
                           data=end.data.get("result"), reason=end.data.get("reason", ""))
         state.answered_calls = record.get("calls", 0)
+        state.events = self.emitted.get(firing, [])
+        state.outputs, state.per_place = record.get("outputs") or {}, bool(record.get("per_place"))
+        if record.get("seq"):  # the agent-held state's guards as the goal's result gave them
+            state.snapshot = (record["seq"], record.get("guards") or {})
         state.at = end.time
         return state
 
