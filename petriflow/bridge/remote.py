@@ -278,7 +278,7 @@ def _check_places(net: Net, tid: str, path: str | None, name: str, local: type[A
     must be ``core.liveness`` (served by calls) or made per world (registered
     ``per_world``: the agent makes them from its own world), never the run's own."""
     resources = getattr(local, "resources", None) or {}
-    unserved = sorted(f"{r} ({kind})" for r, kind in resources.items()
+    unserved = sorted(r for r, kind in resources.items()
                       if kind != LIVENESS and not registry.per_world(kind))
     if unserved:
         raise _at(net, tid, path, f"action {name} takes the run's resource(s) {', '.join(unserved)}, which are"
