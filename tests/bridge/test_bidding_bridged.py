@@ -29,6 +29,8 @@ import pytest
 from petriflow import examples
 from petriflow.runtime.session import run_files
 
+from tests.bridge.conftest import agent_command, shipped_config
+
 pytestmark = pytest.mark.slow
 
 ROBOTS = ("robot1", "robot2", "robot3")
@@ -73,16 +75,9 @@ def test_bidding_with_three_bridged_robots_over_each_transport(middleware, tmp_p
     kind, server = middleware
     sim_metrics, sim_events = simulated
     folder = examples.path("bidding", "bidding-autonomous-3.yaml").parent
-    config = (folder / f"run-{kind}.yaml").read_text().replace(
-        f"connect: tcp/127.0.0.1:{7447 if kind == 'zenoh' else 1883}", f"connect: {server.connect}")
-    assert server.connect in config
-    config = config.replace("world: world.yaml", f"world: {folder / 'world.yaml'}")
-    (tmp_path / "run.yaml").write_text(config)
-    env = {**os.environ, "PETRIFLOW_PATH": str(folder)}
-    names = [arg for name in ROBOTS for arg in ("--name", name)]
-    agent = subprocess.Popen([sys.executable, "-m", "petriflow.cli", "agent", *names, "--transport", kind,
-                              "--connect", server.connect, "--world", str(folder / "world.yaml"),
-                              "--log", str(tmp_path / "agent.log")],
+    shipped_config(folder, kind, server, tmp_path)
+    env = {**os.environ, "PETRIFLOW_PATH": str(folder)}  # the run's world: the office and the global map
+    agent = subprocess.Popen(agent_command(ROBOTS, kind, server, folder / "world.yaml", tmp_path / "agent.log"),
                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         run = subprocess.run([sys.executable, "-m", "petriflow.cli", "run",

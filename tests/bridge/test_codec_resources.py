@@ -127,7 +127,7 @@ def mail_registry(made):
 MAIL_NET = """
 petriflow: 1
 net: mail
-final: {reply: 1, seen: 2}
+places: [box, reply, seen]
 subnets:
 - id: desk
   agent: desk
@@ -140,7 +140,7 @@ subnets:
   transitions:
   - {id: answer, action: demo.answer, in: [box], out: [reply]}
   - {id: look, action: demo.look, in: [idle], out: [seen]}
-places: [box, reply, seen]
+final: {reply: 1, seen: 2}
 """
 
 
