@@ -224,9 +224,10 @@ def plan_world_path(label_map: np.ndarray, frame: GridFrame, robot: str | int, g
         "robot": colour, "found": bool(path), "path": path,
         "start": path[0] if path else [round(v, 6) for v in start_xy],
         "goal": path[-1] if path else [round(v, 6) for v in goal_xy],
-        "variant": variant, "steps": plan.steps if plan else 0, "length_m": round(length, 6),
-        "expanded": plan.expanded if plan else 0, "visited": plan.visited if plan else 0,
-        "seconds": plan.seconds if plan else 0.0,
+        "variant": variant, "steps": plan.steps if plan is not None else 0, "length_m": round(length, 6),
+        "expanded": plan.expanded if plan is not None else 0,
+        "visited": plan.visited if plan is not None else 0,
+        "seconds": plan.seconds if plan is not None else 0.0,
     }
 
 
