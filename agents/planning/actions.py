@@ -203,7 +203,8 @@ def plan_world_path(label_map: np.ndarray, frame: GridFrame, robot: str | int, g
                                 f"grown by the robot radius, or off the map) and no free cell is within "
                                 f"{reach * frame.metres_per_cell:g} m")
         if what == "start" and free != cell:
-            free = _way_out(label_map, frame, robot, grid, start_xy, cell, cells["goal"][1], reach, cut_corners)
+            free = _way_out(label_map, frame, robot, grid, start_xy, cell, cells["goal"][1], reach,
+                            cut_corners)
         cells[what] = (cell, free)
     path: list[list[float]] = []
     plan = None

@@ -34,6 +34,7 @@ def test_a_plan_with_no_path_detains_the_robot_and_ends_the_run():
     stopped = fire_one(net, "stop", tokens={"stranded": [planned.result], "pushed": [None], "P2": [None],
                                             "P5": [None], "P6": [None], "S": [None]})
     assert stopped.outcome == "ok" and stopped.marking == {"o": 1}
-    frames = [command for event in stopped.events if event.kind == "custom" and event.data["name"] == "smart.frame"
+    frames = [command for event in stopped.events
+              if event.kind == "custom" and event.data["name"] == "smart.frame"
               for command in decode(bytes.fromhex(event.data["data"]["hex"]))]
     assert [(c.action, c.robot) for c in frames] == [(ActionId.STOP, ROBOT_LABELS["yellow"])]
