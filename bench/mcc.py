@@ -16,6 +16,10 @@ counted apart (``no oracle``).
 Printed: one line per model and category (right / wrong / undecided, CPU seconds,
 whether the budget stopped it), the totals per model and overall. No peer is wired in:
 the contest's tools (LoLA, TAPAAL, ITS-Tools) are not Python and not installed here.
+The last column counts the formulas decided by stubborn sets (their ``method``);
+``--reduction`` and ``--check-states`` choose ``check_properties``' reduction and state
+budget (``--check-states`` below a model's size puts it over budget, where ``auto``
+reduces and ``none`` does not).
 
 ``--sample N --seed S --inputs DIR --state-space DIR`` first picks the sample and
 extracts it into ``--models``: from the contest's input archives ``DIR/<model>.tgz``,
@@ -74,7 +78,8 @@ def _verdict_text(verdict: Any) -> str | None:
     return str(verdict)
 
 
-def _category_child(model_dir: str, category: str, budget: float, pipe) -> None:
+def _category_child(model_dir: str, category: str, budget: float, pipe, reduction: str = "auto",
+                    max_states: int | None = None) -> None:
     soft, hard = resource.getrlimit(resource.RLIMIT_CPU)
     limit = int(budget) + 1
     resource.setrlimit(resource.RLIMIT_CPU, (limit, hard if hard != resource.RLIM_INFINITY and hard < limit
@@ -86,18 +91,21 @@ def _category_child(model_dir: str, category: str, budget: float, pipe) -> None:
     start = time.process_time()
     net = load_net(Path(model_dir) / "model.pnml")
     properties = load_mcc_properties(Path(model_dir) / f"{category}.xml")
-    results = check_properties(net, properties)
+    results = check_properties(net, properties, reduction=reduction,
+                               **({"max_states": max_states} if max_states else {}))
     pipe.send({"cpu_s": time.process_time() - start,
                "verdicts": {r["id"]: _verdict_text(r["verdict"]) for r in results},
                "methods": {r["id"]: r.get("method") or r.get("reason") for r in results}})
 
 
-def run_category(model_dir: Path, category: str, budget: float, wall: float) -> dict[str, Any]:
+def run_category(model_dir: Path, category: str, budget: float, wall: float, reduction: str = "auto",
+                 max_states: int | None = None) -> dict[str, Any]:
     """Decide one category of one model in a fresh process within ``budget`` CPU s
-    (and ``wall`` seconds)."""
+    (and ``wall`` seconds), with ``check_properties``' ``reduction`` and ``max_states``."""
     context = multiprocessing.get_context("fork")
     receive, send = context.Pipe(duplex=False)
-    child = context.Process(target=_category_child, args=(str(model_dir), category, budget, send))
+    child = context.Process(target=_category_child, args=(str(model_dir), category, budget, send,
+                                                                      reduction, max_states))
     start = time.perf_counter()
     child.start()
     send.close()
@@ -185,6 +193,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--pick", choices=("family", "model"), default="family",
                         help="draw N families (their smallest instance) or N models")
     parser.add_argument("--exclude", default="", help="comma-separated families left out of the sample")
+    parser.add_argument("--reduction", choices=("auto", "stubborn", "none"), default="auto",
+                        help="check_properties' reduction: stubborn sets where the graph is over"
+                        " budget (auto), for every EF/AG and LTL without X (stubborn), never (none)")
+    parser.add_argument("--check-states", type=int, metavar="N",
+                        help="check_properties' max_states (default its own, 2,000,000)")
     args = parser.parse_args(argv)
     if args.sample:
         if args.inputs is None or args.state_space is None:
@@ -196,12 +209,13 @@ def main(argv: list[str] | None = None) -> int:
     categories = args.only.split(",") if args.only else list(CATEGORIES)
     rows = []
     total = {"right": 0, "wrong": 0, "undecided": 0, "no_oracle": 0}
-    print(f"{'model':40} {'category':24} {'right':>5} {'wrong':>5} {'undec':>5} {'CPU s':>7} {'wall s':>7}")
+    print(f"{'model':40} {'category':24} {'right':>5} {'wrong':>5} {'undec':>5} {'CPU s':>7} {'wall s':>7} {'stubborn':>7}")
     for model_dir in sorted(p for p in args.models.iterdir() if (p / "model.pnml").is_file()):
         per_model = {"right": 0, "wrong": 0, "undecided": 0, "no_oracle": 0}
         for category in categories:
             expected = oracle_verdicts(args.oracle, model_dir.name, category)
-            row = run_category(model_dir, category, args.budget, args.wall or 10 * args.budget)
+            row = run_category(model_dir, category, args.budget, args.wall or 10 * args.budget,
+                               args.reduction, args.check_states)
             counts = score(row, expected)
             row.update(model=model_dir.name, category=category, **counts)
             rows.append(row)
@@ -209,9 +223,10 @@ def main(argv: list[str] | None = None) -> int:
                 per_model[key] += counts[key]
             stopped = f"  stopped: {row['stopped']}" if "stopped" in row else ""
             cpu = row.get("cpu_s")
+            reduced = sum("stubborn sets" in (m or "") for m in row.get("methods", {}).values())
             print(f"{model_dir.name:40} {category:24} {counts['right']:5} {counts['wrong']:5}"
                   f" {counts['undecided']:5} {cpu if cpu is not None else float('nan'):7.2f}"
-                  f" {row['wall_s']:7.2f}{stopped}", flush=True)
+                  f" {row['wall_s']:7.2f} {reduced:7}{stopped}", flush=True)
             for formula, verdict, answer in counts["wrong_ids"]:
                 print(f"  WRONG {formula}: {verdict}, the contest says {answer}", flush=True)
         for key in total:

@@ -77,21 +77,23 @@ def _format_marking(marking: Marking) -> str:
 # Commands ----------------------------------------------------------------------------
 
 
-def _load_bound(path: str, import_actions: bool = False) -> tuple[Net, list[str]]:
+def _load_bound(path: str, import_actions: bool = False, config: str | None = None) -> tuple[Net, list[str], Any]:
     """Load a net as a run would: its run configuration found, every action, parameter,
     port and guard bound (``file:line`` errors with close matches, before anything else
     happens). The configuration's action modules (user code) are imported only when
     ``import_actions``; otherwise what they declare is read from their source and checked
     the same way, and the notes returned (also printed to standard error) list what
-    their source cannot tell, each with the reason (docs/security.md)."""
+    their source cannot tell, each with the reason (docs/security.md). ``config``: this
+    run configuration instead of the one the net names. Returns the net, the notes and
+    the run configuration."""
     from pathlib import Path
 
     from petriflow.runtime.session import prepare
 
-    prepared = prepare(path, import_actions=import_actions)
+    prepared = prepare(path, import_actions=import_actions, config=config)
     config = prepared.config
     if not prepared.binding.unchecked:
-        return prepared.net, []
+        return prepared.net, [], config
     modules = [repr(Path(m).name if Path(m).is_absolute() else m) for m in config.unimported_actions()]
     where = config.path or path
     line = config.lines.get("actions") if config.path else prepared.net.lines.get("run")
@@ -103,11 +105,32 @@ def _load_bound(path: str, import_actions: bool = False) -> tuple[Net, list[str]
         notes.append(f"{at}: {item.transition!r}: {item.describe()} ({named}; --import-actions to check)")
     for note in notes:
         print(f"petriflow: note: {note}", file=sys.stderr)
-    return prepared.net, notes
+    return prepared.net, notes, config
+
+
+def _remote(net: Net, config: Any) -> dict[str, Any] | None:
+    """What a run configuration's ``bridge:`` puts on remote agents: ``{transport, connect,
+    agents: {remote agent: {subnets, transitions}}}`` (``None``: no bridge)."""
+    spec = getattr(config, "bridge", None)
+    if spec is None:
+        return None
+    from petriflow.bridge.remote import remote_transitions
+
+    on = remote_transitions(net, spec)
+    agents: dict[str, dict[str, list[str]]] = {}
+    for subnet in net.subnets.values():
+        names = {on[t] for t in net.nodes_of(subnet.id)[1] if t in on}
+        for name in sorted(names):
+            agents.setdefault(name, {"subnets": [], "transitions": []})["subnets"].append(subnet.id)
+    for tid, name in on.items():
+        agents.setdefault(name, {"subnets": [], "transitions": []})["transitions"].append(tid)
+    return {"transport": spec.transport, "connect": spec.connect, "agents": dict(sorted(agents.items()))}
 
 
 def cmd_info(args: argparse.Namespace) -> int:
-    net, notes = _load_bound(args.net, args.import_actions)
+    net, notes, config = _load_bound(args.net, args.import_actions, args.config)
+    remote = _remote(net, config)
+    on = {t: name for name, where in (remote or {"agents": {}})["agents"].items() for t in where["transitions"]}
     info = {
         "net": net.id,
         "label": net.label,
@@ -124,10 +147,12 @@ def cmd_info(args: argparse.Namespace) -> int:
                 "agent": s.agent or s.id,
                 "places": net.nodes_of(s.id)[0],
                 "transitions": net.nodes_of(s.id)[1],
+                "remote_agent": next((on[t] for t in net.nodes_of(s.id)[1] if t in on), None),
             }
             for s in net.subnets.values()
         },
         "actions": net.actions(),
+        "remote": remote,
         "not_checked": notes,
     }
     if args.json:
@@ -145,16 +170,22 @@ def cmd_info(args: argparse.Namespace) -> int:
         print("  subnets:")
         for sid, sub in info["subnets"].items():
             label = f" ({sub['label']})" if sub["label"] else ""
+            where = f", on remote agent {sub['remote_agent']}" if sub["remote_agent"] else ""
             print(f"    {sid}{label}: agent {sub['agent']}, {len(sub['places'])} places,"
-                  f" {len(sub['transitions'])} transitions")
+                  f" {len(sub['transitions'])} transitions{where}")
     if info["actions"]:
         print("  bound actions:")
         for tid, action in info["actions"].items():
             params = net.transitions[tid].params
             shown = f" {json.dumps(params, sort_keys=True)}" if params else ""
-            print(f"    {tid}: {action}{shown}")
+            print(f"    {tid}: {action}{shown}{f' (on {on[tid]})' if tid in on else ''}")
     else:
         print("  bound actions: none")
+    if remote is not None:
+        print(f"  remote agents (bridge: {remote['transport']} {remote['connect']}):")
+        for name, where in remote["agents"].items():
+            print(f"    {name}: subnets {', '.join(where['subnets']) or '-'};"
+                  f" transitions {', '.join(where['transitions']) or '-'}")
     return EXIT_OK
 
 
@@ -475,7 +506,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                           ("--invariant-budget", args.invariant_budget)):
         if value is not None and value < 0:
             raise PetriflowError(f"{option} must be >= 0, got {value}")
-    net, _ = _load_bound(args.net, args.import_actions)
+    net, _, _ = _load_bound(args.net, args.import_actions)
     if args.properties is not None:
         return _check_properties(args, net)
     result = check_net(
@@ -508,7 +539,10 @@ def _check_properties(args: argparse.Namespace, net) -> int:
         if not properties:
             raise PetriflowError(f"{args.net}: the net declares no properties (a 'properties:' list);"
                                  " name a properties file: --properties FILE")
-    results = check_properties(net, properties, max_states=args.max_states or DEFAULT_MAX_STATES)
+    # --method stubborn forces the stubborn-set searches, explicit forbids them
+    reduction = {"stubborn": "stubborn", "explicit": "none"}.get(args.method, "auto")
+    results = check_properties(net, properties, max_states=args.max_states or DEFAULT_MAX_STATES,
+                               reduction=reduction)
     if args.json:
         _print_json({"net": net.id, "properties": results})
     else:
@@ -539,6 +573,9 @@ def build_parser() -> argparse.ArgumentParser:
     info = net_command("info", "Show sizes, subnets and bound actions of a net.", cmd_info)
     info.add_argument("--json", action="store_true", help="print JSON")
     info.add_argument("--import-actions", action="store_true", help=import_help)
+    info.add_argument("--config", metavar="RUN.yaml",
+                      help="run configuration (default: the one the net names, else run.yaml beside it);"
+                           " its bridge: agents are shown as the remote agents of their subnets")
 
     simulate = net_command("simulate", "Play the random token game.", cmd_simulate)
     simulate.add_argument("--steps", type=limits.integer_argument, default=100,
@@ -654,7 +691,8 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--method", choices=("auto", "explicit", "symmetry", "stubborn", "structural"),
                        default="auto", help="how to answer (docs/analysis.md): the full state space"
                        " (explicit), up to permutations of interchangeable agents (symmetry),"
-                       " deadlocks by stubborn sets (stubborn), soundness of free-choice WF-nets"
+                       " deadlocks by stubborn sets (stubborn; with --properties: EF/AG and LTL"
+                       " without X by stubborn sets), soundness of free-choice WF-nets"
                        " by the Rank Theorem (structural); auto (default) picks and reports which")
     check.add_argument("--invariant-budget", type=limits.integer_argument, default=None, metavar="N",
                        help="work budget of each of the P- and T-semiflow computations (0: skip"

@@ -56,7 +56,8 @@ from petriflow.engine import CompiledNet
 from petriflow.marking import Marking
 from petriflow.net import Net
 
-__all__ = ["Relations", "StubbornResult", "reaches_marking", "relations", "stubborn_deadlocks"]
+__all__ = ["Relations", "StubbornResult", "StubbornSets", "reaches_marking", "relations",
+           "stubborn_deadlocks"]
 
 #: Seeds tried per marking by the compiled search (:func:`relations`), and the most
 #: relations its closures may follow in all before the search stops trying (then the
@@ -173,8 +174,11 @@ class StubbornResult:
     deadlocks: list[Marking] | None = None
 
 
-class _Stubborn:
-    """Stubborn sets of one compiled net."""
+class StubbornSets:
+    """Stubborn sets of one compiled net: :meth:`stubborn` is the D1/D2 closure of seed
+    rows in a marking (a tuple indexed like the compiled net's places), its enabled
+    members returned; ``reduced`` is ``False`` for a net with reset arcs (then every
+    enabled row is returned); ``producers[p]`` are the rows that raise place ``p``."""
 
     def __init__(self, compiled: CompiledNet) -> None:
         self.compiled = compiled
@@ -255,7 +259,7 @@ def stubborn_deadlocks(net: Net, start: Mapping[str, int] | None = None, *,
         sequence, not always the shortest).
     """
     compiled = compiled or CompiledNet(net)
-    stub = _Stubborn(compiled)
+    stub = StubbornSets(compiled)
     start_marking = net.initial_marking if start is None else Marking(start)
     m0 = tuple(compiled.vector(start_marking))
     skip = tuple(compiled.vector(ignore)) if ignore is not None else None
@@ -313,7 +317,7 @@ def reaches_marking(net: Net, target: Mapping[str, int], start: Mapping[str, int
         (True, ['take_0', 'take_2'])
     """
     compiled = compiled or CompiledNet(net)
-    stub = _Stubborn(compiled)
+    stub = StubbornSets(compiled)
     m0 = tuple(compiled.vector(net.initial_marking if start is None else Marking(start)))
     goal = tuple(compiled.vector(Marking(target)))
     parents: dict = {m0: None}

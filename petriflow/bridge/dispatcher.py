@@ -10,9 +10,23 @@ is alive and sends again, with the same id, every goal an agent is not known to 
 never runs it twice).
 
 An agent is *lost* when nothing came from it for ``heartbeat_timeout`` seconds; it is
-back when it announces itself again. :meth:`Dispatcher.watch` says which agents were
-lost or came back since it was last asked, so the run changes its own state only in
-its own thread.
+back when it announces itself again. A cancel not acknowledged within
+``cancel_timeout`` seconds gives its goal up (:attr:`Phase.ABANDONED`: what the action
+did is unknown) and holds its agent lost while the agent's heartbeats still list that
+goal (it may still be doing it). :meth:`Dispatcher.watch` says which agents were lost
+or came back since it was last asked, so the run changes its own state only in its
+own thread.
+
+**Memory stays flat**: the run says when it is done with a goal (:meth:`Dispatcher.done`,
+once its firing ended: the result taken, the ``end`` event recorded), and the goal's
+state is dropped. What de-duplication needs is kept: the ids of the last
+:data:`KEPT_ENDED` goals each agent ended, each with whether a second answer is
+expected (the goal or its cancel was sent again). A message about an id in that record
+is dropped (counted as ``replayed`` unless expected); an older one is dropped as
+``unknown_goal``. Either way it is never recorded: answers for a goal come within a few
+heartbeats of its end (every re-send is paced by heartbeats), so the last thousand
+ended ids of an agent cover every duplicate a working agent or broker sends, and only
+a replay from far back lands under the other reason.
 """
 
 from __future__ import annotations
@@ -38,6 +52,10 @@ log = logging.getLogger("petriflow.bridge")
 LOGGED_DROPS = 5
 #: Replies kept per goal to answer a call sent again (the latest ones).
 KEPT_REPLIES = 64
+#: Ended goal ids kept per agent after the run is done with them (for de-duplication).
+KEPT_ENDED = 1024
+#: Feedback messages of one goal kept until the run records them (the latest ones).
+KEPT_FEEDBACK = 64
 
 
 class Phase:
@@ -49,7 +67,9 @@ class Phase:
     OK = "ok"
     FAILED = "failed"
     CANCELLED = "cancelled"
-    ENDED = (REJECTED, OK, FAILED, CANCELLED)
+    #: The run gave the goal up: its cancel was not acknowledged within ``cancel_timeout``.
+    ABANDONED = "abandoned"
+    ENDED = (REJECTED, OK, FAILED, CANCELLED, ABANDONED)
 
 
 @dataclass
@@ -64,10 +84,15 @@ class GoalState:
         resent: how many times it was sent again.
         data: the result's output token data.
         reason: why it failed or was rejected.
-        cancel_sent: wall-clock time a cancel was sent (``None``: none).
+        cancel_sent: wall-clock time a cancel was sent last (``None``: none).
+        cancel_asked: wall-clock time the first cancel was sent (its deadline counts
+            from it: ``cancel_timeout``).
         cancels_resent: how many times the cancel was sent again (not acknowledged yet:
             an agent computing answers each when its action's call returns).
         feedback: the last feedback's data.
+        feedbacks: the feedback data received and not yet taken by the run
+            (:meth:`Dispatcher.take_feedback`), oldest first, the latest
+            :data:`KEPT_FEEDBACK`; ``skipped``: how many older ones were left out.
     """
 
     goal: protocol.Goal
@@ -79,8 +104,11 @@ class GoalState:
     data: Any = None
     reason: str = ""
     cancel_sent: float | None = None
+    cancel_asked: float | None = None
     cancels_resent: int = 0
     feedback: Any = None
+    feedbacks: list[Any] = field(default_factory=list)
+    skipped: int = 0
     #: Calls of the goal's action waiting for the kernel to answer them (:mod:`~.calls`).
     calls: list[protocol.Call] = field(default_factory=list)
     #: The replies sent, by call number (a call sent again is answered the same).
@@ -131,12 +159,20 @@ class Dispatcher:
         self.now = now
         self.names = set(spec.agents.values())
         self.agents: dict[str, AgentSeen] = {name: AgentSeen(name) for name in self.names}
+        #: The goals the run is not done with (:meth:`done`), by id.
         self.goals: dict[str, GoalState] = {}
+        #: Per agent, the ids of the goals the run was done with (the latest
+        #: :data:`KEPT_ENDED`), each with whether a second answer is expected and its phase.
+        self.ended: dict[str, dict[str, tuple[bool, str]]] = {name: {} for name in self.names}
         self.dropped: Counter[str] = Counter()
         self._lock = threading.Lock()
         self._announced = threading.Condition(self._lock)
         self._ended = threading.Condition(self._lock)
         self._lost: set[str] = set()
+        self._why: dict[str, str] = {}  # lost agent -> why
+        self._held: dict[str, set[str]] = {}  # agent -> the goals given up that it may still be doing
+        self._feedback: set[str] = set()  # goals with feedback the run has not taken
+        self._taken_late: list[tuple[protocol.Goal, list[Any], int]] = []  # ... of goals done meanwhile
         self._stop = threading.Event()
         self.transport = transport or open_transport(spec.transport, spec.endpoint(), "orchestrator")
         self.transport.subscribe(from_agent("*"), self.receive)
@@ -184,6 +220,10 @@ class Dispatcher:
                 seen.running = set(message.running)
                 return
             state = self.goals.get(message.id)
+            ended = self.ended[sender].get(message.id)
+        if state is None and ended is not None:
+            self._after_end(sender, message, *ended)
+            return
         if state is None:
             self.drop(Drop.UNKNOWN_GOAL, f"{message.kind.value} from {sender!r} for goal {message.id[:80]!r},"
                                          " which this run never sent")
@@ -196,6 +236,22 @@ class Dispatcher:
             self._called(state, message)
             return
         self._apply(state, message, now)
+
+    def _after_end(self, sender: str, message: protocol.BridgeMessage, expected: bool, phase: str) -> None:
+        """A message about a goal the run was done with (forgotten but for its id): a
+        call is refused, an expected second answer dropped, anything else dropped and
+        counted as a replay; nothing is recorded."""
+        if isinstance(message, protocol.Call):
+            why = check_call(message)
+            if why:
+                self.drop(Drop.UNKNOWN_CALL, f"from {sender!r} for goal {message.id[:80]!r}: {why}")
+            else:
+                self.transport.publish(to_agent(sender), protocol.encode(protocol.Reply(
+                    message.id, sender, message.call, None,
+                    f"the goal ended ({phase}): the run answers no more calls for it")))
+            return
+        if not (expected or isinstance(message, (protocol.Accepted, protocol.Feedback))):
+            self.drop(Drop.REPLAYED, f"{message.kind.value} for goal {message.id[:80]!r}, which had ended")
 
     def _called(self, state: GoalState, call: protocol.Call) -> None:
         """A call of a goal's action: kept for the kernel to answer (:meth:`take_calls`),
@@ -245,6 +301,7 @@ class Dispatcher:
             if state.goal.agent == seen.name and not state.ended:
                 state.phase, state.answered = Phase.FAILED, now
                 state.reason = "the agent restarted while the goal ran (its outcome is unknown)"
+        self._held.pop(seen.name, None)  # what the old process held died with it
         self._ended.notify_all()
 
     def _apply(self, state: GoalState, message: protocol.BridgeMessage, now: float) -> None:
@@ -257,6 +314,11 @@ class Dispatcher:
                     state.phase = Phase.ACCEPTED
                 elif isinstance(message, protocol.Feedback):
                     state.feedback = message.data
+                    state.feedbacks.append(message.data)
+                    if len(state.feedbacks) > KEPT_FEEDBACK:
+                        del state.feedbacks[0]
+                        state.skipped += 1
+                    self._feedback.add(state.goal.id)
                 elif isinstance(message, protocol.Rejected):
                     state.phase, state.reason, state.answered = Phase.REJECTED, message.reason, now
                 elif isinstance(message, protocol.Result):
@@ -268,7 +330,7 @@ class Dispatcher:
                     self._ended.notify_all()
         # an answer to a goal or a cancel sent again is expected twice; otherwise an ended goal's
         # answer is a replay
-        expected = state.resent or state.cancels_resent or \
+        expected = (state.resent or state.cancels_resent) and state.phase != Phase.ABANDONED or \
             isinstance(message, (protocol.Accepted, protocol.Feedback))
         if replayed and not expected:
             self.drop(Drop.REPLAYED, f"{message.kind.value} for goal {state.goal.id!r}, which had ended")
@@ -326,17 +388,55 @@ class Dispatcher:
             if state is None or state.ended:
                 return
             state.cancel_sent = self.now()
+            if state.cancel_asked is None:
+                state.cancel_asked = state.cancel_sent
             goal = state.goal
         self.transport.publish(to_agent(goal.agent), protocol.encode(protocol.Cancel(goal.id, goal.agent)))
 
     def forget(self, goal_id: str) -> None:
-        """The run is done with this goal (it ended, was cancelled, or its agent lost);
-        its calls waiting for an answer are refused."""
+        """The run gave this goal up (its agent lost): its calls waiting for an answer
+        are refused, and the run is done with it (:meth:`done`); any answer that comes
+        later is dropped and counted."""
         with self._lock:
             state = self.goals.get(goal_id)
             if state is not None and not state.ended:
                 state.phase = Phase.CANCELLED
+                state.resent = state.cancels_resent = 0  # nothing more is expected from it
         self.refuse_calls(goal_id, "the run gave up the goal (cancelled, or its agent lost)")
+        self.done(goal_id)
+
+    def done(self, goal_id: str) -> None:
+        """The run is done with this goal (its firing ended): its state is dropped, its
+        id kept in its agent's record of ended goals (the last :data:`KEPT_ENDED`) for
+        de-duplication. A goal not ended yet is left as it is."""
+        with self._lock:
+            state = self.goals.get(goal_id)
+            if state is None or not state.ended:
+                return
+            del self.goals[goal_id]
+            if goal_id in self._feedback:  # came with its end: still to be recorded
+                self._feedback.discard(goal_id)
+                self._taken_late.append((state.goal, state.feedbacks, state.skipped))
+            record = self.ended.setdefault(state.goal.agent, {})
+            record[goal_id] = (bool(state.resent or state.cancels_resent) and state.phase != Phase.ABANDONED,
+                               state.phase)
+            if len(record) > KEPT_ENDED:
+                del record[next(iter(record))]
+
+    def take_feedback(self) -> list[tuple[protocol.Goal, list[Any], int]]:
+        """``(goal, [feedback data, ...], skipped)`` of each goal with feedback the run
+        has not taken yet, in goal id order (the run's thread records them)."""
+        with self._lock:
+            if not (self._feedback or self._taken_late):
+                return []
+            out, self._taken_late = self._taken_late, []
+            for goal_id in sorted(self._feedback):
+                state = self.goals.get(goal_id)
+                if state is not None and state.feedbacks:
+                    out.append((state.goal, state.feedbacks, state.skipped))
+                    state.feedbacks, state.skipped = [], 0
+            self._feedback.clear()
+            return out
 
     def refuse_calls(self, goal_id: str, why: str) -> None:
         """Refuse the goal's calls waiting for an answer, with ``why``."""
@@ -348,27 +448,62 @@ class Dispatcher:
         return agent in self._lost
 
     def watch(self) -> tuple[list[str], list[str]]:
-        """``(lost, back)``: the agents lost and those back since the last call (an agent
-        is lost when silent for ``heartbeat_timeout``, back when it announced itself
-        since)."""
+        """``(lost, back)``: the agents lost and those back since the last call. An agent
+        is lost when silent for ``heartbeat_timeout``, or when a cancel sent to it went
+        unacknowledged for ``cancel_timeout`` (the goal is given up: :attr:`Phase.ABANDONED`);
+        it is back when it announced itself since and its heartbeats no longer list a
+        goal given up. :meth:`why_lost` says why."""
         now, timeout = self.now(), self.spec.heartbeat_timeout
         lost, back = [], []
         with self._lock:
+            self._give_up(now)
             for name, seen in sorted(self.agents.items()):
+                held = self._held.get(name)
+                if held is not None:
+                    held &= seen.running  # goals given up that it still does
+                    if not held:
+                        del self._held[name]
                 silent = not seen.announced or now - seen.last > timeout
-                if silent and name not in self._lost and seen.announced:
+                if (silent or held) and name not in self._lost and (seen.announced or held):
                     self._lost.add(name)
                     seen.announced = False  # back only when it announces itself again
                     lost.append(name)
-                elif not silent and name in self._lost:
+                    if not held:
+                        self._why[name] = f"no message for {now - seen.last:.1f} s (heartbeat_timeout {timeout:g} s)"
+                elif not silent and not held and name in self._lost:
                     self._lost.discard(name)
+                    self._why.pop(name, None)
                     back.append(name)
         return lost, back
+
+    def _give_up(self, now: float) -> None:
+        """Give up each goal whose cancel went unacknowledged for ``cancel_timeout``; its
+        agent is held lost while it lists the goal. Holds the lock."""
+        limit = self.spec.cancel_timeout
+        for state in self.goals.values():
+            if state.cancel_asked is None or state.ended or now - state.cancel_asked <= limit:
+                continue
+            agent = state.goal.agent
+            state.phase, state.answered = Phase.ABANDONED, now
+            state.reason = (f"the cancel of goal {state.goal.id} was not acknowledged within {limit:g} s"
+                            " (what the action did is unknown)")
+            self._held.setdefault(agent, set()).add(state.goal.id)
+            self.agents[agent].running.add(state.goal.id)  # held until a heartbeat says otherwise
+            if agent not in self._lost:
+                self._why[agent] = f"it did not acknowledge the cancel of {state.goal.transition or state.goal.id!r}" \
+                                   f" within {limit:g} s (cancel_timeout)"
+            self._ended.notify_all()
+
+    def why_lost(self, agent: str) -> str:
+        """Why ``agent`` is lost (as :meth:`watch` found)."""
+        with self._lock:
+            return self._why.get(agent) or "no message (heartbeat_timeout)"
 
     def mark_lost(self, agent: str) -> None:
         """Hold ``agent`` lost (the run had lost it before a resume) until it announces itself."""
         with self._lock:
             self._lost.add(agent)
+            self._why[agent] = "lost before the run was resumed"
             self.agents[agent].announced = False
 
     def silence(self, agent: str) -> float:

@@ -23,13 +23,19 @@ from petriflow.bridge import protocol
 from petriflow.bridge.calls import answer
 from petriflow.bridge.dispatcher import Dispatcher, Phase
 from petriflow.bridge.spec import BridgeSpec
-from petriflow.errors import NetFormatError, did_you_mean
+from petriflow.errors import NetFormatError, PetriflowError, did_you_mean
 from petriflow.net import Net
 from petriflow.runtime.action import Action, ActionContext, Param, Port, Status
 from petriflow.runtime.binding import Binding, BoundTransition
 from petriflow.runtime.registry import Registry, UnknownActionError
 
-__all__ = ["RemoteAction", "bind_remote", "check_announced", "remote_transitions", "firing_number"]
+__all__ = ["RemoteAction", "RemoteCancelFailed", "bind_remote", "check_announced", "remote_transitions",
+           "firing_number"]
+
+
+class RemoteCancelFailed(PetriflowError):
+    """A remote goal's cancel was not acknowledged within ``cancel_timeout``: the run
+    gave it up, and its firing ends ``failed`` (what the action did is unknown)."""
 
 
 def firing_number(ctx: ActionContext) -> int:
@@ -80,6 +86,7 @@ class RemoteAction(Action):
             return self._replayed(ctx, state)
         if state is not None and state.ended:
             self._record(ctx, state)
+            dispatcher.done(self.goal_id)
             if state.phase == Phase.OK:
                 ctx.result = state.data
                 return Status.OK
@@ -107,6 +114,9 @@ class RemoteAction(Action):
         state = dispatcher.goal(self.goal_id)
         if state is not None and state.ended:
             self._record(ctx, state)
+            dispatcher.done(self.goal_id)
+            if state.phase == Phase.ABANDONED:  # the kernel's path for a cancel that failed: `failed`
+                raise RemoteCancelFailed(f"{self.remote_agent}: {state.reason}")
             return True
         return False
 
@@ -134,8 +144,7 @@ class RemoteAction(Action):
         return Status.FAILED
 
     def _lost_reason(self, dispatcher: Dispatcher) -> str:
-        return (f"agent {self.remote_agent!r} lost: no message for {dispatcher.silence(self.remote_agent):.1f} s"
-                f" (heartbeat_timeout {dispatcher.spec.heartbeat_timeout:g} s)")
+        return f"agent {self.remote_agent!r} lost: {dispatcher.why_lost(self.remote_agent)}"
 
     def _record(self, ctx: ActionContext, state: Any) -> None:
         """Which agent executed the firing, and the goal's round trip (a custom event)."""

@@ -5,7 +5,8 @@ the journal. A bridged run ran in wall-clock time, so its remote firings cannot 
 executed again to the same times; instead, until the journal's last event, they are
 *replayed* from it (:class:`Replay`): each remote firing the journal shows ended ends
 at its journaled time with its journaled outcome, data and reason (no goal is sent),
-and each remote agent lost or back comes at its journaled time; the clock runs as fast
+and each remote agent lost or back, and each agent's ``feedback``, comes at its journaled
+time, in its journaled order; the clock runs as fast
 as it can meanwhile (:class:`ResumeClock`). A firing the journal shows started and not
 ended was still running on its agent when the orchestrator died: its goal is sent again
 with the same id (the run's name is journaled), and the agent, which de-duplicates by
@@ -43,6 +44,8 @@ class Replay:
         self.ends: dict[int, Event] = {}
         self.records: dict[int, dict[str, Any]] = {}
         self.faults: list[tuple[float, str, str, str]] = []  # (time, lost|back, agent, why)
+        #: The journal's faults (as :attr:`faults`) and ``feedback`` events, in its order.
+        self.outside: list[tuple[float, str, str, str] | Event] = []
         for event in events:
             firing = event.data.get("firing")
             if event.kind == "end" and event.transition in remote:
@@ -51,6 +54,9 @@ class Replay:
                 self.records[firing] = event.data.get("data") or {}
             elif event.kind == "fault" and event.data.get("fault") in ("lost", "back"):
                 self.faults.append((event.time, event.data["fault"], event.agent, event.data.get("why", "")))
+                self.outside.append(self.faults[-1])
+            elif event.kind == "feedback":
+                self.outside.append(event)
 
     def state(self, goal: protocol.Goal, firing: int) -> GoalState | None:
         """The journaled ending of ``goal`` (firing ``firing``), to be taken at its time."""
@@ -100,6 +106,10 @@ class ReplayingRemote:
         if goal_id not in self.replayed:
             self.dispatcher.forget(goal_id)
 
+    def done(self, goal_id: str) -> None:
+        if self.replayed.pop(goal_id, None) is None:
+            self.dispatcher.done(goal_id)
+
     def take_calls(self, goal_id: str) -> list[protocol.Call]:
         return [] if goal_id in self.replayed else self.dispatcher.take_calls(goal_id)
 
@@ -115,6 +125,9 @@ class ReplayingRemote:
 
     def silence(self, agent: str) -> float:
         return self.dispatcher.silence(agent)
+
+    def why_lost(self, agent: str) -> str:
+        return self.dispatcher.why_lost(agent)
 
 
 class ResumeClock:
@@ -152,15 +165,19 @@ class ReplayWatch:
         self.live = live
         self.runs = runs
         self.owner = {agent: name for name, agents in runs.items() for agent in agents}
-        self.faults = list(remote.replay.faults)
+        self.faults = list(remote.replay.outside)
         self.listening: set[int] = set()
 
     def __call__(self, scheduler: Any) -> None:
         remote, now = self.remote, scheduler.now
         if remote.replaying:
             self._listen(scheduler)
-            while self.faults and self.faults[0][0] <= now + 1e-9:
-                _, kind, agent, why = self.faults.pop(0)
+            while self.faults and _time(self.faults[0]) <= now + 1e-9:
+                head = self.faults.pop(0)
+                if isinstance(head, Event):  # an agent's feedback, as journaled
+                    scheduler.emit(head.kind, head.transition, head.agent, **head.data)
+                    continue
+                _, kind, agent, why = head
                 name = self.owner.get(agent, agent)
                 if kind == "lost":
                     remote.lost.add(name)
@@ -184,10 +201,15 @@ class ReplayWatch:
         """An instant at the next journaled loss or return, and at the journal's end (the
         original run had one there)."""
         kernel = scheduler.kernel
-        times = [self.faults[0][0]] if self.faults else []
+        times = [_time(self.faults[0])] if self.faults else []
         times.append(self.remote.replay.until)
         for at in times:
             tick = kernel.ticks_at(at)
             if tick > kernel.tick and tick not in self.listening:
                 self.listening.add(tick)
                 kernel.schedule(tick, Listen())
+
+
+def _time(entry: Any) -> float:
+    """A journaled fault's or feedback event's time."""
+    return entry.time if isinstance(entry, Event) else entry[0]

@@ -8,6 +8,7 @@
       agents: {red: red, blue: blue}   # subnet (its agent) -> the remote agent's name
       heartbeat: 0.5                # seconds between heartbeats, both ways
       heartbeat_timeout: 3          # an agent silent this long is lost
+      cancel_timeout: 3             # a cancel not acknowledged this long gives the goal up (default: heartbeat_timeout)
       wait: 10                      # seconds to wait for the agents to announce themselves
       rejoin: 30                    # seconds a run with nothing else to do waits for a lost agent
       user: robot                   # authenticate as (optional)
@@ -17,8 +18,8 @@ Subnets not listed run in the run's own process, as without a bridge.
 
 Examples:
     >>> spec = BridgeSpec.from_dict({"transport": "mqtt", "connect": "127.0.0.1:1883", "agents": {"red": "r1"}})
-    >>> spec.agents, spec.heartbeat_timeout
-    ({'red': 'r1'}, 3.0)
+    >>> spec.agents, spec.heartbeat_timeout, spec.cancel_timeout
+    ({'red': 'r1'}, 3.0, 3.0)
     >>> BridgeSpec.from_dict({"transport": "tcp", "agents": {}})
     Traceback (most recent call last):
     ...
@@ -37,8 +38,8 @@ from petriflow.errors import NetFormatError, did_you_mean
 
 __all__ = ["BridgeSpec", "DEFAULT_CONNECT"]
 
-_KEYS = ("transport", "connect", "agents", "heartbeat", "heartbeat_timeout", "wait", "rejoin", "user",
-         "password_env")
+_KEYS = ("transport", "connect", "agents", "heartbeat", "heartbeat_timeout", "cancel_timeout", "wait", "rejoin",
+         "user", "password_env")
 #: Where each transport connects by default: loopback.
 DEFAULT_CONNECT = {"zenoh": "tcp/127.0.0.1:7447", "mqtt": "tcp/127.0.0.1:1883"}
 
@@ -53,6 +54,9 @@ class BridgeSpec:
         agents: ``{subnet: remote agent name}``.
         heartbeat: seconds between heartbeats.
         heartbeat_timeout: seconds of silence after which an agent is lost.
+        cancel_timeout: seconds a cancel may go unacknowledged: then the run gives the
+            goal up (its firing ends ``failed``: what the action did is unknown) and
+            holds the agent lost while its heartbeats still list the goal.
         wait: seconds to wait for the agents to announce themselves before binding.
         rejoin: seconds a run waits for a lost agent to come back (when nothing else is
             to happen; afterwards it may end ``dead``).
@@ -69,6 +73,7 @@ class BridgeSpec:
     rejoin: float = 30.0
     user: str | None = None
     password_env: str | None = None
+    cancel_timeout: float = 3.0
 
     @classmethod
     def from_dict(cls, data: Any, fail: Callable[..., Any] | None = None) -> "BridgeSpec":
@@ -99,7 +104,9 @@ class BridgeSpec:
                 refuse(f"agents: {subnet!r}: an agent name is letters, digits, '_', '.', '-' (at most 64),"
                        f" got {name!r}")
         times = {}
-        for key, default in (("heartbeat", 0.5), ("heartbeat_timeout", 3.0), ("wait", 10.0), ("rejoin", 30.0)):
+        given = data.get("heartbeat_timeout", 3.0)
+        for key, default in (("heartbeat", 0.5), ("heartbeat_timeout", 3.0), ("wait", 10.0), ("rejoin", 30.0),
+                             ("cancel_timeout", given)):
             value = data.get(key, default)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
                     or not 0 < value <= 3600:
@@ -113,7 +120,8 @@ class BridgeSpec:
             if value is not None and not isinstance(value, str):
                 refuse(f"{key} must be a string, got {value!r}")
         return cls(transport, connect.strip(), {str(k): v for k, v in agents.items()}, times["heartbeat"],
-                   times["heartbeat_timeout"], times["wait"], times["rejoin"], user, password_env)
+                   times["heartbeat_timeout"], times["wait"], times["rejoin"], user, password_env,
+                   times["cancel_timeout"])
 
     def endpoint(self) -> Endpoint:
         """Where to connect, with the credentials (the password read from
@@ -125,7 +133,7 @@ class BridgeSpec:
         """Plain data (what the journal keeps; the password is never in it)."""
         data: dict[str, Any] = {"transport": self.transport, "connect": self.connect, "agents": dict(self.agents),
                                 "heartbeat": self.heartbeat, "heartbeat_timeout": self.heartbeat_timeout,
-                                "wait": self.wait, "rejoin": self.rejoin}
+                                "cancel_timeout": self.cancel_timeout, "wait": self.wait, "rejoin": self.rejoin}
         if self.user is not None:
             data["user"] = self.user
         if self.password_env is not None:

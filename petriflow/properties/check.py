@@ -5,7 +5,10 @@ and decides every property on it:
 
 * **reachability** (``EF p``, ``AG p``, a state predicate alone): the states are
   numbered breadth first, so the first state satisfying ``p`` (or violating it) gives
-  a shortest firing sequence as witness (counterexample);
+  a shortest firing sequence as witness (counterexample); when the graph is over
+  budget or the net unbounded, ``EF p``/``AG p`` by a stubborn-set search from the net
+  (:mod:`~petriflow.properties.partial_order`, at most :data:`ON_THE_FLY_STATES`
+  markings per formula);
 * **bound** (the places' token total): P-semiflows first
   (:func:`~petriflow.properties.bounds.invariant_bound`), the explored markings second;
   the witness reaches a marking with the bound; with ``at_most`` the verdict is whether
@@ -14,7 +17,8 @@ and decides every property on it:
 * **ltl**: Spot's Büchi automaton times the graph, searched on the fly
   (:mod:`~petriflow.properties.ltl`); when the graph is over budget or the net
   unbounded, times markings generated from the net as the search goes (at most
-  :data:`ON_THE_FLY_STATES` of them per formula);
+  :data:`ON_THE_FLY_STATES` of them per formula), reduced by stubborn sets when the
+  formula has no ``X``;
 * **boolean** (``A G F p && A F q``): each quantified operand by its own checker, the
   verdicts combined (no evidence: each operand's is its own property's).
 
@@ -59,20 +63,35 @@ from petriflow.properties.language import (
     AllPaths, And, Deadlock, ExistsPath, Finally, Fireable, Globally, Not, Or, Property
 )
 from petriflow.properties.ltl import check_ltl, check_ltl_on_net
+from petriflow.properties.partial_order import has_next, reach_stubborn
 from petriflow.properties.yaml_props import check_property_names
 from petriflow.workflow import workflow_structure
 
-__all__ = ["check_properties"]
+__all__ = ["LTL_STUBBORN_OVER_BUDGET", "REDUCTIONS", "check_properties"]
+
+#: The ``reduction`` choices of :func:`check_properties`.
+REDUCTIONS = ("auto", "stubborn", "none")
+
+#: Whether ``auto`` reduces the LTL search from the net (graph over budget) by stubborn
+#: sets when the formula has no ``X`` (chosen by measurement: docs/benchmarks.md).
+LTL_STUBBORN_OVER_BUDGET = True
 
 
 def check_properties(net: Net, properties: Sequence[Property], *,
-                     max_states: int = DEFAULT_MAX_STATES) -> list[dict[str, Any]]:
+                     max_states: int = DEFAULT_MAX_STATES, reduction: str = "auto") -> list[dict[str, Any]]:
     """Decide every property of ``net`` (see the module documentation for the entries).
+
+    ``reduction`` (one of :data:`REDUCTIONS`): ``auto`` uses stubborn sets where the
+    reachability graph is over budget; ``stubborn`` decides every ``EF p``/``AG p`` and
+    every LTL formula without ``X`` by stubborn sets, graph or no graph; ``none`` never
+    uses them (:mod:`~petriflow.properties.partial_order`).
 
     Raises:
         NetFormatError: a property names a place or transition the net lacks (its file
             and line).
     """
+    if reduction not in REDUCTIONS:
+        raise ValueError(f"unknown reduction {reduction!r}: one of {', '.join(REDUCTIONS)}")
     check_property_names(net, properties)
     start = explored_marking(net, workflow_structure(net))
     space: StateSpace | None = None
@@ -96,7 +115,11 @@ def check_properties(net: Net, properties: Sequence[Property], *,
         entry: dict[str, Any] = {"id": prop.id, "kind": prop.kind,
                                  "formula": _describe(prop), "verdict": None, "method": None,
                                  "witness": None}
-        if prop.formula is None:
+        if reduction == "stubborn" and prop.kind in ("reachability", "ltl"):
+            _by_stubborn_sets(entry, prop, net, start, max_states)
+        if entry["verdict"] is not None:
+            pass
+        elif prop.formula is None:
             if semiflows is None:
                 try:
                     semiflows = p_semiflows(net)
@@ -109,13 +132,16 @@ def check_properties(net: Net, properties: Sequence[Property], *,
         elif kripke is None:
             if prop.kind == "reachability" and partial is not None:
                 _partial_reachability(entry, prop, partial)
-            if entry["verdict"] is None and prop.kind == "reachability":
+            if entry["verdict"] is None and prop.kind == "reachability" and reduction == "auto":
                 _deadlock_by_stubborn_sets(entry, prop, net, start, max_states)
+                if entry["verdict"] is None:
+                    _by_stubborn_sets(entry, prop, net, start, min(max_states, ON_THE_FLY_STATES))
             if entry["verdict"] is None and prop.kind == "reachability" and space is None \
                     and reason is not None and reason.startswith("state space over budget"):
                 _by_symmetry(entry, prop, net, start, max_states, quotient)
             if prop.kind == "ltl":
-                _ltl_on_the_fly(entry, prop, net, start, min(max_states, ON_THE_FLY_STATES))
+                _ltl_on_the_fly(entry, prop, net, start, min(max_states, ON_THE_FLY_STATES),
+                                reduction == "auto" and LTL_STUBBORN_OVER_BUDGET)
         elif prop.kind == "boolean":
             verdict = _boolean(prop.formula, kripke, cache)
             entry.update(verdict=verdict, method="Boolean combination: each quantified formula decided"
@@ -242,16 +268,44 @@ def _deadlock_by_stubborn_sets(entry: dict, prop: Property, net: Net, start, max
                  method="stubborn sets (every reachable deadlock preserved)")
 
 
-def _ltl_on_the_fly(entry: dict, prop: Property, net: Net, start, max_states: int) -> None:
+def _ltl_on_the_fly(entry: dict, prop: Property, net: Net, start, max_states: int,
+                    stubborn: bool = False) -> None:
     """LTL beyond the reachability graph: the product searched from the net, markings
-    generated only as far as the search goes (at most ``max_states`` of them)."""
+    generated only as far as the search goes (at most ``max_states`` of them); with
+    ``stubborn`` and no ``X``, reduced by stubborn sets."""
+    stats: dict = {}
     try:
-        verdict, lasso = check_ltl_on_net(net, start, prop.formula, max_states=max_states)
+        verdict, lasso = check_ltl_on_net(net, start, prop.formula, max_states=max_states,
+                                          stubborn=stubborn, stats=stats)
     except StateSpaceLimit:
         return
-    entry.update(verdict=verdict, method="LTL: Spot Büchi automaton x markings generated on the fly")
+    method = "LTL: Spot Büchi automaton x markings generated on the fly"
+    if stats.get("reduced"):
+        method += f", stubborn sets (visibility, stack proviso; {stats['markings']} markings)"
+    entry.update(verdict=verdict, method=method)
     if lasso is not None:
         entry.update(lasso)
+
+
+def _by_stubborn_sets(entry: dict, prop: Property, net: Net, start, max_states: int) -> None:
+    """``EF p`` / ``AG p`` by the up-set search, LTL without ``X`` by the reduced product
+    (:mod:`~petriflow.properties.partial_order`); nothing for other shapes."""
+    if prop.kind == "ltl":
+        if not has_next(prop.formula):
+            _ltl_on_the_fly(entry, prop, net, start, max_states, stubborn=True)
+        return
+    universal, predicate = _reachability_shape(prop.formula)
+    if universal is None:
+        return
+    try:
+        found = reach_stubborn(net, start, Not(predicate) if universal else predicate,
+                               max_states=max_states)
+    except StateSpaceLimit:
+        return
+    entry.update(verdict=found.found != bool(universal), witness=found.witness,
+                 method=f"stubborn sets (up-set of the predicate; {found.states} markings)"
+                 if found.reduced else f"on-the-fly search ({found.states} markings; reset arcs:"
+                 " no reduction)")
 
 
 def _by_symmetry(entry: dict, prop: Property, net: Net, start, max_states: int, quotient: dict) -> None:

@@ -43,6 +43,7 @@ from petriflow.marking import Marking
 from petriflow.net import Net
 from petriflow.properties.kripke import Kripke
 from petriflow.properties.monitor import compile_predicate
+from petriflow.properties.partial_order import PropertyStubbornSets, has_next
 from petriflow.properties.language import (
     AllPaths, And, Constant, ExistsPath, Finally, Formula, Globally, Next, Not, Or, Until, atoms
 )
@@ -212,8 +213,8 @@ def _lasso(kripke: Kripke, offsets, neighbours, source, target, graph_edge, labe
             "cycle": kripke.names(graph_edge[cycle].tolist())}
 
 
-def check_ltl_on_net(net: Net, start: Marking, formula: Formula, *, max_states: int
-                     ) -> tuple[bool, dict | None]:
+def check_ltl_on_net(net: Net, start: Marking, formula: Formula, *, max_states: int,
+                     stubborn: bool = False, stats: dict | None = None) -> tuple[bool, dict | None]:
     """:func:`check_ltl` without the reachability graph: the markings are generated from
     the net only as the product's search reaches them.
 
@@ -223,6 +224,13 @@ def check_ltl_on_net(net: Net, start: Marking, formula: Formula, *, max_states: 
     when the reachability graph is over budget or the net unbounded; with the graph
     built, :func:`check_ltl` is faster (compiled, and the graph is shared by all the
     formulas).
+
+    With ``stubborn`` and a formula without ``X``, each marking is reduced to a stubborn
+    set under the visibility condition and the stack proviso
+    (:mod:`~petriflow.properties.partial_order`): the same verdicts, fewer markings;
+    a formula with ``X`` is searched in full. ``stats``, when given, receives
+    ``markings`` (how many the search stored) and ``reduced`` (whether the reduction
+    was applied).
 
     Raises:
         StateSpaceLimit: the search stored more than ``max_states`` markings before
@@ -239,7 +247,13 @@ def check_ltl_on_net(net: Net, start: Marking, formula: Formula, *, max_states: 
     """
     exists = isinstance(formula, ExistsPath)
     body = formula.operand if isinstance(formula, (AllPaths, ExistsPath)) else formula
-    found = _NetProduct(net, start, body if exists else Not(body), max_states).lasso()
+    path = body if exists else Not(body)
+    product = _NetProduct(net, start, path, max_states, stubborn and not has_next(path))
+    try:
+        found = product.lasso()
+    finally:
+        if stats is not None:
+            stats.update(markings=len(product.vectors), reduced=product.reduction is not None)
     if exists:
         return found is not None, found
     return found is None, found
@@ -249,10 +263,17 @@ class _NetProduct:
     """The product of the net's markings and the Büchi automaton of ``path``, explored
     lazily (states ``(marking id, q)``; a deadlock stutters, as in the Kripke structure)."""
 
-    def __init__(self, net: Net, start: Marking, path: Formula, max_states: int) -> None:
+    def __init__(self, net: Net, start: Marking, path: Formula, max_states: int,
+                 stubborn: bool = False) -> None:
         spot = _spot()
         self.compiled = CompiledNet(net)
         names = {atom: f"p{k}" for k, atom in enumerate(atoms(path))}
+        # stubborn sets (visibility, stack proviso) for a formula without X
+        self.reduction = PropertyStubbornSets(net, self.compiled) if stubborn else None
+        if self.reduction is not None and not self.reduction.reduced:
+            self.reduction = None
+        self.visible = self.reduction.visible(list(names)) if self.reduction is not None else None
+        self.reduced: dict[int, list[tuple[str | None, int]] | None] = {}
         automaton = spot.translate(to_spot(path, names), "Buchi", "SBAcc")
         index = self.compiled.place_index
         self.atoms = [compile_predicate(net, atom, index) for atom in names]
@@ -296,20 +317,56 @@ class _NetProduct:
             self.moves[m] = moves = moves or [(None, m)]
         return moves
 
-    def successors(self, state: tuple[int, int]):
-        """``(successor, accepting, row id)`` of a product state ``(marking, q)``."""
+    def _reduced_moves(self, m: int) -> list[tuple[str | None, int]] | None:
+        """The firings of a stubborn set of marking ``m`` (C0-C2), or ``None``: all of them."""
+        if m not in self.reduced:
+            compiled, vector = self.compiled, self.vectors[m]
+            rows = self.reduction.ltl_set(vector, compiled.enabled(vector), self.visible)
+            moves = None
+            if rows is not None:
+                moves = []
+                for t in rows:
+                    after = list(vector)
+                    compiled.consume(after, t)
+                    compiled.produce(after, t)
+                    moves.append((compiled.transitions[t], self._marking(tuple(after))))
+            self.reduced[m] = moves
+        return self.reduced[m]
+
+    def successors(self, state: tuple[int, int], on_stack: set | None = None):
+        """``(successor, accepting, row id)`` of a product state ``(marking, q)``: every
+        firing, or with ``on_stack`` (the search's depth-first stack) and the reduction
+        on, a stubborn set's unless one of its successors is on the stack (C3)."""
         m, q = state
         values = self.values[m]
-        for guard, target, accepting in self.edges[q]:
-            if guard(values):
-                for name, after in self._moves(m):
-                    yield (after, target), accepting, name
+        taken = [(target, accepting) for guard, target, accepting in self.edges[q] if guard(values)]
+        moves = None
+        if on_stack is not None and self.reduction is not None and taken:
+            moves = self._reduced_moves(m)
+            if moves is not None and any((after, target) in on_stack
+                                         for _, after in moves for target, _ in taken):
+                moves = None
+        if moves is None:
+            moves = self._moves(m)
+        return [((after, target), accepting, name) for target, accepting in taken for name, after in moves]
+
+    def _known(self, state: tuple[int, int]):
+        """:meth:`successors` through the firings already generated from the state's
+        marking (every firing, or a stubborn set's): real edges, no new marking."""
+        m, q = state
+        moves = self.moves[m] if self.moves[m] is not None else self.reduced.get(m)
+        if moves is None:
+            return self.successors(state)
+        values = self.values[m]
+        return [((after, target), accepting, name) for guard, target, accepting in self.edges[q]
+                if guard(values) for name, after in moves]
 
     def lasso(self) -> dict | None:
         """Couvreur's search from ``(M0, q0)``, then the lasso around the component found."""
         start = (self.start, self.q0)
         number = {start: 1}
-        stack = [(start, self.successors(start))]
+        on_stack = {start}
+        stack = [(start, iter(self.successors(start, on_stack)))]
         live, roots = [start], [(1, False, False)]      # (number, acceptance inside, entering)
         while stack:
             state, moves = stack[-1]
@@ -317,7 +374,8 @@ class _NetProduct:
                 seen = number.get(after, 0)
                 if seen == 0:
                     number[after] = len(number) + 1
-                    stack.append((after, self.successors(after)))
+                    on_stack.add(after)
+                    stack.append((after, iter(self.successors(after, on_stack))))
                     live.append(after)
                     roots.append((number[after], False, accepting))
                     break
@@ -329,9 +387,12 @@ class _NetProduct:
                     root, inside, entering = roots[-1]
                     roots[-1] = (root, inside or acc, entering)
                     if inside or acc:
-                        return self._lasso(start, [s for s in live if number[s] >= root])
+                        # with the reduction, the prefix keeps to the states searched
+                        visited = set(number) if self.reduction is not None else None
+                        return self._lasso(start, [s for s in live if number[s] >= root], visited)
             else:
                 stack.pop()
+                on_stack.discard(state)
                 if roots[-1][0] == number[state]:       # the component closes
                     roots.pop()
                     while True:
@@ -341,12 +402,12 @@ class _NetProduct:
                             break
         return None
 
-    def _lasso(self, start, component: list) -> dict:
+    def _lasso(self, start, component: list, visited: set | None) -> dict:
         members = set(component)
         for u in component:                             # in depth-first order
-            for v, accepting, name in self.successors(u):
+            for v, accepting, name in self._known(u):
                 if accepting and v in members:
-                    prefix = self._shortest(start, u, None)
+                    prefix = self._shortest(start, u, visited)
                     back = self._shortest(v, u, members)
                     return {"witness": [n for n in prefix if n is not None],
                             "cycle": [n for n in [name] + back if n is not None]}
@@ -358,7 +419,7 @@ class _NetProduct:
         queue = deque([start])
         while queue and goal not in parent:
             state = queue.popleft()
-            for after, _, name in self.successors(state):
+            for after, _, name in self._known(state):
                 if after not in parent and (allowed is None or after in allowed):
                     parent[after] = (state, name)
                     queue.append(after)

@@ -62,9 +62,16 @@ from petriflow.outcome import Name, Outcome
 from petriflow.runtime.trace import Event, EventKind
 
 __all__ = ["Command", "Intervention", "Breakpoint", "parse_breakpoint", "Control", "Steerable", "ControlError",
-           "Reply", "BREAKPOINT_SYNTAX"]
+           "Reply", "BREAKPOINT_SYNTAX", "PAUSED_STEP"]
 
 _CONTROL = EventKind.CONTROL.value
+
+#: Seconds a paused run whose time goes on (remote agents) lets pass at a time: its
+#: :attr:`Control.idle` advances the run that far; a paced clock waits for the wall
+#: clock as it goes, and for an unpaced one the control waits out what is left of the
+#: step (cut short by an intervention), so a pause neither spins the CPU nor races
+#: ahead of the agents.
+PAUSED_STEP = 0.05
 
 #: The breakpoint language, as the errors and the docs say it.
 BREAKPOINT_SYNTAX = "transition NAME | place NAME >= N (or >, ==, <=, <) | lost | failed"
@@ -203,6 +210,10 @@ class Steerable(Protocol):
     def now(self) -> float:
         """Simulated time."""
 
+    @property
+    def paced(self) -> bool:
+        """Whether the run's clock waits for the wall clock itself (real-time pacing)."""
+
 
 @dataclass
 class Reply:
@@ -331,9 +342,13 @@ class Control:
         #: Called (in the run's thread) when the run stops to wait (paused): a live page
         #: samples the run's state then.
         self.waiting: list[Any] = []
-        #: Called (in the run's thread) over and over while paused, instead of sleeping,
-        #: by a run whose time goes on during a pause (remote agents): it takes in what
-        #: happens meanwhile and fires nothing; ``True`` when something happened.
+        #: Called (in the run's thread) over and over while paused by a run whose time
+        #: goes on during a pause (remote agents): it lets up to :data:`PAUSED_STEP`
+        #: seconds of the run pass, takes in what happens meanwhile and fires nothing;
+        #: ``True`` when something happened. When the run is not paced
+        #: (:attr:`Steerable.paced`), the control waits out the rest of
+        #: :data:`PAUSED_STEP` in wall-clock time after each call, or until an
+        #: intervention comes (a paced clock has waited for the wall clock itself).
         self.idle: Any = None
 
     # Any thread -------------------------------------------------------------------
@@ -431,7 +446,10 @@ class Control:
                     for watcher in self.waiting:
                         watcher()
                 if self.idle is not None:  # the run's time goes on: take in what comes
+                    began = wallclock.monotonic()
                     changed |= self.idle()
+                    if not self._run.paced:
+                        self._rest(PAUSED_STEP - (wallclock.monotonic() - began))
                 else:
                     with self._wakeup:
                         if not self._queue and not self.closed:
@@ -441,6 +459,15 @@ class Control:
             if waited:
                 self._run.rebase_clock()
             return changed
+
+    def _rest(self, seconds: float) -> None:
+        """Wait up to ``seconds`` of wall-clock time, or until an intervention is queued
+        or the run closes."""
+        if seconds <= 0:
+            return
+        with self._wakeup:
+            if not self._queue and not self.closed:
+                self._wakeup.wait(seconds)
 
     def _here(self, event: Event) -> bool:
         """Whether a journaled control event was applied at this checkpoint."""

@@ -63,7 +63,6 @@ Examples:
 
 from __future__ import annotations
 
-import time as wallclock
 from typing import Any, Iterable, Mapping
 
 from petriflow import limits
@@ -78,7 +77,7 @@ from petriflow.runtime.agents import Agents
 from petriflow.runtime.binding import Binding
 from petriflow.runtime.channels import Channels
 from petriflow.runtime.clock import Clock, RealtimeClock, SimulatedClock
-from petriflow.runtime.control import Control, ControlError
+from petriflow.runtime.control import PAUSED_STEP, Control, ControlError
 from petriflow.runtime.config import RunConfig
 from petriflow.runtime.enabling import EnabledSet
 from petriflow.runtime.faults import Faults
@@ -100,10 +99,6 @@ from petriflow.workflow import final_marking_of
 __all__ = ["Scheduler", "RunResult", "ZenoError", "EmptySchedule"]
 
 _RUN, _STOP = EventKind.RUN.value, EventKind.STOP.value
-
-#: Seconds a paused run with remote agents lets pass at a time (between two looks at
-#: its control queue), taking in what its agents did meanwhile.
-PAUSED_STEP = 0.05
 
 
 class EmptySchedule(PetriflowError):
@@ -372,15 +367,16 @@ class Scheduler:
         :data:`PAUSED_STEP` seconds, take in what is due (a remote firing's result, its
         ``end`` recorded now; an agent lost, its firings ended ``failed``) and let the
         watchers look, but fire nothing (a pause stops dispatching). ``True`` if
-        something happened. The control calls it while it waits, instead of sleeping.
+        something happened. The control calls it while it waits
+        (:attr:`Control.idle <petriflow.runtime.control.Control.idle>`): a paced clock
+        waits for the wall clock here, and for an unpaced one (:attr:`paced`) the
+        control waits out the rest of the step itself.
         """
         kernel, seen = self.kernel, self.recorder.count
         tick = kernel.peek()
         target = kernel.tick + max(1, kernel.ticks_at(PAUSED_STEP))
         if tick is not None:
             target = min(target, max(tick, kernel.tick + 1))
-        if getattr(self.clock, "rebase", None) is None:  # an unpaced clock would race ahead of the agents
-            wallclock.sleep(PAUSED_STEP)
         while kernel.tick < target:  # the clock stops after each tick while paused (interrupt)
             self.clock.advance(kernel, self.world, target)
         self.firer.new_instant()
@@ -388,6 +384,11 @@ class Scheduler:
         for watcher in self._watchers:
             watcher(self)
         return self.recorder.count != seen
+
+    @property
+    def paced(self) -> bool:
+        """Whether the run's clock waits for the wall clock itself (a real-time clock)."""
+        return getattr(self.clock, "rebase", None) is not None
 
     def rebase_clock(self) -> None:
         """The run stood still: a paced run goes on from now, without rushing to catch up."""

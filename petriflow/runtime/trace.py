@@ -55,6 +55,9 @@ class EventKind(Name):
     CONTROL = "control"
     """Someone steered the run (:mod:`petriflow.runtime.control`): who, what, when, and
     the tokens it ``added`` or ``removed``; or a breakpoint triggered (``hit``)."""
+    FEEDBACK = "feedback"
+    """A remote agent reported progress on a running firing's goal (``firing``,
+    ``goal``, the remote ``agent``, its ``data``): docs/bridge.md."""
 
 
 #: The kinds of events a run records, as written in traces.
@@ -189,6 +192,7 @@ _NEEDS = {
     "message": {"place": lambda v: isinstance(v, str), "fate": lambda v: isinstance(v, str)},
     "pose": {"poses": lambda v: isinstance(v, dict)},
     "control": {"action": lambda v: isinstance(v, str), "point": lambda v: type(v) is int},
+    "feedback": {"firing": lambda v: type(v) is int, "goal": lambda v: isinstance(v, str)},
 }
 
 

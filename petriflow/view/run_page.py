@@ -305,6 +305,7 @@ _KEEP = {"run": {"marking", "agents", "net", "seed", "dt"}, "start": {"firing", 
          "end": {"firing", "outcome", "produced", "reason"}, "cancel": {"withdrawn", "actions"},
          "message": {"place", "fate", "channel", "receiver", "why", "arrival", "in_flight", "size", "distance"},
          "pose": {"poses", "outlines"}, "custom": {"name", "firing", "property", "event"},
+         "feedback": {"firing", "goal", "remote_agent"},
          "control": {"action", "added", "removed", "by", "wall", "spec", "place", "count", "firing", "number",
                      "outcome", "factor", "point", "tokens"}}
 

@@ -15,6 +15,9 @@ from tests.bridge.test_bridged_run import write
 pytestmark = pytest.mark.slow
 
 HEARTBEAT, HEARTBEAT_TIMEOUT = 0.1, 1.0
+#: Longer than the computation a cancel waits for here (a cancel not acknowledged within it
+#: gives the goal up: tests/bridge/test_cancel_deadline.py).
+CANCEL_TIMEOUT = 10.0
 
 BUSY = """\
 petriflow: 1
@@ -72,7 +75,7 @@ def run_busy(middleware, serve, folder, net_text, final):
     kind, server = middleware
     agent = serve(kind, server.connect, ["robot1"], heartbeat=HEARTBEAT, registry=busy_registry())
     path = write(folder, kind, server.connect, net=net_text, heartbeat=HEARTBEAT,
-                 heartbeat_timeout=HEARTBEAT_TIMEOUT)
+                 heartbeat_timeout=HEARTBEAT_TIMEOUT, cancel_timeout=CANCEL_TIMEOUT)
     result = run_files(path, trace=folder / "t.jsonl")
     events = [json.loads(line) for line in (folder / "t.jsonl").read_text().splitlines()]
     assert not [e for e in events if e["kind"] == "fault"], "the busy agent was declared lost"

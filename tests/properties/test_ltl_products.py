@@ -99,7 +99,7 @@ def test_check_properties_decides_ltl_on_an_unbounded_net_from_the_net():
     results = check_properties(net, [parse_property({"id": "v", "ltl": "F G a == 1"}),
                                      parse_property({"id": "s", "ltl": "G F a == 1"})],
                                max_states=1000)
-    assert results[0]["verdict"] is False and results[0]["method"].endswith("generated on the fly")
+    assert results[0]["verdict"] is False and "generated on the fly" in results[0]["method"]
     start = fire_sequence(net, net.initial_marking, results[0]["witness"])
     assert fire_sequence(net, start, results[0]["cycle"]) == start
     assert results[1]["verdict"] is None and results[1]["reason"].startswith("unbounded net")

@@ -196,3 +196,28 @@ transitions:
     ends = [e.seq for e in events if e.kind == "end"]
     starts = [e.seq for e in events if e.kind == "start"]
     assert ends[0] < hits[0].seq < starts[1]  # before the next firing
+
+
+def test_a_paused_run_whose_time_goes_on_rests_between_looks_and_wakes_for_the_operator():
+    """A paused run with an ``idle`` (remote agents) and an unpaced clock: the control waits out
+    each step in wall-clock time between two calls (no spinning), and a resume ends the wait."""
+    import time
+
+    from petriflow.runtime.control import PAUSED_STEP
+
+    control = Control(paused=True, interactive=True)
+    scheduler = Scheduler(loads_net(NET), seed=1, control=control)
+    assert not scheduler.paced
+    calls: list[float] = []
+
+    def idle() -> bool:
+        calls.append(time.monotonic())
+        if len(calls) == 6:
+            control.submit(Intervention.of("resume", by="test"))
+        return False
+
+    control.idle = idle
+    result = scheduler.run()
+    assert result.marking.to_dict() == {"o": 3} and len(calls) == 6
+    gaps = [b - a for a, b in zip(calls, calls[1:])]
+    assert min(gaps) >= 0.8 * PAUSED_STEP  # it rested between looks

@@ -62,6 +62,7 @@
       }
       case "stop": return `stop   ${d.reason} after ${d.firings} firings`;
       case "run": return `run    ${d.net} seed ${d.seed}`;
+      case "feedback": return `fb     ${e.transition}${who} from ${d.remote_agent} (firing ${d.firing}): ${JSON.stringify(d.data).slice(0, 100)}`;
       case "custom": if (d.name === "property_violated") return PF.violation(e);
       default: return `${e.kind} ${e.transition || ""}${who}`;
     }

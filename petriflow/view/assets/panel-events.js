@@ -17,6 +17,7 @@ PF.eventsPanel = function (view) {
       case "run": return `run    ${d.net} seed ${d.seed}`;
       case "stop": return `stop   ${d.reason} after ${d.firings} firings`;
       case "pose": return `pose   ${Object.keys(d.poses || {}).length} bodies${d.outlines ? ", " + d.outlines.length + " outlines" : ""}`;
+      case "feedback": return `fb     ${ev.transition}${who} from ${d.remote_agent} (firing ${d.firing}): ${JSON.stringify(d.data).slice(0, 100)}`;
       case "custom": if (d.name === "property_violated") return PF.violation(ev);
       default: return `${ev.kind} ${ev.transition || ""}${who} ${JSON.stringify(d).slice(0, 120)}`;
     }
