@@ -53,10 +53,15 @@ from petriflow.agents.planning.errors import PlanningError
 from petriflow.agents.planning.maps import (
     ROBOT_LABELS,
     GridFrame,
+    binary_map,
+    cell_grid,
+    free_cells_near,
+    free_region,
     nearest_free,
     planning_grid,
     robot_centre,
     robot_label,
+    segment_free,
 )
 from petriflow.agents.planning.tracking import check_track
 from petriflow.capabilities import Poses, Positions, provides
@@ -159,14 +164,19 @@ def plan_world_path(label_map: np.ndarray, frame: GridFrame, robot: str | int, g
         radius: robot radius (m), by which obstacles are dilated.
         variant: ``"optimal"`` or ``"paper"`` (see :mod:`~petriflow.agents.planning.astar`).
         cut_corners: allow diagonal moves between two occupied cells.
-        snap: a start or goal in an occupied cell moves to the nearest free cell within
-            this distance (m); default twice the radius (a goal on another robot).
+        snap: a start or goal in an occupied cell moves to a free cell within this
+            distance (m); default twice the radius (a goal on another robot, a robot
+            pushed into an obstacle's margin). A goal moves to the nearest free cell.
+            A start moves to the nearest free cell from which the goal can be reached
+            and whose straight leg from the start crosses no obstacle itself, only the
+            margin grown around it: a robot in the margin walks out of it.
 
     Returns:
         ``{"robot", "found", "path", "start", "goal", "variant", "steps", "length_m",
         "expanded", "visited", "seconds"}``; ``path`` is ``[]`` when no path exists.
-        Its first and last points are the exact start and goal unless they were moved
-        to a free cell; the others are cell centres.
+        Its first point is the exact start (a start that was moved keeps it: the path's
+        first leg leads from it to the free cell the search began at); its last point is
+        the exact goal unless that was moved to a free cell; the others are cell centres.
 
     Raises:
         PlanningError: unknown robot, robot not on the map, start or goal blocked with
@@ -185,32 +195,56 @@ def plan_world_path(label_map: np.ndarray, frame: GridFrame, robot: str | int, g
     start_xy, goal_xy = _point(start, "start"), _point(goal, "goal")
     reach = (2.0 * radius if snap is None else snap) / frame.metres_per_cell
     cells = {}
-    for what, point in (("start", start_xy), ("goal", goal_xy)):
+    for what, point in (("goal", goal_xy), ("start", start_xy)):
         cell = tuple(int(v) for v in frame.world_to_cell(point))
         free = nearest_free(grid, cell, reach)
         if free is None:
             raise PlanningError(f"{what} {list(point)} of robot {colour!r} is blocked (inside an obstacle "
                                 f"grown by the robot radius, or off the map) and no free cell is within "
                                 f"{reach * frame.metres_per_cell:g} m")
+        if what == "start" and free != cell:
+            free = _way_out(label_map, frame, robot, grid, start_xy, cell, cells["goal"][1], reach,
+                            cut_corners)
         cells[what] = (cell, free)
-    with stopwatch.measure("search", keep=True):
-        plan = astar(grid, cells["start"][1], cells["goal"][1], variant=variant, cut_corners=cut_corners)
     path: list[list[float]] = []
-    if plan.found:
+    plan = None
+    if cells["start"][1] is not None:  # else free cells near, but none is a way out toward the goal
+        with stopwatch.measure("search", keep=True):
+            plan = astar(grid, cells["start"][1], cells["goal"][1], variant=variant, cut_corners=cut_corners)
+    if plan is not None and plan.found:
         points = frame.cell_to_world(plan.cells)
         if cells["start"][0] == cells["start"][1]:
             points[0] = start_xy
+        else:  # the way out of the margin: from where the robot stands to the free cell
+            points = np.vstack([start_xy, points])
         if cells["goal"][0] == cells["goal"][1]:
             points[-1] = goal_xy
         path = np.round(points, 6).tolist()
     length = float(np.hypot(*np.diff(np.asarray(path), axis=0).T).sum()) if len(path) > 1 else 0.0
     return {
-        "robot": colour, "found": plan.found, "path": path,
+        "robot": colour, "found": bool(path), "path": path,
         "start": path[0] if path else [round(v, 6) for v in start_xy],
         "goal": path[-1] if path else [round(v, 6) for v in goal_xy],
-        "variant": variant, "steps": plan.steps, "length_m": round(length, 6),
-        "expanded": plan.expanded, "visited": plan.visited, "seconds": plan.seconds,
+        "variant": variant, "steps": plan.steps if plan is not None else 0, "length_m": round(length, 6),
+        "expanded": plan.expanded if plan is not None else 0,
+        "visited": plan.visited if plan is not None else 0,
+        "seconds": plan.seconds if plan is not None else 0.0,
     }
+
+
+def _way_out(label_map: np.ndarray, frame: GridFrame, robot: str | int, grid: np.ndarray,
+             start: tuple[float, float], cell: tuple[int, int], goal: tuple[int, int], reach: float,
+             cut_corners: bool) -> tuple[int, int] | None:
+    """The free cell a start inside an obstacle's grown margin moves to: the nearest one
+    within ``reach`` (cells) from which the search can reach the goal, and whose
+    straight leg from the start crosses no obstacle itself (only its margin); ``None``
+    if there is none."""
+    region = free_region(grid, goal, cut_corners)
+    obstacles = cell_grid(binary_map(label_map, robot), frame.cell)
+    for row, col in free_cells_near(grid, cell, reach, region):
+        if segment_free(obstacles, frame, start, frame.cell_to_world((row, col))):
+            return int(row), int(col)
+    return None
 
 
 class PlanPath(InstantAction):

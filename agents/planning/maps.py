@@ -57,6 +57,8 @@ __all__ = [
     "cell_grid",
     "planning_grid",
     "nearest_free",
+    "free_cells_near",
+    "free_region",
     "draw_disc",
     "segment_free",
     "GridFrame",
@@ -240,9 +242,78 @@ def planning_grid(label_map: np.ndarray, robot: str | int | None, radius_px: flo
     return cell_grid(configuration_space(occupied, radius_px, border=border), cell)
 
 
-def nearest_free(grid: np.ndarray, cell: Sequence[int], max_distance: float) -> tuple[int, int] | None:
+def free_region(grid: np.ndarray, cell: Sequence[int], cut_corners: bool = False) -> np.ndarray:
+    """The free cells the planner can reach from ``cell``: a boolean mask, all ``False``
+    when ``cell`` is occupied or off the map.
+
+    The planner's moves decide what is connected: without ``cut_corners`` a diagonal
+    step needs both cells it passes between free, so it never joins two cells that
+    straight steps do not already join (4-connectivity); with ``cut_corners`` diagonal
+    neighbours are joined too (8-connectivity).
+
+    Examples:
+        >>> grid = np.zeros((3, 5), bool); grid[:, 2] = True; grid[1, 2] = False
+        >>> free_region(grid, (0, 0)).astype(int)
+        array([[1, 1, 0, 1, 1],
+               [1, 1, 1, 1, 1],
+               [1, 1, 0, 1, 1]])
+        >>> diagonal = np.array([[0, 1], [1, 0]], bool)
+        >>> free_region(diagonal, (0, 0)).sum(), free_region(diagonal, (0, 0), cut_corners=True).sum()
+        (np.int64(1), np.int64(2))
+    """
+    import cv2  # heavy dependency, only where regions are labelled
+
+    grid = np.asarray(grid, dtype=bool)
+    row, col = int(cell[0]), int(cell[1])
+    if not (0 <= row < grid.shape[0] and 0 <= col < grid.shape[1]) or grid[row, col]:
+        return np.zeros(grid.shape, bool)
+    _, labels = cv2.connectedComponents((~grid).astype(np.uint8), connectivity=8 if cut_corners else 4)
+    return labels == labels[row, col]
+
+
+def free_cells_near(grid: np.ndarray, cell: Sequence[int], max_distance: float,
+                    region: np.ndarray | None = None) -> np.ndarray:
+    """The free cells within ``max_distance`` of ``cell`` (Euclidean, in cells), nearest
+    first, equally near ones in row-major order: an ``(n, 2)`` array of ``(row, col)``.
+
+    Args:
+        grid: the occupancy grid (``True`` occupied).
+        cell: ``(row, col)``, on the map or off it.
+        max_distance: the farthest a cell may be (cells).
+        region: only cells where this mask is ``True`` count (e.g. :func:`free_region`
+            of the goal: the cells from which the goal can be reached).
+
+    Examples:
+        >>> grid = np.ones((5, 5), bool); grid[4, 4] = False; grid[0, 3] = False
+        >>> free_cells_near(grid, (2, 2), 3).tolist()
+        [[0, 3], [4, 4]]
+        >>> region = np.zeros((5, 5), bool); region[4, 4] = True
+        >>> free_cells_near(grid, (2, 2), 3, region).tolist()
+        [[4, 4]]
+    """
+    grid = np.asarray(grid, dtype=bool)
+    row, col = int(cell[0]), int(cell[1])
+    reach = math.floor(max_distance)
+    r0, r1 = max(row - reach, 0), min(row + reach + 1, grid.shape[0])
+    c0, c1 = max(col - reach, 0), min(col + reach + 1, grid.shape[1])
+    if r0 >= r1 or c0 >= c1:
+        return np.zeros((0, 2), np.int64)
+    free = ~grid[r0:r1, c0:c1]
+    if region is not None:
+        free &= np.asarray(region, dtype=bool)[r0:r1, c0:c1]
+    rows, cols = np.nonzero(free)  # row-major
+    rows, cols = rows + r0, cols + c0
+    distance2 = (rows - row) ** 2 + (cols - col) ** 2
+    keep = distance2 <= max_distance * max_distance + 1e-9
+    order = np.argsort(distance2[keep], kind="stable")  # stable: row-major among equals
+    return np.stack([rows[keep][order], cols[keep][order]], axis=1).astype(np.int64)
+
+
+def nearest_free(grid: np.ndarray, cell: Sequence[int], max_distance: float,
+                 region: np.ndarray | None = None) -> tuple[int, int] | None:
     """The free cell nearest to ``cell`` (Euclidean, in cells), or ``None`` if none lies
-    within ``max_distance``. Equally near cells are chosen in row-major order.
+    within ``max_distance``. Equally near cells are chosen in row-major order; with
+    ``region``, only cells where that mask is ``True`` count (:func:`free_cells_near`).
 
     Examples:
         >>> grid = np.ones((5, 5), bool); grid[4, 4] = False; grid[0, 3] = False
@@ -253,22 +324,11 @@ def nearest_free(grid: np.ndarray, cell: Sequence[int], max_distance: float) -> 
     """
     grid = np.asarray(grid, dtype=bool)
     row, col = int(cell[0]), int(cell[1])
-    if 0 <= row < grid.shape[0] and 0 <= col < grid.shape[1] and not grid[row, col]:
+    on_map = 0 <= row < grid.shape[0] and 0 <= col < grid.shape[1]
+    if on_map and not grid[row, col] and (region is None or region[row, col]):
         return row, col
-    reach = math.floor(max_distance)
-    r0, r1 = max(row - reach, 0), min(row + reach + 1, grid.shape[0])
-    c0, c1 = max(col - reach, 0), min(col + reach + 1, grid.shape[1])
-    if r0 >= r1 or c0 >= c1:
-        return None
-    rows, cols = np.nonzero(~grid[r0:r1, c0:c1])
-    if rows.size == 0:
-        return None
-    rows, cols = rows + r0, cols + c0
-    distance2 = (rows - row) ** 2 + (cols - col) ** 2
-    best = int(np.argmin(distance2))  # argmin keeps the first (row-major) of equals
-    if distance2[best] > max_distance * max_distance + 1e-9:
-        return None
-    return int(rows[best]), int(cols[best])
+    cells = free_cells_near(grid, cell, max_distance, region)
+    return None if len(cells) == 0 else (int(cells[0][0]), int(cells[0][1]))
 
 
 def draw_disc(label_map: np.ndarray, centre: Sequence[float], radius_px: float, label: int) -> np.ndarray:

@@ -100,6 +100,49 @@ def test_plan_world_path_snaps_a_goal_on_another_robot():
         plan_world_path(label_map(), frame, "red", blue, radius=0.04, snap=0.01)
 
 
+def pushed_into_a_margin() -> tuple[np.ndarray, tuple[float, float], tuple[float, float]]:
+    """A wall along the top and three obstacle pixels below it; the start is inside the
+    wall's grown margin, and the free cell nearest to it is a pocket the search cannot
+    leave (a robot pushed against a wall, next to a stray obstacle)."""
+    label = np.zeros((48, 64), np.uint8)
+    label[:8, :] = OBSTACLE
+    for row, col in ((12, 14), (12, 26), (17, 20)):
+        label[row, col] = OBSTACLE
+    frame = GridFrame(MPP)
+    start = tuple(frame.pixel_to_world((10, 20)).tolist())
+    goal = tuple(frame.pixel_to_world((40, 50)).tolist())
+    return label, start, goal
+
+
+def test_plan_world_path_leads_a_start_in_a_margin_out_toward_the_goal():
+    """A start inside an obstacle's grown margin moves to the nearest free cell from which
+    the goal is reached (not to a nearer pocket), and the path begins where the robot
+    stands, its first leg crossing no obstacle."""
+    from petriflow.agents.planning.astar import astar
+    from petriflow.agents.planning.maps import nearest_free, planning_grid, segment_free
+
+    label, start, goal = pushed_into_a_margin()
+    frame = GridFrame(MPP)
+    grid = planning_grid(label, "red", 0.04 / MPP, 1)
+    pocket = nearest_free(grid, (10, 20), 15)
+    assert pocket is not None and not astar(grid, pocket, (40, 50)).found   # the nearest one is a trap
+    result = plan_world_path(label, frame, "red", goal, start, radius=0.04, snap=0.15)
+    assert result["found"] and result["path"][0] == list(start) and result["path"][-1] == list(goal)
+    out = tuple(int(v) for v in frame.world_to_cell(result["path"][1]))
+    assert out != pocket and not grid[out]
+    assert segment_free(label == OBSTACLE, frame, start, result["path"][1])
+    cells = frame.world_to_cell(result["path"][1:])
+    assert not grid[cells[:, 0], cells[:, 1]].any()
+
+
+def test_plan_world_path_finds_no_way_out_beyond_the_snap_distance():
+    """With no free cell toward the goal within the snap distance, there is no path (a
+    measured failure, not an error)."""
+    label, start, goal = pushed_into_a_margin()
+    result = plan_world_path(label, GridFrame(MPP), "red", goal, start, radius=0.04, snap=0.03)
+    assert not result["found"] and result["path"] == [] and result["start"] == list(start)
+
+
 def test_plan_world_path_reports_no_path():
     """A goal walled off gives found=False and an empty path."""
     label = label_map()

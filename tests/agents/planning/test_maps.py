@@ -16,6 +16,8 @@ from petriflow.agents.planning.maps import (
     configuration_space,
     disc_kernel,
     draw_disc,
+    free_cells_near,
+    free_region,
     nearest_free,
     planning_grid,
     robot_centre,
@@ -103,6 +105,39 @@ def test_nearest_free_cell():
     assert nearest_free(grid, (4, 6), 3) == (2, 7)
     assert nearest_free(grid, (4, 6), 2) is None
     assert nearest_free(grid, (10, 10), 3) == (8, 8)  # from off the map too
+
+
+def test_nearest_free_cell_within_a_region():
+    """With a region, the nearest free cell inside it: a nearer free cell outside is passed over."""
+    grid = np.ones((9, 9), bool)
+    grid[2, 7] = grid[8, 8] = False
+    region = np.zeros((9, 9), bool)
+    region[8, 8] = True
+    assert nearest_free(grid, (4, 6), 5, region=region) == (8, 8)
+    assert nearest_free(grid, (4, 6), 3, region=region) is None
+    assert free_cells_near(grid, (4, 6), 5).tolist() == [[2, 7], [8, 8]]
+
+
+def test_free_region_follows_the_planners_moves():
+    """A free region is what the search can reach: without corner cutting a diagonal gap
+    between two occupied cells does not join two regions; with it, it does. On random
+    grids the region is exactly the cells A* finds a path to."""
+    from petriflow.agents.planning.astar import astar
+
+    grid = np.ones((4, 4), bool)
+    grid[0, 0] = grid[1, 1] = grid[2, 1] = grid[3, 3] = False
+    assert free_region(grid, (1, 1)).sum() == 2           # (2, 1) straight; (0, 0) only diagonal
+    assert free_region(grid, (1, 1), cut_corners=True)[0, 0]
+    assert not free_region(grid, (1, 1), cut_corners=True)[3, 3]
+    assert not free_region(grid, (0, 1)).any()            # an occupied cell has no region
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        grid = rng.random((9, 11)) < 0.45
+        grid[4, 5] = False
+        for cut in (False, True):
+            region = free_region(grid, (4, 5), cut_corners=cut)
+            for row, col in zip(*np.nonzero(~grid)):
+                assert region[row, col] == astar(grid, (4, 5), (row, col), cut_corners=cut).found
 
 
 def test_frame_round_trips_pixels_cells_and_world():

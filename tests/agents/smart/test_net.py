@@ -19,15 +19,17 @@ PAPER_TRANSITIONS = [f"T{k}" for k in range(1, 10)]
 
 
 def reachable(net, start):
-    """Every marking reachable from ``start`` (the nets are small and safe)."""
+    """Every marking reachable from ``start`` (the nets are small and safe), each action
+    ending ``ok`` or with any outcome the net routes (a failed re-plan, say)."""
     seen, queue = {start}, deque([start])
     while queue:
         marking = queue.popleft()
         for t in enabled(net, marking):
-            after = fire(net, marking, t)
-            if after not in seen:
-                seen.add(after)
-                queue.append(after)
+            for outcome in [None, *net.outcomes(t)]:
+                after = fire(net, marking, t, outcome)
+                if after not in seen:
+                    seen.add(after)
+                    queue.append(after)
     return seen
 
 
