@@ -43,6 +43,10 @@ def register(registry) -> None:
         registry.predicate(name, reads=reads)(function)
     from petriflow.agents.bidding.needs import OFFICE_SETTINGS
 
+    # made from the world alone: a bridged robot's agent makes it from its own world
     registry.register_resource("bidding.office", "petriflow.agents.bidding.office:plan_resource",
-                               settings=OFFICE_SETTINGS)
+                               settings=OFFICE_SETTINGS, per_world=True)
+    from petriflow.agents.bidding.protocol import Payload
+
+    registry.register_data_type("bidding.payload", Payload)  # a message's payload, rebuilt across a bridge
     metrics.register(registry)

@@ -45,12 +45,14 @@ from typing import Any, Callable, TextIO
 
 from petriflow.bridge import protocol
 from petriflow.bridge.calls import CallRefused, calling_services
-from petriflow.bridge.held import AgentMemory, Held, HeldStates, check_spec, memory_error
+from petriflow.bridge.codec import Codec, CodecError
+from petriflow.bridge.held import KEPT_RUNS, AgentMemory, Held, HeldStates, check_spec, memory_error
 from petriflow.bridge.protocol import Refused
 from petriflow.bridge.transport import Transport, agent_of, from_agent, to_agent
-from petriflow.errors import NetFormatError
+from petriflow.errors import NetFormatError, PetriflowError
 from petriflow.runtime.action import REQUIRED, Action, ActionContext, Status, first_data, type_names
 from petriflow.runtime.registry import Registry, UnknownActionError, default_registry
+from petriflow.runtime.resources import ResourceContext, ResourceError
 from petriflow.runtime.settings import read_settings
 
 __all__ = ["AgentServer", "announcement"]
@@ -99,6 +101,46 @@ class _Running:
     seen: int = 0  # the state's changes when it was last polled (an action asleep on it wakes)
 
 
+class WorldResources:
+    """The resources an agent makes from its own world for one run: those registered
+    ``per_world`` (:meth:`~petriflow.runtime.registry.Registry.register_resource`), each
+    made once, on first use, by the factory a local run uses, from the agent's world
+    and its file's settings (no liveness, no configuration: a per-world resource reads
+    neither; the run's ``core.liveness`` is served by calls).
+
+    Examples:
+        >>> registry = Registry(False)
+        >>> registry.register_resource("demo.size", lambda context: len(context.world), per_world=True)
+        >>> made = WorldResources(registry, [1, 2, 3])
+        >>> made.get("demo.size"), made.get("demo.size") is made.get("demo.size")
+        (3, True)
+    """
+
+    def __init__(self, registry: Registry, world: Any) -> None:
+        self.registry = registry
+        self.world = world
+        self.made: dict[str, Any] = {}
+
+    def get(self, kind: str) -> Any:
+        """The run's resource of type ``kind``, made here on first use.
+
+        Raises:
+            ResourceError: its settings do not check, or its factory refused.
+        """
+        if kind not in self.made:
+            section = self.registry.resource_settings(kind)
+            try:
+                settings = {} if section is None else read_settings(getattr(self.world, "meta", None),
+                                                                     {section.name: section})
+                self.made[kind] = self.registry.resource_factory(kind)(
+                    ResourceContext(self.world, None, None, settings))
+            except ResourceError:
+                raise
+            except PetriflowError as exc:
+                raise ResourceError(f"resource {kind} (made on the agent): {exc}") from None
+        return self.made[kind]
+
+
 class AgentServer:
     """Executes goals for ``names`` (see the module).
 
@@ -136,6 +178,8 @@ class AgentServer:
         self.ended: dict[str, protocol.BridgeMessage] = {}
         self.instances: dict[tuple[str, str, str], Action] = {}
         self.memory = AgentMemory(self.registry)  # the agent states it holds (:mod:`petriflow.bridge.held`)
+        self.codec = Codec(self.registry.data_types())  # token data's messages and payloads (:mod:`~.codec`)
+        self.own: dict[str, WorldResources] = {}  # per run: the resources made from its world
         self.executed = 0
         self.dropped = 0
         self._stop = threading.Event()
@@ -334,6 +378,15 @@ class AgentServer:
             del self.ended[next(iter(self.ended))]
         self._send(answer.agent, answer)
 
+    def _own(self, run: str) -> WorldResources:
+        """The resources made from this agent's world for ``run`` (the last runs' kept)."""
+        own = self.own.get(run)
+        if own is None:
+            own = self.own[run] = WorldResources(self.registry, self.world)
+            while len(self.own) > KEPT_RUNS:
+                del self.own[next(iter(self.own))]
+        return own
+
     def execute(self, goal: protocol.Goal) -> None:
         """Start executing ``goal``: reject it if its action or parameters do not check."""
         try:
@@ -368,11 +421,18 @@ class AgentServer:
         except NetFormatError as exc:
             self._remember(goal.id, protocol.Rejected(goal.id, goal.agent, f"the world's settings: {exc}"))
             return
+        try:
+            inputs = {place: [self.codec.decode(d) for d in data] for place, data in goal.inputs.items()}
+        except CodecError as exc:
+            self._remember(goal.id, protocol.Rejected(goal.id, goal.agent, str(exc)))
+            return
         now = self.now
-        ctx = ActionContext(goal.transition or goal.action, goal.agent, params, dict(goal.inputs), self.world,
+        ctx = ActionContext(goal.transition or goal.action, goal.agent, params, inputs, self.world,
                             goal.seed or goal.id, now, now, action=cls,
                             services=calling_services(settings, lambda *asked: self.call(goal, *asked),
-                                                      None if held is None else HeldStates(held)))
+                                                      None if held is None else HeldStates(held),
+                                                      self._own(goal.id.partition("/")[0]), self.registry.per_world,
+                                                      self.codec))
         self.executed += 1
         if self.log_file is not None:
             self.log_file.write(json.dumps({"goal": goal.id, "agent": goal.agent, "action": goal.action,
@@ -466,8 +526,12 @@ class AgentServer:
         if status is Status.OK:
             data = ctx.result
             per_place = bool(ctx.per_place and isinstance(data, dict))
-            answer = protocol.Result(goal.id, goal.agent, "ok", protocol.to_data(data), "", values, seq, events,
-                                     protocol.to_data(ctx.outputs or {}), per_place)
+            try:
+                answer = protocol.Result(goal.id, goal.agent, "ok", self.codec.encode(data), "", values, seq,
+                                         events, self.codec.encode(ctx.outputs or {}), per_place)
+            except ValueError as exc:
+                answer = protocol.Result(goal.id, goal.agent, "failed", None, f"the output tokens: {exc}", values,
+                                         seq, events)
         else:
             answer = protocol.Result(goal.id, goal.agent, "failed", None, reason or ctx.reason or "failed", values,
                                      seq, events)

@@ -29,9 +29,13 @@ service        method      context method                             served
                                                                        (:mod:`~.held`)
 ``channels``               ``ctx.link``, ``ctx.medium``               no
 ``resources``              ``ctx.resource``                           ``core.liveness``
-                                                                       only; others
-                                                                       refused at bind
-                                                                       time
+                                                                       by calls; those
+                                                                       registered
+                                                                       ``per_world`` on
+                                                                       the agent, from
+                                                                       its own world;
+                                                                       others refused
+                                                                       at bind time
 =============  ==========  =========================================  =================
 
 An action that uses a service not served fails its goal with a one-line reason
@@ -55,6 +59,7 @@ from __future__ import annotations
 from typing import Any, Callable, Mapping
 
 from petriflow.bridge import protocol
+from petriflow.bridge.codec import Codec
 from petriflow.errors import PetriflowError
 from petriflow.runtime.resources import LIVENESS
 from petriflow.runtime.services import RunServices
@@ -96,9 +101,11 @@ def check_call(call: protocol.Call) -> str:
     return ""
 
 
-def answer(call: protocol.Call, services: RunServices, ports: set[str]) -> protocol.Reply:
+def answer(call: protocol.Call, services: RunServices, ports: set[str], codec: Codec | None = None) \
+        -> protocol.Reply:
     """The reply to ``call`` (checked with :func:`check_call`) from the run's ``services``;
-    ``ports``: the places the goal's action may read (those its ports name)."""
+    ``ports``: the places the goal's action may read (those its ports name); ``codec``:
+    how token data is sent (:mod:`~.codec`; default: messages tagged, no payload types)."""
     def refuse(error: str) -> protocol.Reply:
         return protocol.Reply(call.id, call.agent, call.call, None, error)
 
@@ -116,7 +123,7 @@ def answer(call: protocol.Call, services: RunServices, ports: set[str]) -> proto
     else:
         value = True if services.liveness is None else bool(services.liveness.alive(call.args[0]))
     try:
-        data = protocol.to_data(value)
+        data = (codec or Codec()).encode(value)
         reply = protocol.Reply(call.id, call.agent, call.call, data)
         protocol.encode(reply)
     except ValueError as exc:
@@ -142,14 +149,15 @@ class Unserved:
 
 
 class _Tokens:
-    def __init__(self, call: Callable[[str, str, list], Any]) -> None:
+    def __init__(self, call: Callable[[str, str, list], Any], codec: Codec) -> None:
         self._call = call
+        self._codec = codec
 
     def read(self, place: str) -> list[Any]:
         value = self._call("tokens", "read", [place])
         if not isinstance(value, list):
             raise CallRefused(f"tokens.read: the run replied with a {type(value).__name__}, not a list")
-        return value
+        return self._codec.decode(value)
 
 
 class _Liveness:
@@ -172,24 +180,34 @@ class _Liveness:
 
 
 class _Resources:
-    """``ctx.resource`` on an agent: the run's ``core.liveness`` (served by calls); any
-    other resource is refused when the net is bound."""
+    """``ctx.resource`` on an agent: the run's ``core.liveness`` (served by calls), the
+    resources made per world from the agent's own world (``own``: the agent's
+    :class:`~petriflow.runtime.resources.Resources` for the run, ``own_kinds`` the
+    per-world types); any other resource is refused when the net is bound."""
 
-    def __init__(self, live: _Liveness) -> None:
+    def __init__(self, live: _Liveness, own: Any = None, own_kinds: Callable[[str], bool] | None = None) -> None:
         self._live = live
+        self._own = own
+        self._own_kinds = own_kinds
 
     def get(self, kind: str) -> Any:
         if kind == LIVENESS:
             return self._live
-        raise CallRefused(f"resource {kind!r} is not served to remote agents (served: {LIVENESS})")
+        if self._own is not None and self._own_kinds is not None and self._own_kinds(kind):
+            return self._own.get(kind)
+        raise CallRefused(f"resource {kind!r} is not served to remote agents (served: {LIVENESS}, and the"
+                          " resources registered per_world, made on the agent)")
 
 
 def calling_services(settings: Mapping[str, Mapping[str, Any]],
-                     call: Callable[[str, str, list], Any], agents: Any = None) -> RunServices:
+                     call: Callable[[str, str, list], Any], agents: Any = None, own: Any = None,
+                     own_kinds: Callable[[str], bool] | None = None, codec: Codec | None = None) -> RunServices:
     """A remote goal's services: ``settings`` (the agent's own), proxies that ``call``
     the run for what :data:`SERVED` lists, :class:`Unserved` for the rest; ``agents``
     (the agent's own, when it holds its subnet's state: :mod:`petriflow.bridge.held`)
-    serves ``ctx.state`` on the agent.
+    serves ``ctx.state`` on the agent; ``own`` (the agent's resources made from its own
+    world) serves ``ctx.resource`` for the types ``own_kinds`` says are per world;
+    ``codec`` decodes the token data the run replies (:mod:`~.codec`).
 
     Examples:
         >>> services = calling_services({}, lambda service, method, args: [f"{service}.{method}{args}"])
@@ -202,6 +220,6 @@ def calling_services(settings: Mapping[str, Mapping[str, Any]],
     """
     live = _Liveness(call)
     return RunServices(agents=agents if agents is not None else Unserved("agent states", "ctx.state"),
-                       tokens=_Tokens(call),
+                       tokens=_Tokens(call, codec or Codec()),
                        channels=Unserved("channel places", "ctx.link/ctx.medium"),
-                       resources=_Resources(live), liveness=live, settings=settings)
+                       resources=_Resources(live, own, own_kinds), liveness=live, settings=settings)

@@ -21,6 +21,7 @@ from typing import Any, ClassVar
 
 from petriflow.bridge import protocol
 from petriflow.bridge.calls import answer
+from petriflow.bridge.codec import Codec
 from petriflow.bridge.dispatcher import Dispatcher, Phase
 from petriflow.bridge.held import HeldGuards, held_guards, state_spec
 from petriflow.bridge.spec import BridgeSpec
@@ -55,6 +56,8 @@ class RemoteAction(Action):
     needs_world: ClassVar[bool] = False
     remote_agent: ClassVar[str] = ""
     remote_action: ClassVar[str] = ""
+    #: How token data crosses the bridge (:mod:`~.codec`: messages and registered payloads tagged).
+    codec: ClassVar[Codec] = Codec()
     #: What the goals carry of the subnet's agent-held state (:mod:`~.held`; ``{}``: none).
     remote_state: ClassVar[dict[str, Any]] = {}
     params: ClassVar[dict[str, Param]] = {}
@@ -77,7 +80,7 @@ class RemoteAction(Action):
             raise RuntimeError(f"agent {self.remote_agent!r} is lost")
         self.goal_id = protocol.goal_id(dispatcher.run, firing_number(ctx))
         self.cancel_asked = False
-        inputs = {place: [protocol.to_data(d) for d in data] for place, data in ctx.inputs.items()}
+        inputs = {place: [self.codec.encode(d) for d in data] for place, data in ctx.inputs.items()}
         dispatcher.send(protocol.Goal(self.goal_id, self.remote_agent, self.remote_action,
                                       protocol.to_data(dict(ctx.params)), ctx.transition, inputs, str(ctx.seed),
                                       self.remote_state))
@@ -127,12 +130,16 @@ class RemoteAction(Action):
             return True
         return False
 
-    @staticmethod
-    def _ok(ctx: ActionContext, state: Any) -> None:
-        """The output tokens' data of a goal ended ``ok`` (its places given apart: ``ctx.put`` on the agent)."""
-        ctx.result, ctx.per_place = state.data, state.per_place
+    def _ok(self, ctx: ActionContext, state: Any) -> None:
+        """The output tokens' data of a goal ended ``ok`` (its places given apart: ``ctx.put``
+        on the agent), its messages and payloads rebuilt (:mod:`~.codec`).
+
+        Raises:
+            CodecError: a tagged object does not rebuild (the firing fails with it).
+        """
+        ctx.result, ctx.per_place = self.codec.decode(state.data), state.per_place
         for place, data in state.outputs.items():
-            ctx.put(place, data)
+            ctx.put(place, self.codec.decode(data))
 
     def _held(self, ctx: ActionContext, snapshot: tuple[int, dict[str, bool]]) -> None:
         """The agent's newest values of the subnet's state guards into the run's cache
@@ -153,7 +160,7 @@ class RemoteAction(Action):
         ports = {ctx.params.get(name) for name, declared in type(self).params.items() if isinstance(declared, Port)}
         services = ctx.services
         for call in calls:
-            dispatcher.reply(answer(call, services, {p for p in ports if isinstance(p, str)}))
+            dispatcher.reply(answer(call, services, {p for p in ports if isinstance(p, str)}, self.codec))
 
     def _replayed(self, ctx: ActionContext, state: Any) -> Status:
         """The journaled ending of a resumed run's firing, at its journaled time."""
@@ -228,6 +235,7 @@ def bind_remote(net: Net, spec: BridgeSpec, registry: Registry, bind_local: Any,
         local_net.transitions[tid] = dataclasses.replace(local_net.transitions[tid], action=None)
     binding: Binding = bind_local(local_net)
     transitions = dict(binding.transitions)
+    codec = Codec(registry.data_types())
     classes: dict[tuple[str, str], type[RemoteAction]] = {}
     for tid, agent in remote.items():
         transition = net.transitions[tid]
@@ -242,11 +250,11 @@ def bind_remote(net: Net, spec: BridgeSpec, registry: Registry, bind_local: Any,
                 params = local.check_params(transition.params, tid)
             except NetFormatError as exc:
                 raise _at(net, tid, path, exc.message, getattr(exc, "param", None)) from None
-            _check_places(net, tid, path, name, local, params)
+            _check_places(net, tid, path, name, local, params, registry)
         cls = classes.get((agent, name))
         if cls is None:
             cls = classes[agent, name] = type(f"Remote[{agent}:{name}]", (RemoteAction,),
-                                              {"remote_agent": agent, "remote_action": name,
+                                              {"remote_agent": agent, "remote_action": name, "codec": codec,
                                                "params": dict(getattr(local, "params", {}) or {}),
                                                "__module__": __name__})
         old = transitions[tid]
@@ -264,16 +272,18 @@ def _at(net: Net, tid: str, path: str | None, message: str, param: str | None = 
 
 
 def _check_places(net: Net, tid: str, path: str | None, name: str, local: type[Action],
-                  params: dict[str, Any]) -> None:
+                  params: dict[str, Any], registry: Registry) -> None:
     """The places a remote action's parameters name must be the net's (its ports are
-    read through the bridge, :mod:`petriflow.bridge.calls`); an action that declares
-    resources cannot run on a remote agent (they are not served)."""
+    read through the bridge, :mod:`petriflow.bridge.calls`); the resources it declares
+    must be ``core.liveness`` (served by calls) or made per world (registered
+    ``per_world``: the agent makes them from its own world), never the run's own."""
     resources = getattr(local, "resources", None) or {}
-    unserved = sorted(r for r, kind in resources.items() if kind != LIVENESS)  # liveness is served by calls
+    unserved = sorted(r for r, kind in resources.items()
+                      if kind != LIVENESS and not registry.per_world(kind))
     if unserved:
-        raise _at(net, tid, path, f"action {name} takes the run's resource(s) {', '.join(unserved)},"
-                  f" which are not served to remote agents (only {LIVENESS} is; leave its subnet out of bridge:"
-                  " agents)")
+        raise _at(net, tid, path, f"action {name} takes the run's resource(s) {', '.join(unserved)}, which are"
+                  f" not served to remote agents (served: {LIVENESS}, by calls; a resource registered per_world,"
+                  " made on the agent from its own world; leave its subnet out of bridge: agents)",)
     for pname, declared in getattr(local, "params", {}).items():
         for place in declared.place_names(params.get(pname)):
             if not isinstance(place, str) or place not in net.places:

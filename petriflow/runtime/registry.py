@@ -140,6 +140,8 @@ class Registry:
         self._states: dict[str, type] = {}
         self._resources: dict[str, Callable[..., Any]] = {}
         self._resource_settings: dict[str, Any] = {}
+        self._per_world: set[str] = set()
+        self._data_types: dict[str, type] = {}
         self._metrics: dict[str, MetricSpec] = {}
         self._channels: dict[str, Any] = {}
         self._plugins_pending = load_plugins
@@ -345,12 +347,16 @@ class Registry:
         return self._reads.get(name)
 
     def register_resource(self, name: str, factory: Callable[..., Any] | str, *, replace: bool = False,
-                          settings: Any = None) -> None:
+                          settings: Any = None, per_world: bool = False) -> None:
         """Register a resource type: ``factory(context) -> object`` (or a lazy
         ``"module:function"``) makes the run's one instance (see
         :mod:`petriflow.runtime.resources`); ``settings``: the world file's settings
         section it reads (a :class:`~petriflow.runtime.settings.Section`), read as the
-        actions' are for a run whose actions use it (``context.settings``)."""
+        actions' are for a run whose actions use it (``context.settings``).
+        ``per_world``: the resource is made from a world alone (its file's settings,
+        its bodies), never from the run's tokens or configuration, so wherever actions
+        run against a world of their own (a remote agent's ``--world``) it is made
+        there, by the same factory (docs/bridge.md, *Resources on the agent*)."""
         old = self._resources.get(name)
         if old is not None and not replace and _identity(old) != _identity(factory):
             raise PetriflowError(f"resource {name!r} is already registered")
@@ -359,6 +365,33 @@ class Registry:
                                  f" got {factory!r}")
         self._resources[name] = factory
         self._resource_settings[name] = settings
+        if per_world:
+            self._per_world.add(name)
+        else:
+            self._per_world.discard(name)
+
+    def per_world(self, name: str) -> bool:
+        """Whether the resource type ``name`` is made from a world alone (``per_world``
+        when registered), so an agent with a world of its own makes it there."""
+        self.load_plugins()
+        return name in self._per_world
+
+    def register_data_type(self, name: str, cls: type, *, replace: bool = False) -> None:
+        """Register a dataclass that token data carries (a message's payload) under
+        ``name``, so the bridge sends it as tagged JSON (``{"$type": NAME, field: value,
+        ...}``) and the other side rebuilds it (:mod:`petriflow.bridge.codec`)."""
+        import dataclasses
+
+        if name in self._data_types and not replace and self._data_types[name] is not cls:
+            raise PetriflowError(f"data type {name!r} is already registered")
+        if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):
+            raise PetriflowError(f"data type {name!r} must be a dataclass, got {cls!r}")
+        self._data_types[name] = cls
+
+    def data_types(self) -> dict[str, type]:
+        """``{name: dataclass}`` of the registered data types."""
+        self.load_plugins()
+        return dict(self._data_types)
 
     def resource_settings(self, name: str) -> Any:
         """The settings section the resource type ``name`` reads (``None``: none)."""

@@ -228,6 +228,22 @@ def start_middleware(kind: str, folder: Path) -> Broker | Router:
 INSIDE = "PETRIFLOW_TEST_OWN_NETWORK"
 
 
+def shipped_config(folder: Path, kind: str, server, out: Path) -> Path:
+    """A shipped net's ``run-KIND.yaml`` from ``folder``, its endpoint the test's ``server``
+    and its world the folder's, written into ``out``."""
+    config = (folder / f"run-{kind}.yaml").read_text().replace(
+        f"connect: tcp/127.0.0.1:{7447 if kind == 'zenoh' else 1883}", f"connect: {server.connect}")
+    assert server.connect in config
+    (out / "run.yaml").write_text(config.replace("world: world.yaml", f"world: {folder / 'world.yaml'}"))
+    return out / "run.yaml"
+
+
+def agent_command(names, kind: str, server, world: Path, log: Path, *extra: str) -> list[str]:
+    """``petriflow agent`` serving ``names`` with its own ``world``, one line per goal in ``log``."""
+    return [sys.executable, "-m", "petriflow.cli", "agent", *[a for name in names for a in ("--name", name)],
+            "--transport", kind, "--connect", server.connect, "--world", str(world), *extra, "--log", str(log)]
+
+
 def own_network(request) -> bool:
     """Run the calling test again in a network namespace of its own (``unshare -n``, loopback
     up, everything it starts inside it) when this machine permits one; ``True`` when it did

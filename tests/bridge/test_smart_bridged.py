@@ -16,6 +16,8 @@ import pytest
 from petriflow import examples
 from petriflow.runtime.session import run_files
 
+from tests.bridge.conftest import agent_command, shipped_config
+
 pytestmark = pytest.mark.slow
 
 ROBOTS = ("robot3l", "robot4l")
@@ -47,16 +49,10 @@ def test_smart_helping_over_each_transport_matches_the_simulated_order(middlewar
     executed once, and the walk's port read answered by the run."""
     kind, server = middleware
     folder = examples.path("smart", "smart.yaml").parent
-    config = (folder / f"run-{kind}.yaml").read_text().replace(
-        f"connect: tcp/127.0.0.1:{7447 if kind == 'zenoh' else 1883}", f"connect: {server.connect}")
-    assert server.connect in config
-    config = config.replace("world: world.yaml", f"world: {folder / 'world.yaml'}")
-    (tmp_path / "run.yaml").write_text(config)
+    shipped_config(folder, kind, server, tmp_path)
     env = {**os.environ, "PETRIFLOW_PATH": str(folder)}  # the run's world: the camera's arena
-    names = [arg for name in ROBOTS for arg in ("--name", name)]
-    agent = subprocess.Popen([sys.executable, "-m", "petriflow.cli", "agent", *names, "--transport", kind,
-                              "--connect", server.connect, "--world", str(folder / "world.yaml"), "--speed", "4",
-                              "--log", str(tmp_path / "agent.log")],
+    agent = subprocess.Popen(agent_command(ROBOTS, kind, server, folder / "world.yaml", tmp_path / "agent.log",
+                                           "--speed", "4"),
                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         run = subprocess.run([sys.executable, "-m", "petriflow.cli", "run", str(folder / "smart.yaml"), "--config",
