@@ -81,7 +81,6 @@ def test_rule_3_new_data_becomes_pending_and_goes_by_request():
     assert ro1.pending(2, 1) == 1
     assert ro1.outgoing(2) == [(1, ["x1"], "pending")]
     assert [m.code for m in plan(ro1, 2)] == [0]   # Algorithm 1: a query first
-    ro3 = History(3)
     assert [(m.code, m.count, len(m.vertices)) for m in plan(ro1, 3)] == [(3, 2, 2)]  # never sent to 3: at once
 
 
