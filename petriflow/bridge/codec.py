@@ -116,8 +116,8 @@ class Codec:
         if tag == MESSAGE:
             return self._build(tag, Message, fields)
         cls = self.types.get(tag) if isinstance(tag, str) else None
-        if cls is None:
-            return {k: self.decode(v) for k, v in value.items()}
+        if cls is None:  # untagged, or a tag this side does not know: the JSON object itself
+            return fields if TAG not in value else {TAG: tag, **fields}
         return self._build(tag, cls, fields)
 
     @staticmethod
