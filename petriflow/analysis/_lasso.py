@@ -19,15 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from petriflow.analysis._graph import COMPILED_FROM_EDGES
 from petriflow.analysis._numba import njit
 
 __all__ = ["accepting_lasso"]
 
 _jit = njit(__name__)
 
-#: Below this many product edges (graph edges times automaton edges) the loops run as
-#: plain Python: loading the compiled ones costs more than they save.
-COMPILED_FROM_EDGES = 30_000
 
 
 def _loops(edges: int) -> tuple:

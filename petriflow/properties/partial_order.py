@@ -106,11 +106,10 @@ class PropertyStubbornSets:
         self.compiled = compiled or CompiledNet(net)
         self.sets = StubbornSets(self.compiled)
         self.reduced = self.sets.reduced
-        self.effect = self.compiled.post_matrix - self.compiled.pre_matrix
+        self.effect = self.compiled.incidence
         index = self.compiled.place_index
         self.lowerers = [np.flatnonzero(self.effect[:, p] < 0).tolist() for p in range(len(index))]
         self.preset = {t: [(index[p], w) for p, w in net.preset(t).items()] for t in net.transitions}
-        self.enabled_rows = self.compiled.enabled
         self._checks: dict[Formula, object] = {}
         self._slopes: dict[Formula, tuple] = {}
 
@@ -208,7 +207,7 @@ class PropertyStubbornSets:
 
     def reach_set(self, goal: Formula, m) -> list[int]:
         """The enabled rows to explore from ``m`` (where ``goal`` is false)."""
-        enabled = self.enabled_rows(m)
+        enabled = self.compiled.enabled(m)
         if not enabled or not self.reduced:
             return enabled
         seeds = self.up_set(goal, m)
