@@ -108,29 +108,30 @@ def _load_bound(path: str, import_actions: bool = False, config: str | None = No
     return prepared.net, notes, config
 
 
-def _remote(net: Net, config: Any) -> dict[str, Any] | None:
+def _remote(net: Net, config: Any) -> tuple[dict[str, Any] | None, dict[str, str], dict[str, str]]:
     """What a run configuration's ``bridge:`` puts on remote agents: ``{transport, connect,
-    agents: {remote agent: {subnets, transitions}}}`` (``None``: no bridge)."""
+    agents: {remote agent: {subnets, transitions}}}`` (``None``: no bridge),
+    ``{subnet id: remote agent}`` and ``{transition: remote agent}``."""
     spec = getattr(config, "bridge", None)
     if spec is None:
-        return None
-    from petriflow.bridge.remote import remote_transitions
+        return None, {}, {}
+    from petriflow.bridge.remote import bridged_subnets, remote_transitions
 
-    on = remote_transitions(net, spec)
+    subnets = bridged_subnets(net, spec)
     agents: dict[str, dict[str, list[str]]] = {}
-    for subnet in net.subnets.values():
-        names = {on[t] for t in net.nodes_of(subnet.id)[1] if t in on}
-        for name in sorted(names):
-            agents.setdefault(name, {"subnets": [], "transitions": []})["subnets"].append(subnet.id)
+    for subnet in net.subnets:  # in the net's order
+        if subnet in subnets:
+            agents.setdefault(subnets[subnet], {"subnets": [], "transitions": []})["subnets"].append(subnet)
+    on = remote_transitions(net, spec)
     for tid, name in on.items():
         agents.setdefault(name, {"subnets": [], "transitions": []})["transitions"].append(tid)
-    return {"transport": spec.transport, "connect": spec.connect, "agents": dict(sorted(agents.items()))}
+    return ({"transport": spec.transport, "connect": spec.connect, "agents": dict(sorted(agents.items()))},
+            subnets, on)
 
 
 def cmd_info(args: argparse.Namespace) -> int:
     net, notes, config = _load_bound(args.net, args.import_actions, args.config)
-    remote = _remote(net, config)
-    on = {t: name for name, where in (remote or {"agents": {}})["agents"].items() for t in where["transitions"]}
+    remote, remote_subnets, on = _remote(net, config)
     info = {
         "net": net.id,
         "label": net.label,
@@ -147,7 +148,7 @@ def cmd_info(args: argparse.Namespace) -> int:
                 "agent": s.agent or s.id,
                 "places": net.nodes_of(s.id)[0],
                 "transitions": net.nodes_of(s.id)[1],
-                "remote_agent": next((on[t] for t in net.nodes_of(s.id)[1] if t in on), None),
+                "remote_agent": remote_subnets.get(s.id),
             }
             for s in net.subnets.values()
         },

@@ -451,9 +451,7 @@ class Control:
                     if not self._run.paced:
                         self._rest(PAUSED_STEP - (wallclock.monotonic() - began))
                 else:
-                    with self._wakeup:
-                        if not self._queue and not self.closed:
-                            self._wakeup.wait(0.25)
+                    self._rest(0.25)
                 waited = True
                 continue
             if waited:

@@ -57,7 +57,7 @@ class EventKind(Name):
     the tokens it ``added`` or ``removed``; or a breakpoint triggered (``hit``)."""
     FEEDBACK = "feedback"
     """A remote agent reported progress on a running firing's goal (``firing``,
-    ``goal``, the remote ``agent``, its ``data``): docs/bridge.md."""
+    ``goal``, the remote agent as ``remote_agent``, its ``data``): docs/bridge.md."""
 
 
 #: The kinds of events a run records, as written in traces.
