@@ -93,7 +93,6 @@ class AgentWatch:
         self.lost_at: dict[str, float] = {}  # lost remote agent -> the run's time it was lost
         self.listening = -1  # the tick of the Listen scheduled last
         self.runs: dict[str, list[str]] = {}
-        self.killed: set[str] = set()  # the net's agents a fault had killed when their remote agent was lost
         for subnet, remote in spec.agents.items():
             found = net.subnets.get(subnet) or next((s for s in net.subnets.values() if s.agent == subnet), None)
             if found is not None:
@@ -105,16 +104,12 @@ class AgentWatch:
         for remote in lost:
             self.lost_at[remote] = scheduler.now
             why = f"{remote!r}: {self.dispatcher.why_lost(remote)}"
-            alive = scheduler.alive
             for agent in self.runs.get(remote, []):
-                if not alive.get(agent, True):  # killed (a configured fault): it stays killed when back
-                    self.killed.add(agent)
                 scheduler.agent_lost(agent, why)
         for remote in back:
             self.lost_at.pop(remote, None)
             for agent in self.runs.get(remote, []):
-                if agent not in self.killed:
-                    scheduler.agent_back(agent)
+                scheduler.agent_back(agent)  # one a kill fault stopped stays stopped (Faults.rejoin)
         self.listen(scheduler)
 
     def listen(self, scheduler: Any) -> None:

@@ -65,6 +65,9 @@ class Faults:
         self.agents = list(agents)
         #: The agents not running now (killed, or not yet joined): every other agent runs.
         self.stopped: set[str] = set()
+        #: The agents stopped by :meth:`lose` alone: what :meth:`rejoin` starts again (an
+        #: agent a ``kill`` stopped, or one not joined yet, stays stopped).
+        self.lost: set[str] = set()
         self.down: set[frozenset[str]] = set()
         for fault in faults:
             kernel.schedule(kernel.ticks_at(fault.at), FaultEvent(self.apply, fault))
@@ -89,6 +92,7 @@ class Faults:
         emit = self.recorder.emit
         if fault.kind == FaultKind.KILL:
             self.stopped.add(fault.agent)
+            self.lost.discard(fault.agent)
             emit("fault", None, fault.agent, fault=FaultKind.KILL.value)
             self.on_stopped(fault.agent)
         elif fault.kind == FaultKind.JOIN:
@@ -104,11 +108,17 @@ class Faults:
     def lose(self, agent: str, why: str = "") -> None:
         """``agent`` stopped answering (a remote agent silent too long): it no longer
         runs, as if killed, until :meth:`rejoin`; the caller ends its running actions."""
-        self.stopped.add(agent)
+        if agent not in self.stopped:
+            self.lost.add(agent)
+            self.stopped.add(agent)
         self.recorder.emit("fault", None, agent, fault=FaultKind.LOST.value, **({"why": why} if why else {}))
 
     def rejoin(self, agent: str) -> None:
-        """A lost ``agent`` is back: it runs again, as a late joiner does."""
+        """A lost ``agent`` is back: it runs again, as a late joiner does (one that was
+        stopped before it was lost, killed or not joined yet, stays stopped)."""
+        if agent not in self.lost:
+            return
+        self.lost.discard(agent)
         self.stopped.discard(agent)
         self.recorder.emit("fault", None, agent, fault=FaultKind.BACK.value)
         self.on_started(agent)
